@@ -1,0 +1,165 @@
+// mfr render: one method on a scene, with images, maps and statistics.
+#include <cstdio>
+#include <fstream>
+#include <memory>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "mfr/core/colormap.hpp"
+#include "mfr/core/units.hpp"
+#include "mfr/method/render.hpp"
+#include "mfr/method/stats_json.hpp"
+
+namespace mfr::cli {
+namespace {
+
+struct RenderArgs {
+  SceneOptions scene;
+  std::string out = "mfr.png";
+  std::string depthComplexity;
+  std::string kMap;
+  std::string statsJson;
+  std::string method = "abuffer";
+  std::string budget;
+  std::optional<uint32_t> k;
+  std::string composite = "kbuffer";
+  int occupancyD = 1;
+  std::string capture = "tile";
+};
+
+Result<MethodDesc> buildMethod(const RenderArgs& a) {
+  auto method = methodPreset(a.method);
+  if (!method) return method.error();
+  MethodDesc m = method.value();
+  if (a.k) {
+    if (*a.k < 1 || *a.k > (1u << 20)) return makeError("--k: must be in [1, 1048576]");
+    if (m.allocation == AllocationPolicy::Unbounded)
+      return makeError("--k: the abuffer keeps every fragment; pick a bounded method");
+    if (m.name.rfind("zbuffer", 0) == 0 && *a.k != 1)
+      return makeError("--k: zbuffer has k = 1");
+    m.k = *a.k;
+  }
+  auto compositing = parseCompositing(a.composite);
+  if (!compositing) return makeError("--composite: " + compositing.error().message);
+  m.compositing = compositing.value();
+  if (m.occupancyWords > 0) {
+    if (a.occupancyD < 1 || a.occupancyD > 64) return makeError("--occupancy-d: must be in [1, 64]");
+    m.occupancyWords = a.occupancyD;
+  }
+  return m;
+}
+
+void writeMap(const std::string& path, const std::vector<uint32_t>& values, int w, int h,
+              const std::string& title) {
+  std::vector<float> v(values.begin(), values.end());
+  float maxValue = 1.0f;
+  for (float x : v) maxValue = std::max(maxValue, x);
+  auto written = writePng(path, colorMapWithLegend(v, w, h, maxValue, title));
+  if (!written) throw std::runtime_error(written.error().message);
+}
+
+int run(const RenderArgs& a) {
+  auto method = buildMethod(a);
+  if (!method) return fail(method.error().message);
+  RenderOptions options;
+  if (!a.budget.empty()) {
+    auto budget = parseByteSize(a.budget);
+    if (!budget) return fail(budget.error().message);
+    options.budgetBytes = budget.value();
+  }
+  if (a.capture == "parallel")
+    options.capture = CaptureMode::FragmentParallel;
+  else if (a.capture != "tile")
+    return fail("--capture '" + a.capture + "': expected tile or parallel");
+  if (a.out.empty()) return fail("--out: empty path");
+
+  Progress progress(!a.scene.quiet);
+  progress.set("loading " + a.scene.source);
+  auto prepared = prepareScene(a.scene);
+  if (!prepared) return fail(prepared.error().message);
+  const Scene& scene = prepared->scene;
+  options.background = scene.background;
+  const int views = static_cast<int>(prepared->cameras.size());
+  nlohmann::json allStats = nlohmann::json::array();
+  for (int v = 0; v < views; ++v) {
+    progress.set("rendering " + method->name, v, views);
+    RasterOptions ro;
+    ro.width = a.scene.width;
+    ro.height = a.scene.height;
+    ro.threads = a.scene.threads;
+    auto frame = RasterFrame::build(scene, prepared->cameras[v], ro);
+    if (!frame) return fail(a.scene.source + ": " + frame.error().message);
+    auto result = render(frame.value(), method.value(), options);
+    if (!result) return fail(a.scene.source + ": " + result.error().message);
+    const std::string out = viewPath(a.out, v, views);
+    auto written = writePng(out, encodeSrgb(result->image));
+    if (!written) return fail(written.error().message);
+    try {
+      if (!a.depthComplexity.empty()) {
+        const std::vector<uint32_t> n = result->depthComplexity.empty()
+                                            ? countFragments(frame.value())
+                                            : result->depthComplexity;
+        writeMap(viewPath(a.depthComplexity, v, views), n, ro.width, ro.height,
+                 "fragments per pixel");
+      }
+      if (!a.kMap.empty())
+        writeMap(viewPath(a.kMap, v, views), result->kMap, ro.width, ro.height, "k(p)");
+    } catch (const std::exception& e) {
+      return fail(e.what());
+    }
+    nlohmann::json stats = statsToJson(result->stats);
+    stats["scene"] = a.scene.source;
+    stats["width"] = ro.width;
+    stats["height"] = ro.height;
+    stats["image"] = out;
+    stats["view"] = v;
+    stats["compositing"] = toString(method->compositing);
+    stats["capture"] = a.capture;
+    allStats.push_back(stats);
+    if (!a.scene.quiet && !a.scene.json) {
+      const RenderStats& s = result->stats;
+      std::fprintf(stderr,
+                   "\r\033[K%s: %s  %llu fragments, %llu captured (%.2f%% lost), k %u-%u, %s, "
+                   "%.1f ms\n",
+                   method->name.c_str(), out.c_str(),
+                   static_cast<unsigned long long>(s.fragmentsGenerated),
+                   static_cast<unsigned long long>(s.captured), s.lostPercent(), s.kMin, s.kMax,
+                   formatBytes(s.bytesUsed).c_str(), s.totalMs());
+    }
+  }
+  const nlohmann::json statsOut = views == 1 ? allStats[0] : allStats;
+  if (!a.statsJson.empty()) {
+    std::ofstream f(a.statsJson);
+    if (!f) return fail(a.statsJson + ": cannot write");
+    f << statsOut.dump(2) << "\n";
+  }
+  if (a.scene.json) std::printf("%s\n", statsOut.dump(2).c_str());
+  return 0;
+}
+
+}  // namespace
+
+Runner addRenderCommand(CLI::App& app) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method");
+  args->scene.add(*cmd);
+  cmd->add_option("--out,-o", args->out, "Output PNG (sRGB)");
+  cmd->add_option("--depth-complexity", args->depthComplexity,
+                  "Write the fragments-per-pixel map (colour-mapped PNG with legend)");
+  cmd->add_option("--k-map", args->kMap, "Write the per-pixel k as a colour-mapped PNG");
+  cmd->add_option("--stats-json", args->statsJson, "Write the run's statistics as JSON");
+  cmd->add_option("--method,-m", args->method,
+                  "zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic "
+                  "(+occupancy)");
+  cmd->add_option("--budget,-M", args->budget, "Memory budget, e.g. 20MB (MB = 2^20 bytes)");
+  cmd->add_option("--k", args->k, "Explicit k (otherwise derived from the budget)");
+  cmd->add_option("--composite", args->composite, "kbuffer or hybrid");
+  cmd->add_option("--occupancy-d", args->occupancyD, "Occupancy map: 32*d buckets (default 1)");
+  cmd->add_option("--capture", args->capture,
+                  "tile (tile-owned, lock-free) or parallel (fragment-parallel, spin-locks)");
+  return [args] { return run(*args); };
+}
+
+}  // namespace mfr::cli

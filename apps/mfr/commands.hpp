@@ -1,0 +1,14 @@
+#pragma once
+
+#include <functional>
+
+#include <CLI/CLI.hpp>
+
+namespace mfr::cli {
+
+/// Each command registers its subcommand and returns the function that runs it (exit code).
+using Runner = std::function<int()>;
+Runner addRenderCommand(CLI::App& app);
+Runner addInfoCommand(CLI::App& app);
+
+}  // namespace mfr::cli

@@ -1,0 +1,142 @@
+#include "common.hpp"
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "mfr/raster/raster_frame.hpp"
+
+namespace mfr::cli {
+
+void SceneOptions::add(CLI::App& app) {
+  app.add_option("scene", source, "Scene file (.gltf .glb .obj .ply .json) or procedural:NAME[?k=v&...]")
+      ->required();
+  app.add_option("--width", width, "Image width in pixels (1-16384)");
+  app.add_option("--height", height, "Image height in pixels (1-16384)");
+  app.add_option("--camera", camera, "EX,EY,EZ,TX,TY,TZ[,UX,UY,UZ[,FOV]]: eye, target, up, fov (deg)")
+      ->delimiter(',')
+      ->expected(6, 10);
+  app.add_option("--view", view, "Use the scene file's camera number N (0-based)");
+  app.add_option("--orbit", orbit, "Render N views on a circle around the scene");
+  app.add_option("--threads", threads, "Worker threads (default: all cores)");
+  app.add_option("--seed", seed, "Seed for procedural scenes and noise (default 1)");
+  app.add_option("--alpha", alpha, "Override every material's alpha (render the whole scene transparent)");
+  app.add_option("--background", background, "Background R,G,B (linear, 0-1)")->delimiter(',')->expected(3);
+  app.add_option("--transmission-floor", transmissionFloor,
+                 "Alpha floor for KHR_materials_transmission glass (alpha = max(floor, 1 - transmission))");
+  app.add_flag("--quiet,-q", quiet, "No progress or summary on the terminal");
+  app.add_flag("--json", json, "Print machine-readable JSON on stdout");
+}
+
+Result<PreparedScene> prepareScene(const SceneOptions& o) {
+  auto finiteAll = [](const std::vector<double>& v) {
+    for (double x : v)
+      if (!std::isfinite(x)) return false;
+    return true;
+  };
+  if (o.width < 1 || o.height < 1 || o.width > kMaxImageSize || o.height > kMaxImageSize)
+    return makeError("--width/--height " + std::to_string(o.width) + "x" + std::to_string(o.height) +
+                     ": must be in [1, " + std::to_string(kMaxImageSize) + "]");
+  if (o.threads < 0 || o.threads > 1024)
+    return makeError("--threads " + std::to_string(o.threads) + ": must be in [1, 1024]");
+  if (o.orbit < 0 || o.orbit > 10000)
+    return makeError("--orbit " + std::to_string(o.orbit) + ": must be in [1, 10000]");
+  if (o.alpha && !(*o.alpha >= 0.0 && *o.alpha <= 1.0))
+    return makeError("--alpha: must be in [0, 1]");
+  if (!finiteAll(o.background) || !finiteAll(o.camera))
+    return makeError("--camera/--background: values must be finite numbers");
+  if (!(o.transmissionFloor >= 0.0 && o.transmissionFloor <= 1.0))
+    return makeError("--transmission-floor: must be in [0, 1]");
+  for (double b : o.background)
+    if (b < 0.0 || b > 1.0) return makeError("--background: components must be in [0, 1]");
+  if (o.camera.size() != 0 && o.camera.size() != 6 && o.camera.size() != 9 && o.camera.size() != 10)
+    return makeError("--camera: expected 6, 9 or 10 numbers");
+
+  LoadOptions load;
+  load.seed = o.seed;
+  load.transmissionAlphaFloor = static_cast<float>(o.transmissionFloor);
+  auto loaded = loadScene(o.source, load);
+  if (!loaded) return loaded.error();
+  PreparedScene prepared{std::move(loaded.value()), {}};
+  Scene& scene = prepared.scene;
+  if (o.alpha) scene.alphaOverride = static_cast<float>(*o.alpha);
+  if (o.background.size() == 3)
+    scene.background = glm::vec3(o.background[0], o.background[1], o.background[2]);
+
+  Camera camera;
+  if (!o.camera.empty()) {
+    camera.eye = glm::vec3(o.camera[0], o.camera[1], o.camera[2]);
+    camera.target = glm::vec3(o.camera[3], o.camera[4], o.camera[5]);
+    if (o.camera.size() >= 9) camera.up = glm::vec3(o.camera[6], o.camera[7], o.camera[8]);
+    if (o.camera.size() == 10) camera.fovYDegrees = static_cast<float>(o.camera[9]);
+  } else if (o.view >= 0) {
+    if (o.view >= static_cast<int>(scene.cameras.size()))
+      return makeError(o.source + ": --view " + std::to_string(o.view) + " but the scene has " +
+                       std::to_string(scene.cameras.size()) + " camera(s)");
+    camera = scene.cameras[o.view];
+  } else if (scene.defaultCamera) {
+    camera = *scene.defaultCamera;
+  } else {
+    camera = frameBounds(sceneBounds(scene));
+  }
+  prepared.cameras = o.orbit > 0 ? orbit(camera, o.orbit) : std::vector<Camera>{camera};
+  return prepared;
+}
+
+std::string viewPath(const std::string& path, int view, int views) {
+  if (views <= 1 || path.empty()) return path;
+  std::filesystem::path p(path);
+  char suffix[32];
+  std::snprintf(suffix, sizeof suffix, "_v%03d", view);
+  return (p.parent_path() / (p.stem().string() + suffix + p.extension().string())).string();
+}
+
+Progress::Progress(bool enabled) : enabled_(enabled && isatty(STDERR_FILENO)) {
+  if (enabled_) thread_ = std::thread([this] { loop(); });
+}
+
+Progress::~Progress() {
+  stop_ = true;
+  if (thread_.joinable()) thread_.join();
+  if (printed_) std::fprintf(stderr, "\r\033[K");
+}
+
+void Progress::set(const std::string& stage, int done, int total) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  stage_ = stage;
+  done_ = done;
+  total_ = total;
+}
+
+void Progress::loop() {
+  const auto start = std::chrono::steady_clock::now();
+  static const char spinner[] = "|/-\\";
+  int tick = 0;
+  while (!stop_) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    const double elapsed =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (elapsed < 1.0 || stop_) continue;
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::string bar;
+    if (total_ > 0) {
+      const int width = 24, filled = done_ * width / total_;
+      bar = "[" + std::string(filled, '#') + std::string(width - filled, '.') + "] " +
+            std::to_string(done_) + "/" + std::to_string(total_) + " ";
+    }
+    std::fprintf(stderr, "\r\033[K%c %s%s  %.1fs", spinner[tick++ % 4], bar.c_str(),
+                 stage_.c_str(), elapsed);
+    std::fflush(stderr);
+    printed_ = true;
+  }
+}
+
+int fail(const std::string& message) {
+  std::fprintf(stderr, "mfr: error: %s\n", message.c_str());
+  return 1;
+}
+
+}  // namespace mfr::cli

@@ -1,0 +1,70 @@
+// Shared pieces of the mfr command line: scene/camera options, progress display, output helpers.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "mfr/core/result.hpp"
+#include "mfr/scene/load.hpp"
+
+namespace mfr::cli {
+
+/// Options every scene-rendering command shares.
+struct SceneOptions {
+  std::string source;
+  int width = 1024;
+  int height = 1024;
+  std::vector<double> camera;  // eye(3) target(3) [up(3) [fov]]
+  int view = -1;               // camera of the file, by index
+  int orbit = 0;               // N views around the scene
+  int threads = 0;
+  uint64_t seed = 1;
+  std::optional<double> alpha;
+  std::vector<double> background;
+  double transmissionFloor = 0.1;
+  bool quiet = false;
+  bool json = false;
+
+  void add(CLI::App& app);
+};
+
+struct PreparedScene {
+  Scene scene;
+  std::vector<Camera> cameras;  // one per view to render
+};
+
+/// Loads the scene, applies overrides and resolves the cameras. Errors name the input.
+Result<PreparedScene> prepareScene(const SceneOptions& options);
+
+/// "out.png" -> "out_v003.png" when rendering several views.
+std::string viewPath(const std::string& path, int view, int views);
+
+/// A progress line on a terminal (stderr), shown only for work that lasts more than a second.
+class Progress {
+ public:
+  explicit Progress(bool enabled);
+  ~Progress();
+  void set(const std::string& stage, int done = -1, int total = -1);
+
+ private:
+  void loop();
+  bool enabled_;
+  std::atomic<bool> stop_{false};
+  std::mutex mutex_;
+  std::string stage_;
+  int done_ = -1, total_ = -1;
+  bool printed_ = false;
+  std::thread thread_;
+};
+
+/// Prints "mfr: error: <message>" and returns the exit code 1.
+int fail(const std::string& message);
+
+}  // namespace mfr::cli

@@ -1,0 +1,27 @@
+// mfr: bounded-memory multi-fragment rendering from the command line. Parses, calls the library,
+// reports; every failure is one line on stderr and a non-zero exit.
+#include <cstdio>
+#include <exception>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"mfr: bounded-memory multi-fragment rendering and order-independent transparency"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "mfr 0.1.0");
+  const mfr::cli::Runner render = mfr::cli::addRenderCommand(app);
+  const mfr::cli::Runner info = mfr::cli::addInfoCommand(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  try {
+    if (app.got_subcommand("render")) return render();
+    if (app.got_subcommand("info")) return info();
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "mfr: error: %s\n", e.what());
+    return 1;
+  }
+  return 2;
+}

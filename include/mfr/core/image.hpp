@@ -1,0 +1,42 @@
+// Images: linear float RGB for compositing and metrics, sRGB8 RGBA for files.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/core/result.hpp"
+
+namespace mfr {
+
+/// Linear-light RGB image, rows top to bottom.
+struct ImageRGB {
+  int width = 0;
+  int height = 0;
+  std::vector<glm::vec3> pixels;
+
+  ImageRGB() = default;
+  ImageRGB(int w, int h, glm::vec3 fill = glm::vec3(0.0f))
+      : width(w), height(h), pixels(static_cast<size_t>(w) * static_cast<size_t>(h), fill) {}
+  glm::vec3& at(int x, int y) { return pixels[static_cast<size_t>(y) * width + x]; }
+  const glm::vec3& at(int x, int y) const { return pixels[static_cast<size_t>(y) * width + x]; }
+};
+
+/// 8-bit RGBA image as stored in a PNG (sRGB-encoded colour), rows top to bottom.
+struct Image8 {
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> rgba;  // width * height * 4
+};
+
+/// sRGB-encodes a linear image (alpha 255).
+Image8 encodeSrgb(const ImageRGB& image);
+/// Decodes an sRGB8 image to linear floats (alpha ignored).
+ImageRGB decodeSrgb(const Image8& image);
+
+Result<void> writePng(const std::string& path, const Image8& image);
+Result<Image8> readPng(const std::string& path);
+
+}  // namespace mfr

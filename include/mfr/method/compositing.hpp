@@ -1,0 +1,74 @@
+// Compositing rules of the resolve pass, on linear RGB.
+//
+// kbuffer: front-to-back "over" of the depth-sorted captured fragments, then the background:
+//   C = sum_i c_i a_i T_i,  T_i = prod_{j<i} (1 - a_j),  final = C + T_n * background.
+//
+// hybrid (hybrid transparency, Maule et al. 2013, as used by DHOIT sec. 3.3): the sorted core as
+// above gives C_core and 1 - alpha_core = T_k; the t = n - k fragments not kept (culled, rejected
+// or evicted) were accumulated order-independently into sum(a_i c_i), sum(a_i) and t, so
+//   C_tail = sum(a_i c_i) / sum(a_i),  a_avg = sum(a_i) / t,  alpha_tail = 1 - (1 - a_avg)^t
+//   final = C_core + (1 - alpha_core) * (alpha_tail * C_tail + (1 - alpha_tail) * background).
+// The tail colour is weighted by the tail's opacity alpha_tail (the public DHOIT shader forgets
+// this factor). With an empty tail the result is bit-identical to the kbuffer rule.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "mfr/core/color.hpp"
+#include "mfr/raster/fragment.hpp"
+
+namespace mfr {
+
+/// Hybrid tail accumulators of one pixel: 20 bytes.
+struct HybridTail {
+  float r = 0.0f, g = 0.0f, b = 0.0f;  // sum of alpha * linear colour
+  float alpha = 0.0f;                  // sum of alpha
+  uint32_t count = 0;                  // t
+
+  void add(uint32_t rgba) {
+    const glm::vec4 c = unpackFragmentColor(rgba);
+    r += c.a * c.r;
+    g += c.a * c.g;
+    b += c.a * c.b;
+    alpha += c.a;
+    ++count;
+  }
+};
+static_assert(sizeof(HybridTail) == 20);
+
+/// Front-to-back over of `n` sorted nodes; returns the colour and leaves the transmittance in T.
+inline glm::vec3 compositeCore(const FragmentNode* sorted, uint32_t n, float& transmittance) {
+  glm::vec3 color(0.0f);
+  float T = 1.0f;
+  for (uint32_t i = 0; i < n; ++i) {
+    const glm::vec4 c = unpackFragmentColor(nodeColor(sorted[i]));
+    color += glm::vec3(c) * (c.a * T);
+    T *= 1.0f - c.a;
+  }
+  transmittance = T;
+  return color;
+}
+
+inline glm::vec3 compositeKBuffer(const FragmentNode* sorted, uint32_t n, glm::vec3 background) {
+  float T;
+  const glm::vec3 core = compositeCore(sorted, n, T);
+  return core + T * background;
+}
+
+inline glm::vec3 compositeHybrid(const FragmentNode* sorted, uint32_t n, const HybridTail& tail,
+                                 glm::vec3 background) {
+  float T;
+  const glm::vec3 core = compositeCore(sorted, n, T);
+  if (tail.count == 0 || tail.alpha <= 0.0f) return core + T * background;
+  const glm::vec3 tailColor = glm::vec3(tail.r, tail.g, tail.b) / tail.alpha;
+  const float avgAlpha = tail.alpha / static_cast<float>(tail.count);
+  const float tailAlpha =
+      1.0f - std::pow(std::max(0.0f, 1.0f - avgAlpha), static_cast<float>(tail.count));
+  return core + T * (tailAlpha * tailColor + (1.0f - tailAlpha) * background);
+}
+
+}  // namespace mfr

@@ -1,0 +1,42 @@
+// Memory accounting of every method, following DHOIT Eq. 1:
+//   F(M) = floor((M - |P| * S_p - S_i) / S_f)
+// the number of 8-byte fragment nodes (S_f = 8) a budget of M bytes buys once the per-pixel
+// overhead S_p of the method (over all |P| = width * height pixels: full-screen buffers) and its
+// image-level overhead S_i are paid. Per-pixel words by component:
+//
+//   counter   4 B  fragments stored so far (also the count pass's counter)    every method
+//   offset    4 B  first slot of the pixel's region (prefix sum)            abuffer, kplus-sb, dynamic
+//   lock      4 B  spin-lock semaphore                                       k+-buffer family
+//   occupancy 12 + 4d B  zn, zf, k-th bucket, 32d-bit bitmap                 +occupancy
+//   tail      20 B  hybrid tail: sum(alpha * rgb) 3 x f32, sum(alpha) f32, count u32   hybrid
+//   image     4096 B  depth-complexity histogram, 1024 x u32                 kplus-dynamic
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <string>
+
+#include "mfr/method/method.hpp"
+
+namespace mfr {
+
+inline constexpr uint64_t kNodeBytes = 8;
+inline constexpr uint64_t kHistogramBins = 1024;
+
+struct MemoryModel {
+  uint64_t counter = 4, offset = 0, lock = 0, occupancy = 0, tail = 0;  // bytes per pixel
+  uint64_t image = 0;                                                   // bytes per image
+
+  static MemoryModel of(const MethodDesc& method);
+  uint64_t perPixel() const { return counter + offset + lock + occupancy + tail; }
+  uint64_t overhead(uint64_t pixels) const { return pixels * perPixel() + image; }
+  /// F(M): fragment slots a budget buys (0 when the overhead alone exceeds it).
+  uint64_t fragmentSlots(uint64_t budget, uint64_t pixels) const {
+    const uint64_t fixed = overhead(pixels);
+    return budget > fixed ? (budget - fixed) / kNodeBytes : 0;
+  }
+  /// Bytes by category for `slots` allocated nodes.
+  std::map<std::string, uint64_t> breakdown(uint64_t pixels, uint64_t slots) const;
+};
+
+}  // namespace mfr

@@ -1,0 +1,66 @@
+// A method is a composition: allocation policy x fragment store x culling test x compositing rule,
+// run as the passes count -> allocate -> capture -> resolve. The same description drives every
+// backend; presets name the combinations of the papers.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "mfr/capture/fragment_stores.hpp"
+#include "mfr/core/result.hpp"
+
+namespace mfr {
+
+/// How many fragment slots each pixel gets.
+enum class AllocationPolicy : uint8_t {
+  Unbounded,  // count pass, exact slots for every fragment (A-buffer / S-buffer)
+  FixedK,     // the same k pre-allocated for every pixel (k-buffer, k+-buffer)
+  CountedK,   // count pass capped at k, prefix-sum offsets, exact memory (K+B-SB)
+  DynamicK,   // largest global k whose exact memory fits the budget, from the histogram
+};
+
+/// Which store holds a pixel's fragments.
+enum class StoreChoice : uint8_t {
+  Append,    // exact-size arrays (only with Unbounded)
+  MaxArray,
+  MaxHeap,
+  PerPixel,  // K+B-SB rule: max-heap when n(p) > k(p) and k(p) > 16, else max-array
+};
+
+enum class CullingTest : uint8_t {
+  None,   // insertion with replacement, no test before the critical section
+  KPlus,  // reject a fragment not nearer than the current maximum of a full store, re-check inside
+};
+
+enum class Compositing : uint8_t {
+  KBuffer,  // sort the captured fragments, composite front to back, drop the rest
+  Hybrid,   // sorted core + order-independent tail (hybrid transparency)
+};
+
+struct MethodDesc {
+  std::string name;
+  AllocationPolicy allocation = AllocationPolicy::Unbounded;
+  StoreChoice store = StoreChoice::Append;
+  CullingTest culling = CullingTest::None;
+  bool perPixelLock = false;  // spin-lock word per pixel (k+-buffer family)
+  int occupancyWords = 0;     // 0: no occupancy culling; d > 0: 32*d buckets
+  Compositing compositing = Compositing::KBuffer;
+  std::optional<uint32_t> k;  // explicit k (otherwise derived from the budget)
+};
+
+/// Preset names: zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, each
+/// optionally followed by "+occupancy".
+std::vector<std::string> presetNames();
+
+/// Looks up a preset ("kplus-heap", "fkb+occupancy", ...). Errors list the known names.
+Result<MethodDesc> methodPreset(const std::string& name);
+
+const char* toString(AllocationPolicy a);
+const char* toString(StoreChoice s);
+const char* toString(CullingTest c);
+const char* toString(Compositing c);
+Result<Compositing> parseCompositing(const std::string& text);
+
+}  // namespace mfr

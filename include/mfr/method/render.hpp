@@ -1,0 +1,82 @@
+// Runs a method description on a rasterized frame: count -> allocate -> [occupancy] -> capture ->
+// resolve, with exact memory accounting and per-pass statistics.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/core/image.hpp"
+#include "mfr/core/result.hpp"
+#include "mfr/method/method.hpp"
+#include "mfr/raster/raster_frame.hpp"
+
+namespace mfr {
+
+enum class CaptureMode : uint8_t {
+  TileOwned,         // each tile owned by one worker: no locks, deterministic
+  FragmentParallel,  // the paper's algorithm as written: triangles from many threads, per-pixel
+                     // spin-locks, culling test outside the critical section and again inside
+};
+
+struct RenderOptions {
+  std::optional<uint64_t> budgetBytes;  // M; required by bounded presets unless k is explicit
+  CaptureMode capture = CaptureMode::TileOwned;
+  glm::vec3 background{1.0f};  // linear RGB
+  bool keepStores = false;     // keep the captured nodes in the output (tests, tools)
+};
+
+struct PassTime {
+  std::string name;
+  double ms = 0.0;
+};
+
+struct RenderStats {
+  std::string method;
+  std::optional<uint64_t> budgetBytes;
+  uint64_t bytesUsed = 0;
+  std::map<std::string, uint64_t> bytesByCategory;
+  uint64_t fragmentSlots = 0;  // nodes allocated
+  uint64_t fragmentsGenerated = 0;
+  uint64_t culledOccupancy = 0;  // rejected by the occupancy threshold
+  uint64_t culledKPlus = 0;      // rejected by the k+ test before the critical section
+  uint64_t rejectedInStore = 0;  // rejected inside the critical section (re-check / full store)
+  uint64_t inserted = 0;
+  uint64_t evicted = 0;
+  uint64_t captured = 0;  // fragments in the final cores
+  uint64_t lost = 0;      // generated - captured
+  uint64_t coveredPixels = 0;
+  uint32_t kMin = 0, kMax = 0;  // slots over covered pixels
+  std::optional<uint32_t> globalK;  // fixed / counted / dynamic k
+  std::optional<uint32_t> maxDepthComplexity;  // when a count pass ran
+  std::optional<double> meanDepthComplexity;   // over covered pixels
+  std::vector<PassTime> passes;
+  double lostPercent() const {
+    return fragmentsGenerated ? 100.0 * static_cast<double>(lost) / fragmentsGenerated : 0.0;
+  }
+  double totalMs() const;
+};
+
+struct RenderOutput {
+  ImageRGB image;                       // linear RGB, composited over the background
+  std::vector<uint32_t> kMap;           // slots per pixel
+  std::vector<uint32_t> depthComplexity;  // n(p), when a count pass ran (else empty)
+  RenderStats stats;
+  // with keepStores: pixel p's captured nodes are nodes[offsets[p] .. offsets[p] + counts[p]),
+  // unsorted, as the store left them
+  std::vector<FragmentNode> nodes;
+  std::vector<uint64_t> offsets;
+  std::vector<uint32_t> counts;
+};
+
+Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
+                            const RenderOptions& options);
+
+/// Per-pixel fragment counts n(p) (a Coverage count pass).
+std::vector<uint32_t> countFragments(const RasterFrame& frame);
+
+}  // namespace mfr

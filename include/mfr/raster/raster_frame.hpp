@@ -1,0 +1,142 @@
+// CPU rasterizer with OpenGL's rules, so the GPU backend can be compared pixel for pixel:
+//   - pixel centres at (x + 0.5, y + 0.5); vertices snapped to 1/256 pixel (8 sub-pixel bits);
+//   - a fill rule that covers a pixel centre on a shared edge exactly once (top-left in the image's
+//     y-down coordinates, which is GL's lower-left-origin rule seen upside down);
+//   - clipping in homogeneous clip space against near and far (z = -w, z = w) and an x/y guard band;
+//   - perspective-correct attributes, depth = window z in [0, 1] interpolated linearly in screen;
+//   - no back-face culling (transparent geometry shows both sides).
+// Set-up transforms, clips and bins the triangles once per frame into square tiles; every capture
+// pass then rasterizes tile by tile. A tile is owned by one worker for the whole pass, so per-pixel
+// updates need no locks, and within a pixel fragments arrive in primitive order: output is the same
+// for any thread count.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/core/result.hpp"
+#include "mfr/raster/fragment.hpp"
+#include "mfr/scene/scene.hpp"
+
+namespace mfr {
+
+inline constexpr int kMaxImageSize = 16384;
+/// Shading: colour = base * (kAmbient + (1 - kAmbient) * |n.v|) (headlight diffuse).
+inline constexpr float kAmbient = 0.2f;
+
+struct RasterOptions {
+  int width = 512;
+  int height = 512;
+  int tileSize = 32;  // pixels per tile side
+  int threads = 0;    // 0 = all cores
+};
+
+/// Shading inputs of one material, resolved once per frame.
+struct ShadeMaterial {
+  glm::vec3 color{1.0f};  // linear base colour
+  float alpha = 1.0f;     // material alpha (factor, after transmission folding)
+  const Texture* texture = nullptr;
+  AlphaMode mode = AlphaMode::Opaque;
+  float cutoff = 0.5f;
+  bool alphaOverridden = false;
+  float overrideAlpha = 1.0f;
+};
+
+/// Everything the inner loop needs of one (clipped) screen-space triangle.
+struct TriangleSetup {
+  int32_t x[3], y[3];            // fixed-point window coordinates (1/256 px), y down, area > 0
+  int32_t minX, minY, maxX, maxY;  // inclusive pixel bounds of covered centres, clamped to viewport
+  float z[3];                    // window depth
+  float invW[3];                 // 1 / clip w
+  glm::vec3 normalW[3];          // view-space normal / w
+  glm::vec2 uvW[3];              // uv / w
+  float invArea;                 // 1 / (twice the fixed-point area)
+  uint32_t prim;
+  uint32_t material;
+  uint8_t topLeft;  // bit i set: edge opposite vertex i is a top or left edge
+};
+
+enum class ShadeMode {
+  Coverage,  // depth and alpha test only (count / depth-range / occupancy passes)
+  Full,      // plus shaded colour and n.v (capture passes)
+};
+
+struct TileRect {
+  int x0, y0, x1, y1;  // inclusive
+};
+
+class RasterFrame {
+ public:
+  /// Validates the size, fits the clip planes to the scene, transforms, clips and bins.
+  static Result<RasterFrame> build(const Scene& scene, const Camera& camera,
+                                   const RasterOptions& options);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  size_t pixelCount() const { return static_cast<size_t>(width_) * height_; }
+  int threads() const { return threads_; }
+  const Camera& camera() const { return camera_; }
+
+  int tileCount() const { return tilesX_ * tilesY_; }
+  TileRect tileRect(int tile) const;
+  /// Triangle set-ups overlapping a tile, in primitive order.
+  const uint32_t* tileBegin(int tile) const { return binned_.data() + binOffsets_[tile]; }
+  const uint32_t* tileEnd(int tile) const { return binned_.data() + binOffsets_[tile + 1]; }
+
+  const std::vector<TriangleSetup>& setups() const { return setups_; }
+
+  /// Rasterizes every triangle binned to `tile`, restricted to the tile. For each covered pixel
+  /// centre that survives the alpha test it calls sink.accept(pixel, depth) (an early test before
+  /// shading, like early-z), and when that returns true, shades (Full mode) and calls
+  /// sink.emit(const Fragment&).
+  template <ShadeMode Mode, class Sink>
+  void rasterizeTile(int tile, Sink&& sink) const;
+
+  /// Rasterizes one set-up triangle over the whole viewport (fragment-parallel capture).
+  template <ShadeMode Mode, class Sink>
+  void rasterizeTriangle(size_t setupIndex, Sink&& sink) const;
+
+  /// Runs fn(tile) for every tile on the frame's worker threads, each tile on one worker.
+  template <class Fn>
+  void forEachTile(Fn&& fn) const;
+
+ private:
+  template <ShadeMode Mode, class Sink>
+  void rasterizeRect(const TriangleSetup& t, int x0, int y0, int x1, int y1, Sink& sink) const;
+  // alpha test and base colour (texture x factor); false when the fragment is discarded
+  template <ShadeMode Mode>
+  bool surface(const TriangleSetup& t, const ShadeMaterial& m, float l0, float l1, float l2,
+               glm::vec4& base) const;
+  // colour and n.v of a surviving fragment
+  void shade(const TriangleSetup& t, float l0, float l1, float l2, int px, int py,
+             const glm::vec4& base, Fragment& f) const;
+
+  int width_ = 0, height_ = 0, threads_ = 1, tileSize_ = 32, tilesX_ = 0, tilesY_ = 0;
+  Camera camera_;
+  std::vector<TriangleSetup> setups_;
+  std::vector<uint32_t> binned_;
+  std::vector<uint32_t> binOffsets_;
+  std::vector<ShadeMaterial> materials_;
+  // view-ray reconstruction: direction of pixel centre (x, y) in view space is
+  // (x * rayScaleX + rayBiasX, y * rayScaleY + rayBiasY, -1)
+  float rayScaleX_ = 0, rayBiasX_ = 0, rayScaleY_ = 0, rayBiasY_ = 0;
+};
+
+/// Adapts a callable taking a Fragment to the sink protocol (accepts everything).
+template <class F>
+struct EmitAll {
+  F fn;
+  bool accept(uint32_t, float) const { return true; }
+  void emit(const Fragment& f) { fn(f); }
+};
+template <class F>
+EmitAll(F) -> EmitAll<F>;
+
+/// Resolves a number of threads: 0 means all hardware threads.
+int resolveThreads(int threads);
+
+}  // namespace mfr
+
+#include "mfr/raster/raster_frame_impl.hpp"

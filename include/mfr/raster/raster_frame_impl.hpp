@@ -1,0 +1,162 @@
+// Inner loops of RasterFrame (templates over the shading mode and the fragment sink, so that each
+// capture pass compiles to one tight loop). Included by raster_frame.hpp only.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "mfr/core/color.hpp"
+
+namespace mfr {
+
+inline TileRect RasterFrame::tileRect(int tile) const {
+  const int tx = tile % tilesX_, ty = tile / tilesX_;
+  return {tx * tileSize_, ty * tileSize_, std::min(width_, (tx + 1) * tileSize_) - 1,
+          std::min(height_, (ty + 1) * tileSize_) - 1};
+}
+
+template <class Fn>
+void RasterFrame::forEachTile(Fn&& fn) const {
+  tbb::task_arena arena(threads_);
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, tileCount(), 1),
+                      [&](const tbb::blocked_range<int>& r) {
+                        for (int tile = r.begin(); tile != r.end(); ++tile) fn(tile);
+                      });
+  });
+}
+
+namespace detail {
+/// Bilinear sample with repeat wrapping; returns linear RGB and alpha.
+inline glm::vec4 sampleTexture(const Texture& tex, glm::vec2 uv) {
+  const ColorTables& t = ColorTables::get();
+  const float fx = uv.x * static_cast<float>(tex.width) - 0.5f;
+  const float fy = uv.y * static_cast<float>(tex.height) - 0.5f;
+  const float flx = std::floor(fx), fly = std::floor(fy);
+  const float ax = fx - flx, ay = fy - fly;
+  auto wrap = [](long v, int n) { return static_cast<int>(((v % n) + n) % n); };
+  const long ix = std::isfinite(flx) ? static_cast<long>(flx) : 0;
+  const long iy = std::isfinite(fly) ? static_cast<long>(fly) : 0;
+  const int x0 = wrap(ix, tex.width), x1 = wrap(ix + 1, tex.width);
+  const int y0 = wrap(iy, tex.height), y1 = wrap(iy + 1, tex.height);
+  auto texel = [&](int x, int y) {
+    const uint8_t* p = &tex.rgba[(static_cast<size_t>(y) * tex.width + x) * 4];
+    return glm::vec4(t.srgb8ToLinear[p[0]], t.srgb8ToLinear[p[1]], t.srgb8ToLinear[p[2]],
+                     static_cast<float>(p[3]) * (1.0f / 255.0f));
+  };
+  const glm::vec4 top = glm::mix(texel(x0, y0), texel(x1, y0), ax);
+  const glm::vec4 bottom = glm::mix(texel(x0, y1), texel(x1, y1), ax);
+  return glm::mix(top, bottom, ay);
+}
+}  // namespace detail
+
+template <ShadeMode Mode>
+[[gnu::always_inline]] inline bool RasterFrame::surface(const TriangleSetup& t,
+                                                        const ShadeMaterial& m, float l0, float l1,
+                                                        float l2, glm::vec4& base) const {
+  const bool needsAlphaTest = m.mode == AlphaMode::Mask;
+  if constexpr (Mode == ShadeMode::Coverage) {
+    if (!needsAlphaTest) return true;
+  }
+  base = glm::vec4(m.color, m.alpha);
+  if (m.texture != nullptr) {
+    const float invQ = 1.0f / (t.invW[0] * l0 + t.invW[1] * l1 + t.invW[2] * l2);
+    const glm::vec2 uv = (t.uvW[0] * l0 + t.uvW[1] * l1 + t.uvW[2] * l2) * invQ;
+    base *= detail::sampleTexture(*m.texture, uv);
+  }
+  if (needsAlphaTest) {
+    if (base.a < m.cutoff) return false;
+    base.a = 1.0f;
+  } else if (m.mode == AlphaMode::Opaque) {
+    base.a = 1.0f;
+  }
+  if (m.alphaOverridden) base.a = m.overrideAlpha;
+  return true;
+}
+
+[[gnu::always_inline]] inline void RasterFrame::shade(const TriangleSetup& t, float l0, float l1, float l2, int px,
+                               int py, const glm::vec4& base, Fragment& f) const {
+  // headlight: the light sits at the eye, so diffuse = |n.v|
+  const glm::vec3 n = t.normalW[0] * l0 + t.normalW[1] * l1 + t.normalW[2] * l2;
+  const glm::vec3 d(static_cast<float>(px) * rayScaleX_ + rayBiasX_,
+                    static_cast<float>(py) * rayScaleY_ + rayBiasY_, -1.0f);
+  const float nn = glm::dot(n, n) * glm::dot(d, d);
+  const float ndotv = nn > 0.0f ? std::clamp(-glm::dot(n, d) / std::sqrt(nn), -1.0f, 1.0f) : 1.0f;
+  const float light = kAmbient + (1.0f - kAmbient) * std::fabs(ndotv);
+  f.rgba = packFragmentColor(glm::vec3(base) * light, base.a);
+  f.ndotv = ndotv;
+}
+
+template <ShadeMode Mode, class Sink>
+inline void RasterFrame::rasterizeRect(const TriangleSetup& t, int x0, int y0, int x1, int y1,
+                                       Sink& sink) const {
+  x0 = std::max(x0, t.minX);
+  y0 = std::max(y0, t.minY);
+  x1 = std::min(x1, t.maxX);
+  y1 = std::min(y1, t.maxY);
+  if (x0 > x1 || y0 > y1) return;
+  // edge i runs from vertex (i+1)%3 to (i+2)%3; w_i = B_i (py - ay) + A_i (px - ax)
+  int64_t stepX[3], stepY[3], row[3], bias[3];
+  const int64_t px0 = static_cast<int64_t>(x0) * 256 + 128;
+  const int64_t py0 = static_cast<int64_t>(y0) * 256 + 128;
+  for (int i = 0; i < 3; ++i) {
+    const int a = (i + 1) % 3, b = (i + 2) % 3;
+    const int64_t A = static_cast<int64_t>(t.y[a]) - t.y[b];
+    const int64_t B = static_cast<int64_t>(t.x[b]) - t.x[a];
+    stepX[i] = A * 256;
+    stepY[i] = B * 256;
+    bias[i] = (t.topLeft >> i) & 1 ? 0 : -1;
+    row[i] = B * (py0 - t.y[a]) + A * (px0 - t.x[a]) + bias[i];
+  }
+  const float dz1 = t.z[1] - t.z[0], dz2 = t.z[2] - t.z[0];
+  const ShadeMaterial& material = materials_[t.material];
+  Fragment f;
+  f.prim = t.prim;
+  f.rgba = 0;
+  f.ndotv = 0.0f;
+  for (int y = y0; y <= y1; ++y) {
+    int64_t w0 = row[0], w1 = row[1], w2 = row[2];
+    const uint32_t rowPixel = static_cast<uint32_t>(y) * static_cast<uint32_t>(width_);
+    for (int x = x0; x <= x1; ++x) {
+      if ((w0 | w1 | w2) >= 0) {
+        const float l1 = static_cast<float>(w1 - bias[1]) * t.invArea;
+        const float l2 = static_cast<float>(w2 - bias[2]) * t.invArea;
+        const float l0 = 1.0f - l1 - l2;
+        glm::vec4 base;
+        if (surface<Mode>(t, material, l0, l1, l2, base)) {
+          const float z = t.z[0] + l1 * dz1 + l2 * dz2;
+          f.depth = z > 0.0f ? (z < 1.0f ? z : 1.0f) : 0.0f;
+          f.pixel = rowPixel + static_cast<uint32_t>(x);
+          if (sink.accept(f.pixel, f.depth)) {
+            if constexpr (Mode == ShadeMode::Full) shade(t, l0, l1, l2, x, y, base, f);
+            sink.emit(f);
+          }
+        }
+      }
+      w0 += stepX[0];
+      w1 += stepX[1];
+      w2 += stepX[2];
+    }
+    row[0] += stepY[0];
+    row[1] += stepY[1];
+    row[2] += stepY[2];
+  }
+}
+
+template <ShadeMode Mode, class Sink>
+void RasterFrame::rasterizeTile(int tile, Sink&& sink) const {
+  const TileRect r = tileRect(tile);
+  for (const uint32_t* it = tileBegin(tile); it != tileEnd(tile); ++it)
+    rasterizeRect<Mode>(setups_[*it], r.x0, r.y0, r.x1, r.y1, sink);
+}
+
+template <ShadeMode Mode, class Sink>
+void RasterFrame::rasterizeTriangle(size_t setupIndex, Sink&& sink) const {
+  rasterizeRect<Mode>(setups_[setupIndex], 0, 0, width_ - 1, height_ - 1, sink);
+}
+
+}  // namespace mfr

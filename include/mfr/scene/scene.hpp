@@ -1,0 +1,79 @@
+// The scene every backend renders: one flat triangle soup in world space (node transforms already
+// applied by the loaders), materials with glTF-style alpha semantics, textures and cameras.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/core/result.hpp"
+#include "mfr/scene/camera.hpp"
+
+namespace mfr {
+
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
+
+/// RGBA8 texture, rows top to bottom, colour channels sRGB-encoded (glTF base colour convention),
+/// alpha linear. Sampled bilinearly with repeat wrapping.
+struct Texture {
+  int width = 0;
+  int height = 0;
+  std::vector<uint8_t> rgba;  // width * height * 4
+};
+
+struct Material {
+  std::string name;
+  glm::vec4 baseColor{1.0f};  // linear RGB, alpha factor
+  int baseColorTexture = -1;  // index into Scene::textures, or -1
+  AlphaMode alphaMode = AlphaMode::Blend;
+  float alphaCutoff = 0.5f;  // AlphaMode::Mask only
+  /// KHR_materials_transmission: set when the material declares transmission; the loader folds it
+  /// into baseColor.a (alpha = max(floor, 1 - transmissionFactor)) and records the raw factor here.
+  std::optional<float> transmission;
+};
+
+struct Scene {
+  std::string name;  // file path or procedural spec it came from
+
+  std::vector<glm::vec3> positions;  // world space
+  std::vector<glm::vec3> normals;    // per vertex, same size as positions (loaders fill flat ones)
+  std::vector<glm::vec2> uvs;        // empty, or same size as positions
+  std::vector<uint32_t> indices;     // 3 per triangle
+  std::vector<uint32_t> triangleMaterial;  // one per triangle, index into materials
+
+  std::vector<Material> materials;
+  std::vector<Texture> textures;
+
+  std::vector<Camera> cameras;  // cameras the file defines (may be empty)
+  std::optional<Camera> defaultCamera;  // procedural scenes frame themselves
+
+  glm::vec3 background{1.0f, 1.0f, 1.0f};  // linear RGB behind everything
+  /// When set, every material's alpha becomes this value and its mode becomes Blend
+  /// (the papers render whole scenes as transparent).
+  std::optional<float> alphaOverride;
+
+  size_t triangleCount() const { return indices.size() / 3; }
+  size_t vertexCount() const { return positions.size(); }
+};
+
+struct Bounds {
+  glm::vec3 min{0.0f};
+  glm::vec3 max{0.0f};
+  glm::vec3 center() const { return 0.5f * (min + max); }
+  float radius() const { return 0.5f * glm::length(max - min); }
+};
+
+/// Axis-aligned bounds of the vertices referenced by triangles.
+Bounds sceneBounds(const Scene& scene);
+
+/// Checks the invariants every consumer relies on (index ranges, sizes, finite values, at least one
+/// triangle). The message names the scene.
+Result<void> validateScene(const Scene& scene);
+
+/// Fills `normals` with area-weighted vertex normals when empty.
+void computeVertexNormals(Scene& scene);
+
+}  // namespace mfr

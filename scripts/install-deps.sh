@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Installs every Debian package mfr needs to build, test and benchmark. Idempotent: packages already
+# present are not touched, and `apt-get update` runs only when something is missing.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libtbb-dev            # tiled parallel rasterizer (oneTBB)
+  libcli11-dev          # command line
+  nlohmann-json3-dev    # JSON scenes, --json, stats
+  libglm-dev            # vector maths
+  libstb-dev            # PNG/JPEG read (textures), PNG write
+  libtinygltf-dev       # glTF 2.0 loader
+  libtinyobjloader-dev  # Wavefront OBJ + MTL loader
+  libassimp-dev         # PLY loader
+  libgtest-dev libgmock-dev
+  libbenchmark-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -eq 0 ] || SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -q
+$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"

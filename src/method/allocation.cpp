@@ -1,0 +1,150 @@
+// Allocation policies: how many fragment slots each pixel gets under a budget M.
+//   fixed k       k = floor(F(M) / |P|) (or explicit), the same k pre-allocated for every pixel
+//                 (k-buffer / k+-buffer, k+-buffer paper sec. 3.2);
+//   counted k     k(p) = min(n(p), k), exact memory from the count pass (K+B-SB, sec. 3.3); k as
+//                 for fixed k unless explicit;
+//   dynamic k     the largest global k whose exact memory fits M, read off the depth-complexity
+//                 histogram (dynamic k-buffer, [VPF15] as summarised by the variable k-buffer paper);
+//   unbounded     k(p) = n(p) (A-buffer / S-buffer).
+// Offsets are an exclusive prefix sum of k(p) in tile-major order (the S-buffer's clustering of
+// pixels by tiles, for locality).
+#include <algorithm>
+#include <string>
+
+#include "pipeline.hpp"
+
+namespace mfr::detail {
+namespace {
+
+std::string bytesText(uint64_t b) { return std::to_string(b) + " B"; }
+
+std::string sizeText(const RasterFrame& f) {
+  return std::to_string(f.width()) + "x" + std::to_string(f.height());
+}
+
+// Store of a pixel: the K+B-SB rule picks the heap when the pixel overflows and k > 16.
+StoreKind pickStore(StoreChoice choice, uint32_t n, uint32_t k) {
+  switch (choice) {
+    case StoreChoice::Append: return StoreKind::Append;
+    case StoreChoice::MaxArray: return StoreKind::MaxArray;
+    case StoreChoice::MaxHeap: return StoreKind::MaxHeap;
+    default: return (n > k && k > 16) ? StoreKind::MaxHeap : StoreKind::MaxArray;
+  }
+}
+
+}  // namespace
+
+Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
+                            const MemoryModel& memory, std::optional<uint64_t> budget,
+                            const std::vector<uint32_t>& n) {
+  const uint64_t pixels = frame.pixelCount();
+  const uint64_t overhead = memory.overhead(pixels);
+  const std::string& name = method.name;
+  Allocation a;
+  a.capacity.assign(pixels, 0);
+  a.kind.assign(pixels, StoreKind::MaxArray);
+
+  if (budget && *budget < overhead + kNodeBytes)
+    return makeError("budget " + bytesText(*budget) + ": too small for " + name + " at " +
+                     sizeText(frame) + " (its per-pixel buffers alone need " +
+                     bytesText(overhead) + ")");
+  const uint64_t slotsInBudget = budget ? memory.fragmentSlots(*budget, pixels) : UINT64_MAX;
+
+  auto sumCapped = [&](uint64_t k) {
+    uint64_t s = 0;
+    for (uint32_t c : n) s += std::min<uint64_t>(c, k);
+    return s;
+  };
+  uint64_t covered = 0;
+  for (uint32_t c : n) covered += c > 0;
+
+  switch (method.allocation) {
+    case AllocationPolicy::Unbounded: {
+      a.slots = sumCapped(UINT32_MAX);
+      if (a.slots > slotsInBudget)
+        return makeError("budget " + bytesText(*budget) + ": " + name + " needs " +
+                         bytesText(overhead + a.slots * kNodeBytes) + " for all " +
+                         std::to_string(a.slots) + " fragments at " + sizeText(frame));
+      for (size_t p = 0; p < pixels; ++p) a.capacity[p] = n[p];
+      break;
+    }
+    case AllocationPolicy::FixedK: {
+      uint64_t k = method.k.value_or(0);
+      if (!method.k) {
+        if (!budget) return makeError(name + ": needs a budget or an explicit k");
+        k = std::min<uint64_t>(slotsInBudget / pixels, 1u << 20);
+        if (k == 0)
+          return makeError("budget " + bytesText(*budget) + ": too small for one fragment per "
+                           "pixel with " + name + " at " + sizeText(frame) + " (needs " +
+                           bytesText(overhead + pixels * kNodeBytes) + ")");
+      }
+      if (k == 0) return makeError(name + ": k must be at least 1");
+      if (k * pixels > slotsInBudget)
+        return makeError("budget " + bytesText(*budget) + ": " + name + " with k = " +
+                         std::to_string(k) + " needs " +
+                         bytesText(overhead + k * pixels * kNodeBytes) + " at " + sizeText(frame));
+      a.globalK = static_cast<uint32_t>(k);
+      a.slots = k * pixels;
+      std::fill(a.capacity.begin(), a.capacity.end(), static_cast<uint32_t>(k));
+      break;
+    }
+    case AllocationPolicy::CountedK:
+    case AllocationPolicy::DynamicK: {
+      uint64_t k = 0;
+      if (method.allocation == AllocationPolicy::CountedK && method.k) {
+        k = *method.k;
+      } else if (method.allocation == AllocationPolicy::CountedK) {
+        if (!budget) return makeError(name + ": needs a budget or an explicit k");
+        k = std::max<uint64_t>(1, std::min<uint64_t>(slotsInBudget / pixels, 1u << 20));
+      } else {
+        if (!budget && !method.k) return makeError(name + ": needs a budget");
+        // histogram of n(p) (last bin: n >= bins - 1), then the largest k that fits, scanning
+        // from high to low; exact because k never exceeds the last bin
+        std::vector<uint64_t> histogram(kHistogramBins, 0);
+        for (uint32_t c : n) ++histogram[std::min<uint64_t>(c, kHistogramBins - 1)];
+        const uint64_t kLimit = std::min<uint64_t>(method.k.value_or(kHistogramBins - 1),
+                                                   kHistogramBins - 1);
+        for (uint64_t candidate = kLimit; candidate >= 1 && k == 0; --candidate) {
+          uint64_t need = 0;
+          for (uint64_t bin = 1; bin < kHistogramBins; ++bin)
+            need += histogram[bin] * std::min(bin, candidate);
+          if (need <= slotsInBudget) k = candidate;
+        }
+        if (k == 0)
+          return makeError("budget " + bytesText(*budget) + ": too small for one fragment per "
+                           "covered pixel with " + name + " at " + sizeText(frame) + " (needs " +
+                           bytesText(overhead + covered * kNodeBytes) + ")");
+      }
+      if (k == 0) return makeError(name + ": k must be at least 1");
+      a.slots = sumCapped(k);
+      if (a.slots > slotsInBudget)
+        return makeError("budget " + bytesText(*budget) + ": " + name + " with k = " +
+                         std::to_string(k) + " needs " + bytesText(overhead + a.slots * kNodeBytes) +
+                         " at " + sizeText(frame));
+      a.globalK = static_cast<uint32_t>(k);
+      for (size_t p = 0; p < pixels; ++p)
+        a.capacity[p] = static_cast<uint32_t>(std::min<uint64_t>(n[p], k));
+      break;
+    }
+  }
+
+  for (size_t p = 0; p < pixels; ++p)
+    a.kind[p] = pickStore(method.store, n.empty() ? a.capacity[p] + 1 : n[p], a.capacity[p]);
+
+  // exclusive prefix sum in tile-major order
+  a.offsets.assign(pixels, 0);
+  uint64_t running = 0;
+  for (int tile = 0; tile < frame.tileCount(); ++tile) {
+    const TileRect r = frame.tileRect(tile);
+    for (int y = r.y0; y <= r.y1; ++y)
+      for (int x = r.x0; x <= r.x1; ++x) {
+        const size_t p = static_cast<size_t>(y) * frame.width() + x;
+        a.offsets[p] = running;
+        running += a.capacity[p];
+      }
+  }
+  MFR_CHECK(running == a.slots);
+  return a;
+}
+
+}  // namespace mfr::detail

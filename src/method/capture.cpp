@@ -1,0 +1,178 @@
+// The capture pass (k+-buffer paper, Algorithm 3 STORE; occupancy paper sec. 2 for the early test).
+//
+// Per fragment, in order:
+//   1. occupancy test: a fragment in a bucket beyond the pixel's k-th occupied one is rejected;
+//   2. k+ test, outside the critical section: a full store rejects a fragment that is not nearer
+//      than its maximum (slot 0);
+//   3. critical section: insert into the max-array / max-heap / append store, which tests again
+//      (another fragment may have filled the store or lowered its maximum meanwhile).
+// With kbuffer compositing, tests 1 and 2 run before shading (like early-z). With hybrid
+// compositing every fragment is shaded, and the rejected and evicted ones are added to the
+// pixel's tail.
+//
+// Tile-owned mode: a tile is one worker's, fragments reach a pixel in primitive order, no locks.
+// Fragment-parallel mode: triangles are rasterized whole by any thread in any interleaving; each
+// pixel's critical section is guarded by a spin-lock taken with an atomic exchange (the paper's
+// semaphore); slot 0 and the counter, read by test 2 outside the lock, are relaxed atomics. On a
+// CPU the spinning thread yields instead of giving up after a number of iterations (the GPU code
+// drops the fragment after 1000 tries; a CPU thread cannot deadlock a SIMT group here), so no
+// fragment is ever dropped.
+#include <atomic>
+#include <thread>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "pipeline.hpp"
+
+namespace mfr::detail {
+namespace {
+
+struct SpinLock {
+  static void lock(Stores& stores, uint32_t p) {
+    std::atomic_ref<uint32_t> a(stores.locks[p]);
+    int spins = 0;
+    while (a.exchange(1, std::memory_order_acquire) != 0) {
+      while (a.load(std::memory_order_relaxed) != 0) {
+        if (++spins > 64) std::this_thread::yield();
+      }
+    }
+  }
+  static void unlock(Stores& stores, uint32_t p) {
+    std::atomic_ref<uint32_t>(stores.locks[p]).store(0, std::memory_order_release);
+  }
+};
+
+struct NoLock {
+  static void lock(Stores&, uint32_t) {}
+  static void unlock(Stores&, uint32_t) {}
+};
+
+template <bool Hybrid, bool Occupancy, bool KPlus, class Access, class Lock>
+struct CaptureSink {
+  const Allocation& alloc;
+  const OccupancyMap* occupancy;
+  Stores& stores;
+  CaptureCounters counters;
+
+  FragmentNode* slots(uint32_t p) { return stores.nodes.data() + alloc.offsets[p]; }
+
+  // early test before shading (kbuffer compositing only: hybrid needs every fragment's colour)
+  bool accept(uint32_t p, float depth) {
+    ++counters.generated;
+    if constexpr (!Hybrid) {
+      if (Occupancy && occupancy->culls(p, depth)) {
+        ++counters.culledOccupancy;
+        return false;
+      }
+      // conservative: colour 0 is the smallest tie-break, so a reject here is a reject for any
+      if (KPlus && !passesKPlusTest<Access>(slots(p), stores.counts[p], alloc.capacity[p],
+                                            makeNode(depth, 0u))) {
+        ++counters.culledKPlus;
+        return false;
+      }
+    }
+    return true;
+  }
+
+  void toTail(uint32_t p, uint32_t rgba) {
+    if constexpr (Hybrid) stores.tails[p].add(rgba);
+  }
+
+  void emit(const Fragment& f) {
+    const uint32_t p = f.pixel;
+    const FragmentNode node = makeNode(f);
+    if constexpr (Hybrid && Occupancy) {
+      if (occupancy->culls(p, f.depth)) {
+        ++counters.culledOccupancy;
+        Lock::lock(stores, p);
+        toTail(p, f.rgba);
+        Lock::unlock(stores, p);
+        return;
+      }
+    }
+    FragmentNode* s = slots(p);
+    if constexpr (KPlus) {
+      if (!passesKPlusTest<Access>(s, stores.counts[p], alloc.capacity[p], node)) {
+        ++counters.culledKPlus;
+        if constexpr (Hybrid) {
+          Lock::lock(stores, p);
+          toTail(p, f.rgba);
+          Lock::unlock(stores, p);
+        }
+        return;
+      }
+    }
+    Lock::lock(stores, p);
+    FragmentNode evicted = 0;
+    switch (storeInsert<Access>(alloc.kind[p], s, stores.counts[p], alloc.capacity[p], node,
+                                evicted)) {
+      case InsertOutcome::Inserted: ++counters.inserted; break;
+      case InsertOutcome::Replaced:
+        ++counters.inserted;
+        ++counters.evicted;
+        toTail(p, nodeColor(evicted));
+        break;
+      case InsertOutcome::Rejected:
+        ++counters.rejected;
+        toTail(p, f.rgba);
+        break;
+    }
+    Lock::unlock(stores, p);
+  }
+};
+
+template <bool Hybrid, bool Occupancy, bool KPlus>
+CaptureCounters runCapture(const RasterFrame& frame, const Allocation& alloc,
+                           const OccupancyMap* occupancy, CaptureMode mode, Stores& stores) {
+  CaptureCounters total;
+  if (mode == CaptureMode::TileOwned) {
+    std::vector<CaptureCounters> perTile(static_cast<size_t>(frame.tileCount()));
+    frame.forEachTile([&](int tile) {
+      CaptureSink<Hybrid, Occupancy, KPlus, PlainAccess, NoLock> sink{alloc, occupancy, stores, {}};
+      frame.rasterizeTile<ShadeMode::Full>(tile, sink);
+      perTile[tile] = sink.counters;
+    });
+    for (const CaptureCounters& c : perTile) total.add(c);
+    return total;
+  }
+  using Sink = CaptureSink<Hybrid, Occupancy, KPlus, AtomicAccess, SpinLock>;
+  tbb::enumerable_thread_specific<CaptureCounters> perThread;
+  const size_t triangles = frame.setups().size();
+  tbb::task_arena arena(frame.threads());
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles, 16),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                        Sink sink{alloc, occupancy, stores, {}};
+                        for (size_t t = r.begin(); t != r.end(); ++t)
+                          frame.rasterizeTriangle<ShadeMode::Full>(t, sink);
+                        perThread.local().add(sink.counters);
+                      });
+  });
+  for (const CaptureCounters& c : perThread) total.add(c);
+  return total;
+}
+
+}  // namespace
+
+CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,
+                        const Allocation& allocation, const OccupancyMap* occupancy,
+                        CaptureMode mode, Stores& stores) {
+  const bool hybrid = method.compositing == Compositing::Hybrid;
+  const bool occ = occupancy != nullptr;
+  const bool kplus = method.culling == CullingTest::KPlus;
+  // one instantiation per combination, so each inner loop carries only the tests it needs
+  if (hybrid) {
+    if (occ) return kplus ? runCapture<true, true, true>(frame, allocation, occupancy, mode, stores)
+                          : runCapture<true, true, false>(frame, allocation, occupancy, mode, stores);
+    return kplus ? runCapture<true, false, true>(frame, allocation, occupancy, mode, stores)
+                 : runCapture<true, false, false>(frame, allocation, occupancy, mode, stores);
+  }
+  if (occ) return kplus ? runCapture<false, true, true>(frame, allocation, occupancy, mode, stores)
+                        : runCapture<false, true, false>(frame, allocation, occupancy, mode, stores);
+  return kplus ? runCapture<false, false, true>(frame, allocation, occupancy, mode, stores)
+               : runCapture<false, false, false>(frame, allocation, occupancy, mode, stores);
+}
+
+}  // namespace mfr::detail

@@ -1,0 +1,54 @@
+// Internal state shared by the passes of render(): the allocation and the per-pixel stores.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "mfr/capture/occupancy_map.hpp"
+#include "mfr/method/compositing.hpp"
+#include "mfr/method/memory_model.hpp"
+#include "mfr/method/render.hpp"
+
+namespace mfr::detail {
+
+/// Slots per pixel and where they live (tile-major prefix-sum order).
+struct Allocation {
+  std::vector<uint32_t> capacity;  // k(p)
+  std::vector<uint64_t> offsets;   // first slot of pixel p
+  std::vector<StoreKind> kind;     // store used by pixel p
+  uint64_t slots = 0;              // total nodes
+  std::optional<uint32_t> globalK;
+};
+
+/// Turns the policy, the budget and (when a count pass ran) n(p) into k(p) and offsets.
+Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
+                            const MemoryModel& memory, std::optional<uint64_t> budget,
+                            const std::vector<uint32_t>& fragmentCounts);
+
+struct CaptureCounters {
+  uint64_t generated = 0, culledOccupancy = 0, culledKPlus = 0, rejected = 0, inserted = 0,
+           evicted = 0;
+  void add(const CaptureCounters& o) {
+    generated += o.generated;
+    culledOccupancy += o.culledOccupancy;
+    culledKPlus += o.culledKPlus;
+    rejected += o.rejected;
+    inserted += o.inserted;
+    evicted += o.evicted;
+  }
+};
+
+struct Stores {
+  std::vector<FragmentNode> nodes;
+  std::vector<uint32_t> counts;
+  std::vector<uint32_t> locks;
+  std::vector<HybridTail> tails;  // empty unless hybrid
+};
+
+/// The capture pass: every fragment through occupancy test, k+ test and store insertion.
+CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,
+                        const Allocation& allocation, const OccupancyMap* occupancy,
+                        CaptureMode mode, Stores& stores);
+
+}  // namespace mfr::detail

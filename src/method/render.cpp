@@ -1,0 +1,214 @@
+// render(): the pass structure every method shares,
+//   [count] -> allocate -> [depth range -> occupancy fill -> occupancy count] -> capture -> resolve
+// and the statistics and memory accounting of the run.
+#include "mfr/method/render.hpp"
+
+#include <algorithm>
+#include <chrono>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "pipeline.hpp"
+
+namespace mfr {
+namespace {
+
+class PassTimer {
+ public:
+  explicit PassTimer(std::vector<PassTime>& passes) : passes_(passes) {}
+  template <class Fn>
+  auto run(const char* name, Fn&& fn) {
+    const auto start = std::chrono::steady_clock::now();
+    if constexpr (std::is_void_v<decltype(fn())>) {
+      fn();
+      record(name, start);
+    } else {
+      auto result = fn();
+      record(name, start);
+      return result;
+    }
+  }
+
+ private:
+  void record(const char* name, std::chrono::steady_clock::time_point start) {
+    const std::chrono::duration<double, std::milli> d = std::chrono::steady_clock::now() - start;
+    passes_.push_back({name, d.count()});
+  }
+  std::vector<PassTime>& passes_;
+};
+
+template <class PixelFn>
+struct CoverageSink {
+  PixelFn fn;
+  bool accept(uint32_t, float) const { return true; }
+  void emit(const Fragment& f) { fn(f.pixel, f.depth); }
+};
+template <class PixelFn>
+CoverageSink(PixelFn) -> CoverageSink<PixelFn>;
+
+void buildOccupancy(const RasterFrame& frame, const detail::Allocation& alloc, OccupancyMap& occ,
+                    PassTimer& timer) {
+  timer.run("depth_range", [&] {
+    frame.forEachTile([&](int tile) {
+      frame.rasterizeTile<ShadeMode::Coverage>(
+          tile, CoverageSink{[&](uint32_t p, float z) { occ.expandRange(p, z); }});
+    });
+  });
+  timer.run("occupancy_fill", [&] {
+    frame.forEachTile([&](int tile) {
+      frame.rasterizeTile<ShadeMode::Coverage>(
+          tile, CoverageSink{[&](uint32_t p, float z) { occ.mark(p, z); }});
+    });
+  });
+  timer.run("occupancy_count", [&] {
+    frame.forEachTile([&](int tile) {
+      const TileRect r = frame.tileRect(tile);
+      for (int y = r.y0; y <= r.y1; ++y)
+        for (int x = r.x0; x <= r.x1; ++x) {
+          const uint32_t p = static_cast<uint32_t>(y) * frame.width() + x;
+          occ.resolveThreshold(p, alloc.capacity[p]);
+        }
+    });
+  });
+}
+
+ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method,
+                 const detail::Allocation& alloc, const detail::Stores& stores,
+                 glm::vec3 background) {
+  ImageRGB image(frame.width(), frame.height());
+  const bool hybrid = method.compositing == Compositing::Hybrid;
+  frame.forEachTile([&](int tile) {
+    std::vector<FragmentNode> local;
+    const TileRect r = frame.tileRect(tile);
+    for (int y = r.y0; y <= r.y1; ++y)
+      for (int x = r.x0; x <= r.x1; ++x) {
+        const size_t p = static_cast<size_t>(y) * frame.width() + x;
+        const uint32_t n = stores.counts[p];
+        const FragmentNode* slots = stores.nodes.data() + alloc.offsets[p];
+        local.assign(slots, slots + n);
+        std::sort(local.begin(), local.end());
+        image.pixels[p] = hybrid ? compositeHybrid(local.data(), n, stores.tails[p], background)
+                                 : compositeKBuffer(local.data(), n, background);
+      }
+  });
+  return image;
+}
+
+}  // namespace
+
+double RenderStats::totalMs() const {
+  double total = 0.0;
+  for (const PassTime& p : passes) total += p.ms;
+  return total;
+}
+
+std::vector<uint32_t> countFragments(const RasterFrame& frame) {
+  std::vector<uint32_t> counts(frame.pixelCount(), 0);
+  frame.forEachTile([&](int tile) {
+    frame.rasterizeTile<ShadeMode::Coverage>(
+        tile, CoverageSink{[&](uint32_t p, float) { ++counts[p]; }});
+  });
+  return counts;
+}
+
+Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
+                            const RenderOptions& options) {
+  if (method.occupancyWords < 0 || method.occupancyWords > 64)
+    return makeError(method.name + ": occupancy d must be in [1, 64]");
+  if (method.allocation == AllocationPolicy::Unbounded && method.occupancyWords > 0)
+    return makeError(method.name + ": occupancy culling needs a bounded k");
+  if (method.store == StoreChoice::Append && method.allocation != AllocationPolicy::Unbounded)
+    return makeError(method.name + ": the append store needs exact (unbounded) allocation");
+  RenderOutput out;
+  RenderStats& stats = out.stats;
+  stats.method = method.name;
+  stats.budgetBytes = options.budgetBytes;
+  PassTimer timer(stats.passes);
+  const size_t pixels = frame.pixelCount();
+  const MemoryModel memory = MemoryModel::of(method);
+
+  // count pass
+  if (method.allocation != AllocationPolicy::FixedK)
+    out.depthComplexity = timer.run("count", [&] { return countFragments(frame); });
+
+  // allocate
+  auto allocated = timer.run("allocate", [&] {
+    return detail::allocate(frame, method, memory, options.budgetBytes, out.depthComplexity);
+  });
+  if (!allocated) return allocated.error();
+  detail::Allocation& alloc = allocated.value();
+
+  // buffers
+  detail::Stores stores;
+  timer.run("clear", [&] {
+    stores.nodes.resize(alloc.slots);
+    stores.counts.assign(pixels, 0);
+    if (options.capture == CaptureMode::FragmentParallel) stores.locks.assign(pixels, 0);
+    if (method.compositing == Compositing::Hybrid) stores.tails.assign(pixels, HybridTail{});
+  });
+
+  // occupancy culling passes
+  OccupancyMap occupancy;
+  if (method.occupancyWords > 0) {
+    occupancy = OccupancyMap(pixels, method.occupancyWords);
+    buildOccupancy(frame, alloc, occupancy, timer);
+  }
+
+  // capture
+  const detail::CaptureCounters counters = timer.run("capture", [&] {
+    return detail::capture(frame, method, alloc, method.occupancyWords > 0 ? &occupancy : nullptr,
+                           options.capture, stores);
+  });
+
+  // resolve
+  out.image = timer.run("resolve", [&] {
+    return resolve(frame, method, alloc, stores, options.background);
+  });
+
+  // statistics
+  stats.fragmentSlots = alloc.slots;
+  stats.bytesByCategory = memory.breakdown(pixels, alloc.slots);
+  for (const auto& [category, bytes] : stats.bytesByCategory) stats.bytesUsed += bytes;
+  if (options.budgetBytes) MFR_CHECK(stats.bytesUsed <= *options.budgetBytes);
+  stats.fragmentsGenerated = counters.generated;
+  stats.culledOccupancy = counters.culledOccupancy;
+  stats.culledKPlus = counters.culledKPlus;
+  stats.rejectedInStore = counters.rejected;
+  stats.inserted = counters.inserted;
+  stats.evicted = counters.evicted;
+  stats.globalK = alloc.globalK;
+  uint32_t kMin = UINT32_MAX, kMax = 0;
+  uint64_t sumN = 0;
+  uint32_t maxN = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    stats.captured += stores.counts[p];
+    const bool covered =
+        out.depthComplexity.empty() ? stores.counts[p] > 0 : out.depthComplexity[p] > 0;
+    if (!covered) continue;
+    ++stats.coveredPixels;
+    kMin = std::min(kMin, alloc.capacity[p]);
+    kMax = std::max(kMax, alloc.capacity[p]);
+    if (!out.depthComplexity.empty()) {
+      sumN += out.depthComplexity[p];
+      maxN = std::max(maxN, out.depthComplexity[p]);
+    }
+  }
+  stats.kMin = stats.coveredPixels ? kMin : 0;
+  stats.kMax = kMax;
+  stats.lost = stats.fragmentsGenerated - stats.captured;
+  if (!out.depthComplexity.empty()) {
+    stats.maxDepthComplexity = maxN;
+    stats.meanDepthComplexity =
+        stats.coveredPixels ? static_cast<double>(sumN) / stats.coveredPixels : 0.0;
+  }
+  out.kMap = std::move(alloc.capacity);
+  if (options.keepStores) {
+    out.nodes = std::move(stores.nodes);
+    out.offsets = std::move(alloc.offsets);
+    out.counts = std::move(stores.counts);
+  }
+  return out;
+}
+
+}  // namespace mfr

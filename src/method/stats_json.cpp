@@ -1,0 +1,36 @@
+#include "mfr/method/stats_json.hpp"
+
+namespace mfr {
+
+nlohmann::json statsToJson(const RenderStats& s) {
+  nlohmann::json j;
+  j["method"] = s.method;
+  j["budget_bytes"] = s.budgetBytes ? nlohmann::json(*s.budgetBytes) : nlohmann::json(nullptr);
+  j["bytes_used"] = s.bytesUsed;
+  j["bytes_by_category"] = s.bytesByCategory;
+  j["fragment_slots"] = s.fragmentSlots;
+  j["fragments_generated"] = s.fragmentsGenerated;
+  j["fragments_captured"] = s.captured;
+  j["fragments_lost"] = s.lost;
+  j["fragments_lost_percent"] = s.lostPercent();
+  j["culled"] = {{"occupancy", s.culledOccupancy},
+                 {"kplus", s.culledKPlus},
+                 {"in_store", s.rejectedInStore}};
+  j["inserted"] = s.inserted;
+  j["evicted"] = s.evicted;
+  j["covered_pixels"] = s.coveredPixels;
+  j["k_min"] = s.kMin;
+  j["k_max"] = s.kMax;
+  j["k"] = s.globalK ? nlohmann::json(*s.globalK) : nlohmann::json(nullptr);
+  j["max_depth_complexity"] =
+      s.maxDepthComplexity ? nlohmann::json(*s.maxDepthComplexity) : nlohmann::json(nullptr);
+  j["mean_depth_complexity"] =
+      s.meanDepthComplexity ? nlohmann::json(*s.meanDepthComplexity) : nlohmann::json(nullptr);
+  nlohmann::json times = nlohmann::json::object();
+  for (const PassTime& p : s.passes) times[p.name] = p.ms;
+  j["time_ms"] = times;
+  j["total_ms"] = s.totalMs();
+  return j;
+}
+
+}  // namespace mfr

@@ -1,0 +1,262 @@
+// Frame set-up of the CPU rasterizer: vertex transform, homogeneous clipping, triangle set-up in
+// 8-bit sub-pixel fixed point, and binning into tiles (see raster_frame.hpp for the rules).
+#include "mfr/raster/raster_frame.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <thread>
+
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+namespace mfr {
+
+int resolveThreads(int threads) {
+  if (threads > 0) return threads;
+  const unsigned hw = std::thread::hardware_concurrency();
+  return hw > 0 ? static_cast<int>(hw) : 1;
+}
+
+namespace {
+
+struct ClipVertex {
+  glm::vec4 clip;
+  glm::vec3 normal;  // view space
+  glm::vec2 uv;
+};
+
+ClipVertex lerp(const ClipVertex& a, const ClipVertex& b, float t) {
+  return {glm::mix(a.clip, b.clip, t), glm::mix(a.normal, b.normal, t), glm::mix(a.uv, b.uv, t)};
+}
+
+// x/y guard band in NDC units: keeps fixed-point window coordinates below 2^25 at 16384 pixels.
+constexpr float kGuardBand = 8.0f;
+
+// Signed distances to the six clip planes (inside >= 0).
+inline float planeDistance(const glm::vec4& c, int plane) {
+  switch (plane) {
+    case 0: return c.z + c.w;  // near
+    case 1: return c.w - c.z;  // far
+    case 2: return kGuardBand * c.w + c.x;
+    case 3: return kGuardBand * c.w - c.x;
+    case 4: return kGuardBand * c.w + c.y;
+    default: return kGuardBand * c.w - c.y;
+  }
+}
+
+// Sutherland-Hodgman against the planes the triangle crosses; returns the polygon size.
+int clipPolygon(ClipVertex (&poly)[12], int count, unsigned planes) {
+  ClipVertex tmp[12];
+  for (int plane = 0; plane < 6 && count > 0; ++plane) {
+    if (!(planes & (1u << plane))) continue;
+    int out = 0;
+    for (int i = 0; i < count; ++i) {
+      const ClipVertex& a = poly[i];
+      const ClipVertex& b = poly[(i + 1) % count];
+      const float da = planeDistance(a.clip, plane), db = planeDistance(b.clip, plane);
+      if (da >= 0.0f) tmp[out++] = a;
+      if ((da >= 0.0f) != (db >= 0.0f)) tmp[out++] = lerp(a, b, da / (da - db));
+    }
+    count = out;
+    std::copy(tmp, tmp + count, poly);
+  }
+  return count;
+}
+
+struct SetupContext {
+  int width, height;
+};
+
+// Screen-space set-up of one clipped triangle; returns false when it covers no pixel centre.
+bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVertex& v1,
+                   const ClipVertex& v2, uint32_t prim, uint32_t material, TriangleSetup& t) {
+  const ClipVertex* v[3] = {&v0, &v1, &v2};
+  double sx[3], sy[3];
+  for (int i = 0; i < 3; ++i) {
+    const glm::vec4& c = v[i]->clip;
+    const double invW = 1.0 / static_cast<double>(c.w);
+    sx[i] = (static_cast<double>(c.x) * invW * 0.5 + 0.5) * ctx.width;
+    sy[i] = (0.5 - static_cast<double>(c.y) * invW * 0.5) * ctx.height;
+    t.x[i] = static_cast<int32_t>(std::llround(sx[i] * 256.0));
+    t.y[i] = static_cast<int32_t>(std::llround(sy[i] * 256.0));
+    t.z[i] = static_cast<float>(static_cast<double>(c.z) * invW * 0.5 + 0.5);
+    t.invW[i] = static_cast<float>(invW);
+    t.normalW[i] = v[i]->normal * t.invW[i];
+    t.uvW[i] = v[i]->uv * t.invW[i];
+  }
+  int64_t area = (static_cast<int64_t>(t.x[1]) - t.x[0]) * (static_cast<int64_t>(t.y[2]) - t.y[0]) -
+                 (static_cast<int64_t>(t.y[1]) - t.y[0]) * (static_cast<int64_t>(t.x[2]) - t.x[0]);
+  if (area == 0) return false;
+  if (area < 0) {  // no culling: flip to a positive orientation
+    std::swap(t.x[1], t.x[2]);
+    std::swap(t.y[1], t.y[2]);
+    std::swap(t.z[1], t.z[2]);
+    std::swap(t.invW[1], t.invW[2]);
+    std::swap(t.normalW[1], t.normalW[2]);
+    std::swap(t.uvW[1], t.uvW[2]);
+    area = -area;
+  }
+  t.invArea = static_cast<float>(1.0 / static_cast<double>(area));
+  t.topLeft = 0;
+  for (int i = 0; i < 3; ++i) {
+    const int a = (i + 1) % 3, b = (i + 2) % 3;
+    const int32_t dx = t.x[b] - t.x[a], dy = t.y[b] - t.y[a];
+    if ((dy == 0 && dx > 0) || dy < 0) t.topLeft |= static_cast<uint8_t>(1u << i);
+  }
+  // pixel centres c*256+128 inside [min, max] of the fixed-point bounds
+  const int32_t minFx = std::min({t.x[0], t.x[1], t.x[2]}), maxFx = std::max({t.x[0], t.x[1], t.x[2]});
+  const int32_t minFy = std::min({t.y[0], t.y[1], t.y[2]}), maxFy = std::max({t.y[0], t.y[1], t.y[2]});
+  auto ceilDiv = [](int64_t a, int64_t b) { return a >= 0 ? (a + b - 1) / b : -((-a) / b); };
+  auto floorDiv = [](int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
+  t.minX = static_cast<int32_t>(std::max<int64_t>(0, ceilDiv(minFx - 128, 256)));
+  t.minY = static_cast<int32_t>(std::max<int64_t>(0, ceilDiv(minFy - 128, 256)));
+  t.maxX = static_cast<int32_t>(std::min<int64_t>(ctx.width - 1, floorDiv(maxFx - 128, 256)));
+  t.maxY = static_cast<int32_t>(std::min<int64_t>(ctx.height - 1, floorDiv(maxFy - 128, 256)));
+  if (t.minX > t.maxX || t.minY > t.maxY) return false;
+  t.prim = prim;
+  t.material = material;
+  return true;
+}
+
+std::vector<ShadeMaterial> resolveMaterials(const Scene& scene) {
+  std::vector<ShadeMaterial> out;
+  for (const Material& m : scene.materials) {
+    ShadeMaterial s;
+    s.color = glm::vec3(m.baseColor);
+    s.alpha = m.baseColor.a;
+    s.texture = m.baseColorTexture >= 0 ? &scene.textures[m.baseColorTexture] : nullptr;
+    s.mode = m.alphaMode;
+    s.cutoff = m.alphaCutoff;
+    if (scene.alphaOverride) {
+      s.alphaOverridden = true;
+      s.overrideAlpha = *scene.alphaOverride;
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+}  // namespace
+
+Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraIn,
+                                       const RasterOptions& options) {
+  if (options.width < 1 || options.height < 1 || options.width > kMaxImageSize ||
+      options.height > kMaxImageSize)
+    return makeError("image size " + std::to_string(options.width) + "x" +
+                     std::to_string(options.height) + ": width and height must be in [1, " +
+                     std::to_string(kMaxImageSize) + "]");
+  if (options.tileSize < 8 || options.tileSize > 1024)
+    return makeError("tile size " + std::to_string(options.tileSize) + ": must be in [8, 1024]");
+  MFR_TRY(validateScene(scene));
+  const Camera& c = cameraIn;
+  const bool cameraFinite = std::isfinite(c.eye.x) && std::isfinite(c.eye.y) &&
+                            std::isfinite(c.eye.z) && std::isfinite(c.target.x) &&
+                            std::isfinite(c.target.y) && std::isfinite(c.target.z) &&
+                            std::isfinite(c.up.x) && std::isfinite(c.up.y) && std::isfinite(c.up.z);
+  if (!cameraFinite || glm::length(c.target - c.eye) <= 0.0f ||
+      glm::length(glm::cross(c.target - c.eye, c.up)) <= 0.0f)
+    return makeError("camera: eye, target and up must be finite, eye != target, up not parallel "
+                     "to the view direction");
+  if (!(c.fovYDegrees > 0.0f && c.fovYDegrees < 180.0f))
+    return makeError("camera: field of view must be in (0, 180) degrees");
+  if (c.zNear < 0.0f || c.zFar < 0.0f || (c.zNear > 0.0f && c.zFar > 0.0f && c.zFar <= c.zNear))
+    return makeError("camera: need 0 < near < far (or 0 for automatic)");
+
+  RasterFrame frame;
+  frame.width_ = options.width;
+  frame.height_ = options.height;
+  frame.threads_ = resolveThreads(options.threads);
+  frame.tileSize_ = options.tileSize;
+  frame.tilesX_ = (options.width + options.tileSize - 1) / options.tileSize;
+  frame.tilesY_ = (options.height + options.tileSize - 1) / options.tileSize;
+  frame.camera_ = fitClipPlanes(cameraIn, sceneBounds(scene));
+  frame.materials_ = resolveMaterials(scene);
+
+  const glm::mat4 view = viewMatrix(frame.camera_);
+  const glm::mat4 viewProj = projectionMatrix(frame.camera_, options.width, options.height) * view;
+  const glm::mat3 viewRot(view);
+  const float tanHalf = std::tan(glm::radians(frame.camera_.fovYDegrees) * 0.5f);
+  const float aspect = static_cast<float>(options.width) / static_cast<float>(options.height);
+  frame.rayScaleX_ = 2.0f * tanHalf * aspect / static_cast<float>(options.width);
+  frame.rayBiasX_ = (1.0f / static_cast<float>(options.width) - 1.0f) * tanHalf * aspect;
+  frame.rayScaleY_ = -2.0f * tanHalf / static_cast<float>(options.height);
+  frame.rayBiasY_ = (1.0f - 1.0f / static_cast<float>(options.height)) * tanHalf;
+
+  tbb::task_arena arena(frame.threads_);
+  // vertex transform
+  const size_t vertexCount = scene.positions.size();
+  std::vector<ClipVertex> vertices(vertexCount);
+  arena.execute([&] {
+    tbb::parallel_for(size_t{0}, vertexCount, size_t{4096}, [&](size_t begin) {
+      const size_t end = std::min(vertexCount, begin + 4096);
+      for (size_t i = begin; i < end; ++i) {
+        vertices[i].clip = viewProj * glm::vec4(scene.positions[i], 1.0f);
+        vertices[i].normal = viewRot * scene.normals[i];
+        vertices[i].uv = scene.uvs.empty() ? glm::vec2(0.0f) : scene.uvs[i];
+      }
+    });
+  });
+
+  // clip + set-up, in chunks whose outputs are concatenated in order (deterministic)
+  const SetupContext ctx{options.width, options.height};
+  const size_t triangleCount = scene.triangleCount();
+  constexpr size_t kChunk = 8192;
+  const size_t chunks = (triangleCount + kChunk - 1) / kChunk;
+  std::vector<std::vector<TriangleSetup>> chunkSetups(chunks);
+  arena.execute([&] {
+    tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
+      std::vector<TriangleSetup>& out = chunkSetups[chunk];
+      const size_t end = std::min(triangleCount, (chunk + 1) * kChunk);
+      for (size_t tri = chunk * kChunk; tri < end; ++tri) {
+        const uint32_t prim = static_cast<uint32_t>(tri);
+        const uint32_t material = scene.triangleMaterial[tri];
+        ClipVertex poly[12] = {vertices[scene.indices[tri * 3 + 0]],
+                               vertices[scene.indices[tri * 3 + 1]],
+                               vertices[scene.indices[tri * 3 + 2]]};
+        unsigned crossed = 0;
+        bool rejected = false;
+        for (int plane = 0; plane < 6; ++plane) {
+          int inside = 0;
+          for (int i = 0; i < 3; ++i) inside += planeDistance(poly[i].clip, plane) >= 0.0f;
+          if (inside == 0) rejected = true;
+          if (inside < 3) crossed |= 1u << plane;
+        }
+        if (rejected) continue;
+        const int count = crossed ? clipPolygon(poly, 3, crossed) : 3;
+        for (int i = 1; i + 1 < count; ++i) {
+          TriangleSetup t;
+          if (setupTriangle(ctx, poly[0], poly[i], poly[i + 1], prim, material, t))
+            out.push_back(t);
+        }
+      }
+    });
+  });
+  size_t total = 0;
+  for (const auto& c : chunkSetups) total += c.size();
+  frame.setups_.reserve(total);
+  for (auto& c : chunkSetups) {
+    frame.setups_.insert(frame.setups_.end(), c.begin(), c.end());
+    std::vector<TriangleSetup>().swap(c);
+  }
+
+  // binning: count, prefix sum, fill (primitive order within each tile)
+  const int tileSize = frame.tileSize_;
+  frame.binOffsets_.assign(static_cast<size_t>(frame.tileCount()) + 1, 0);
+  auto forTiles = [&](const TriangleSetup& t, auto&& fn) {
+    for (int ty = t.minY / tileSize; ty <= t.maxY / tileSize; ++ty)
+      for (int tx = t.minX / tileSize; tx <= t.maxX / tileSize; ++tx)
+        fn(ty * frame.tilesX_ + tx);
+  };
+  for (const TriangleSetup& t : frame.setups_) forTiles(t, [&](int tile) { ++frame.binOffsets_[tile + 1]; });
+  for (size_t i = 1; i < frame.binOffsets_.size(); ++i)
+    frame.binOffsets_[i] += frame.binOffsets_[i - 1];
+  frame.binned_.resize(frame.binOffsets_.back());
+  std::vector<uint32_t> cursor(frame.binOffsets_.begin(), frame.binOffsets_.end() - 1);
+  for (size_t s = 0; s < frame.setups_.size(); ++s)
+    forTiles(frame.setups_[s],
+             [&](int tile) { frame.binned_[cursor[tile]++] = static_cast<uint32_t>(s); });
+  return frame;
+}
+
+}  // namespace mfr

@@ -1,0 +1,650 @@
+// glTF 2.0 loader (.gltf and .glb) on top of tinygltf, following the Khronos glTF 2.0 specification
+// (accessors incl. sparse and normalized integers, node hierarchy with matrix or TRS transforms,
+// triangle primitives, metallic-roughness base colour, alpha modes, perspective cameras) and the
+// KHR_materials_transmission extension (folded into alpha, see LoadOptions).
+//
+// Images are not decoded while tinygltf parses the file: a custom image callback keeps the encoded
+// bytes, and only images used as a base colour texture are decoded (in parallel) afterwards.
+// tinygltf trusts bufferView ranges, so every accessor and image range is bounds-checked here.
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <glm/gtc/quaternion.hpp>
+#include <glm/gtc/type_ptr.hpp>
+#include <tbb/parallel_for.h>
+
+#include "mfr/scene/load.hpp"
+
+namespace mfr {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Image bytes kept by the tinygltf callback.
+
+struct EncodedImages {
+  const tinygltf::Model* model = nullptr;  // the model tinygltf is filling in
+  std::vector<std::vector<unsigned char>> bytes;  // by image index; empty: not available
+};
+
+bool keepEncodedImage(tinygltf::Image* image, const int imageIndex, std::string* err,
+                      std::string* /*warn*/, int /*reqWidth*/, int /*reqHeight*/,
+                      const unsigned char* bytes, int size, void* user) {
+  auto* images = static_cast<EncodedImages*>(user);
+  if (imageIndex < 0 || size < 0) return false;
+  if (image->bufferView >= 0) {
+    // tinygltf hands us &buffer.data[view.byteOffset] without checking the view against the buffer.
+    const tinygltf::Model& model = *images->model;
+    if (static_cast<size_t>(image->bufferView) >= model.bufferViews.size()) return false;
+    const auto& view = model.bufferViews[static_cast<size_t>(image->bufferView)];
+    if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model.buffers.size()) return false;
+    const auto& buffer = model.buffers[static_cast<size_t>(view.buffer)];
+    if (view.byteOffset > buffer.data.size() ||
+        view.byteLength > buffer.data.size() - view.byteOffset) {
+      if (err)
+        *err += "image[" + std::to_string(imageIndex) + "] bufferView lies outside its buffer\n";
+      return false;
+    }
+  }
+  if (images->bytes.size() <= static_cast<size_t>(imageIndex))
+    images->bytes.resize(static_cast<size_t>(imageIndex) + 1);
+  if (size > 0) images->bytes[static_cast<size_t>(imageIndex)].assign(bytes, bytes + size);
+  image->as_is = true;
+  return true;
+}
+
+std::string firstLine(const std::string& text) {
+  size_t begin = text.find_first_not_of(" \t\r\n");
+  if (begin == std::string::npos) return {};
+  size_t end = text.find_first_of("\r\n", begin);
+  return text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+}
+
+bool startsWithGlbMagic(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[4] = {};
+  return in.read(magic, 4) && std::memcmp(magic, "glTF", 4) == 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Accessors.
+
+size_t componentSize(int componentType) {
+  switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
+    default: return 0;  // INT and DOUBLE are not valid glTF 2.0 accessor component types
+  }
+}
+
+int componentCount(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR: return 1;
+    case TINYGLTF_TYPE_VEC2: return 2;
+    case TINYGLTF_TYPE_VEC3: return 3;
+    case TINYGLTF_TYPE_VEC4: return 4;
+    default: return 0;  // matrices are never read here
+  }
+}
+
+/// One component, normalized integers mapped as in the glTF specification (section 3.11).
+double readComponent(const unsigned char* p, int componentType, bool normalized) {
+  switch (componentType) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      int8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
+      uint8_t v;
+      std::memcpy(&v, p, 1);
+      return normalized ? v / 255.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      int16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      uint16_t v;
+      std::memcpy(&v, p, 2);
+      return normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT: {
+      uint32_t v;
+      std::memcpy(&v, p, 4);
+      return normalized ? v / 4294967295.0 : v;
+    }
+    default: {
+      float v;
+      std::memcpy(&v, p, 4);
+      return v;
+    }
+  }
+}
+
+/// A checked, strided range of `count` elements inside one buffer.
+struct ElementRange {
+  const unsigned char* data = nullptr;
+  size_t stride = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+class GltfSceneBuilder {
+ public:
+  GltfSceneBuilder(const tinygltf::Model& model, const EncodedImages& images,
+                   const std::string& path, const LoadOptions& options)
+      : model_(model), images_(images), path_(path), options_(options) {}
+
+  Result<Scene> build();
+
+ private:
+  Error fail(const std::string& what) const { return makeError(path_ + ": " + what); }
+
+  Result<ElementRange> elementRange(int bufferViewIndex, size_t byteOffset, size_t count,
+                                    size_t elementSize, bool allowStride,
+                                    const std::string& what) const;
+  Result<std::vector<double>> readAccessor(int index, int expectedType,
+                                           const std::string& what) const;
+  Result<void> visitNodes();
+  Result<void> addMesh(int meshIndex, const glm::dmat4& world);
+  Result<void> addPrimitive(const tinygltf::Primitive& primitive, const glm::dmat4& world,
+                            const std::string& what);
+  uint32_t materialIndex(int gltfMaterial);
+  int textureIndex(int gltfTexture);
+  Result<void> decodeTextures();
+  void addCameras();
+
+  const tinygltf::Model& model_;
+  const EncodedImages& images_;
+  const std::string& path_;
+  const LoadOptions& options_;
+
+  Scene scene_;
+  bool anyUvs_ = false;
+  std::map<int, uint32_t> materialMap_;  // glTF material (-1: default) -> scene material
+  std::map<int, int> imageMap_;          // glTF image -> scene texture
+  std::vector<std::pair<int, glm::dmat4>> cameraNodes_;  // (camera index, node world matrix)
+};
+
+Result<ElementRange> GltfSceneBuilder::elementRange(int bufferViewIndex, size_t byteOffset,
+                                                    size_t count, size_t elementSize,
+                                                    bool allowStride,
+                                                    const std::string& what) const {
+  if (bufferViewIndex < 0 || static_cast<size_t>(bufferViewIndex) >= model_.bufferViews.size())
+    return fail(what + ": bufferView " + std::to_string(bufferViewIndex) + " does not exist");
+  const tinygltf::BufferView& view = model_.bufferViews[static_cast<size_t>(bufferViewIndex)];
+  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= model_.buffers.size())
+    return fail(what + ": buffer " + std::to_string(view.buffer) + " does not exist");
+  const std::vector<unsigned char>& data = model_.buffers[static_cast<size_t>(view.buffer)].data;
+  if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset)
+    return fail(what + ": bufferView " + std::to_string(bufferViewIndex) +
+                " lies outside buffer " + std::to_string(view.buffer));
+  const size_t stride = (allowStride && view.byteStride != 0) ? view.byteStride : elementSize;
+  if (count > 0) {
+    // byteOffset + stride * (count - 1) + elementSize <= byteLength, without overflow.
+    const size_t length = view.byteLength;
+    const bool fits = byteOffset <= length && elementSize <= length - byteOffset &&
+                      (count - 1) <= (length - byteOffset - elementSize) / std::max<size_t>(stride, 1);
+    if (!fits)
+      return fail(what + ": reads past the end of bufferView " + std::to_string(bufferViewIndex));
+  }
+  return ElementRange{data.data() + view.byteOffset + byteOffset, stride};
+}
+
+/// All components of accessor `index` as doubles (count * components values), sparse substitution
+/// applied. An accessor without a bufferView reads as zeros.
+Result<std::vector<double>> GltfSceneBuilder::readAccessor(int index, int expectedType,
+                                                           const std::string& what) const {
+  if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
+    return fail(what + ": accessor " + std::to_string(index) + " does not exist");
+  const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(index)];
+  const std::string where = what + " (accessor " + std::to_string(index) + ")";
+  if (accessor.type != expectedType) return fail(where + ": unexpected element type");
+  const size_t csize = componentSize(accessor.componentType);
+  if (csize == 0) return fail(where + ": invalid component type");
+  const auto components = static_cast<size_t>(componentCount(accessor.type));
+  const size_t elementSize = csize * components;
+
+  std::vector<double> values;
+  if (accessor.bufferView >= 0) {
+    auto range = elementRange(accessor.bufferView, accessor.byteOffset, accessor.count,
+                              elementSize, true, where);
+    if (!range) return range.error();
+    values.resize(accessor.count * components);
+    for (size_t i = 0; i < accessor.count; ++i)
+      for (size_t c = 0; c < components; ++c)
+        values[i * components + c] = readComponent(range->data + i * range->stride + c * csize,
+                                                   accessor.componentType, accessor.normalized);
+  } else {
+    // No bufferView: zeros (possibly overridden by sparse values). Nothing in the file bounds the
+    // count here, so it is capped.
+    if (accessor.count > (size_t{1} << 22)) return fail(where + ": count too large");
+    values.assign(accessor.count * components, 0.0);
+  }
+
+  if (accessor.sparse.isSparse && accessor.sparse.count > 0) {
+    const auto& sparse = accessor.sparse;
+    const size_t count = static_cast<size_t>(sparse.count);
+    const size_t indexSize = componentSize(sparse.indices.componentType);
+    if (sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_BYTE ||
+        sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_SHORT ||
+        sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || indexSize == 0 ||
+        sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0)
+      return fail(where + ": invalid sparse accessor");
+    auto indexRange = elementRange(sparse.indices.bufferView,
+                                   static_cast<size_t>(sparse.indices.byteOffset), count,
+                                   indexSize, false, where + " sparse indices");
+    if (!indexRange) return indexRange.error();
+    auto valueRange = elementRange(sparse.values.bufferView,
+                                   static_cast<size_t>(sparse.values.byteOffset), count,
+                                   elementSize, false, where + " sparse values");
+    if (!valueRange) return valueRange.error();
+    for (size_t i = 0; i < count; ++i) {
+      const auto target = static_cast<size_t>(readComponent(
+          indexRange->data + i * indexSize, sparse.indices.componentType, false));
+      if (target >= accessor.count) return fail(where + ": sparse index out of range");
+      for (size_t c = 0; c < components; ++c)
+        values[target * components + c] =
+            readComponent(valueRange->data + i * elementSize + c * csize,
+                          accessor.componentType, accessor.normalized);
+    }
+  }
+  return values;
+}
+
+glm::dmat4 localTransform(const tinygltf::Node& node) {
+  if (node.matrix.size() == 16) return glm::make_mat4(node.matrix.data());  // column-major
+  glm::dmat4 m(1.0);
+  if (node.translation.size() == 3) m = glm::translate(m, glm::make_vec3(node.translation.data()));
+  if (node.rotation.size() == 4) {
+    const auto& r = node.rotation;  // x, y, z, w
+    m *= glm::mat4_cast(glm::normalize(glm::dquat(r[3], r[0], r[1], r[2])));
+  }
+  if (node.scale.size() == 3) m = glm::scale(m, glm::make_vec3(node.scale.data()));
+  return m;
+}
+
+/// Walks the chosen scene's node trees (iteratively: depth is not bounded by the stack). The glTF
+/// node hierarchy must be disjoint strict trees, so a node reached twice (cycle or shared child)
+/// makes the file invalid.
+Result<void> GltfSceneBuilder::visitNodes() {
+  std::vector<int> roots;
+  if (model_.defaultScene >= 0 && static_cast<size_t>(model_.defaultScene) < model_.scenes.size())
+    roots = model_.scenes[static_cast<size_t>(model_.defaultScene)].nodes;
+  else if (!model_.scenes.empty())
+    roots = model_.scenes[0].nodes;
+  else {
+    std::vector<char> isChild(model_.nodes.size(), 0);
+    for (const tinygltf::Node& node : model_.nodes)
+      for (int child : node.children)
+        if (child >= 0 && static_cast<size_t>(child) < isChild.size())
+          isChild[static_cast<size_t>(child)] = 1;
+    for (size_t i = 0; i < model_.nodes.size(); ++i)
+      if (!isChild[i]) roots.push_back(static_cast<int>(i));
+  }
+
+  std::vector<char> visited(model_.nodes.size(), 0);
+  std::vector<std::pair<int, glm::dmat4>> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, glm::dmat4(1.0));
+  while (!stack.empty()) {
+    const auto [index, parent] = stack.back();
+    stack.pop_back();
+    if (index < 0 || static_cast<size_t>(index) >= model_.nodes.size())
+      return fail("node " + std::to_string(index) + " does not exist");
+    if (visited[static_cast<size_t>(index)])
+      return fail("node " + std::to_string(index) + " appears twice in the node hierarchy");
+    visited[static_cast<size_t>(index)] = 1;
+    const tinygltf::Node& node = model_.nodes[static_cast<size_t>(index)];
+    const glm::dmat4 world = parent * localTransform(node);
+    if (node.mesh >= 0) MFR_TRY(addMesh(node.mesh, world));
+    if (node.camera >= 0) cameraNodes_.emplace_back(node.camera, world);
+    for (auto it = node.children.rbegin(); it != node.children.rend(); ++it)
+      stack.emplace_back(*it, world);
+  }
+  return {};
+}
+
+Result<void> GltfSceneBuilder::addMesh(int meshIndex, const glm::dmat4& world) {
+  if (static_cast<size_t>(meshIndex) >= model_.meshes.size())
+    return fail("mesh " + std::to_string(meshIndex) + " does not exist");
+  const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(meshIndex)];
+  for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+    const std::string what = "mesh " + std::to_string(meshIndex) + " ('" + mesh.name +
+                             "') primitive " + std::to_string(p);
+    MFR_TRY(addPrimitive(mesh.primitives[p], world, what));
+  }
+  return {};
+}
+
+/// Triangle list for a triangle, strip or fan primitive (glTF section 3.7.2.1); empty otherwise.
+std::vector<uint32_t> triangulate(int mode, const std::vector<uint32_t>& v) {
+  std::vector<uint32_t> out;
+  const size_t n = v.size();
+  if (mode == TINYGLTF_MODE_TRIANGLES) {
+    out.assign(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(n - n % 3));
+  } else if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+    for (size_t i = 0; i + 2 < n; ++i) {
+      const bool odd = i % 2 == 1;
+      out.insert(out.end(), {v[i], v[i + (odd ? 2 : 1)], v[i + (odd ? 1 : 2)]});
+    }
+  } else if (mode == TINYGLTF_MODE_TRIANGLE_FAN) {
+    for (size_t i = 0; i + 2 < n; ++i) out.insert(out.end(), {v[i + 1], v[i + 2], v[0]});
+  }
+  return out;
+}
+
+Result<void> GltfSceneBuilder::addPrimitive(const tinygltf::Primitive& primitive,
+                                            const glm::dmat4& world, const std::string& what) {
+  const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
+  if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+      mode != TINYGLTF_MODE_TRIANGLE_FAN)
+    return {};  // points and lines are not rendered
+  const auto position = primitive.attributes.find("POSITION");
+  if (position == primitive.attributes.end()) return {};  // nothing to draw
+
+  auto positions = readAccessor(position->second, TINYGLTF_TYPE_VEC3, what + " POSITION");
+  if (!positions) return positions.error();
+  const size_t vertexCount = positions->size() / 3;
+  const size_t base = scene_.positions.size();
+  if (vertexCount > std::numeric_limits<uint32_t>::max() - base)
+    return fail(what + ": more than 2^32 vertices in the scene");
+
+  std::vector<double> normals;
+  if (auto it = primitive.attributes.find("NORMAL"); it != primitive.attributes.end()) {
+    auto read = readAccessor(it->second, TINYGLTF_TYPE_VEC3, what + " NORMAL");
+    if (!read) return read.error();
+    if (read->size() != positions->size()) return fail(what + ": NORMAL count differs");
+    normals = std::move(*read);
+  }
+
+  // The texture coordinate set the base colour texture uses (TEXCOORD_0 unless it says otherwise).
+  int texCoord = 0;
+  if (primitive.material >= 0 && static_cast<size_t>(primitive.material) < model_.materials.size())
+    texCoord = std::max(0, model_.materials[static_cast<size_t>(primitive.material)]
+                               .pbrMetallicRoughness.baseColorTexture.texCoord);
+  std::vector<double> uvs;
+  const std::string uvName = "TEXCOORD_" + std::to_string(texCoord);
+  if (auto it = primitive.attributes.find(uvName); it != primitive.attributes.end()) {
+    auto read = readAccessor(it->second, TINYGLTF_TYPE_VEC2, what + " " + uvName);
+    if (!read) return read.error();
+    if (read->size() / 2 != vertexCount) return fail(what + ": " + uvName + " count differs");
+    uvs = std::move(*read);
+  }
+
+  std::vector<uint32_t> corners;
+  if (primitive.indices >= 0) {
+    auto read = readAccessor(primitive.indices, TINYGLTF_TYPE_SCALAR, what + " indices");
+    if (!read) return read.error();
+    const int type = model_.accessors[static_cast<size_t>(primitive.indices)].componentType;
+    if (type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+        type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+        type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+      return fail(what + ": indices must be unsigned integers");
+    corners.reserve(read->size());
+    for (double i : *read) {
+      if (i >= static_cast<double>(vertexCount))
+        return fail(what + ": vertex index " + std::to_string(static_cast<uint64_t>(i)) +
+                    " out of range (" + std::to_string(vertexCount) + " vertices)");
+      corners.push_back(static_cast<uint32_t>(i));
+    }
+  } else {
+    corners.resize(vertexCount);
+    for (size_t i = 0; i < vertexCount; ++i) corners[i] = static_cast<uint32_t>(i);
+  }
+  std::vector<uint32_t> triangles = triangulate(mode, corners);
+  if (triangles.empty()) return {};
+
+  // Geometry to world space; normals by the inverse transpose; mirrored transforms flip winding
+  // so that counter-clockwise stays front-facing.
+  const double det = glm::determinant(glm::dmat3(world));
+  const bool singular = !(std::abs(det) > 1e-300) || !std::isfinite(det);  // e.g. scale 0
+  const glm::dmat3 normalMatrix =
+      singular ? glm::dmat3(1.0) : glm::transpose(glm::inverse(glm::dmat3(world)));
+  for (size_t i = 0; i < vertexCount; ++i) {
+    const glm::dvec3 p = glm::make_vec3(positions->data() + 3 * i);
+    scene_.positions.emplace_back(glm::vec3(world * glm::dvec4(p, 1.0)));
+    if (!normals.empty()) {
+      const glm::dvec3 n = normalMatrix * glm::make_vec3(normals.data() + 3 * i);
+      const double length = glm::length(n);
+      scene_.normals.emplace_back(length > 0.0 ? glm::vec3(n / length) : glm::vec3(n));
+    } else {
+      scene_.normals.emplace_back(0.0f);  // filled from the faces below
+    }
+    scene_.uvs.emplace_back(uvs.empty() ? glm::vec2(0.0f)
+                                        : glm::vec2(static_cast<float>(uvs[2 * i]),
+                                                    static_cast<float>(uvs[2 * i + 1])));
+  }
+  anyUvs_ = anyUvs_ || !uvs.empty();
+
+  const bool mirrored = det < 0.0;
+  const uint32_t material = materialIndex(primitive.material);
+  for (size_t t = 0; t < triangles.size(); t += 3) {
+    const uint32_t a = static_cast<uint32_t>(base) + triangles[t];
+    uint32_t b = static_cast<uint32_t>(base) + triangles[t + 1];
+    uint32_t c = static_cast<uint32_t>(base) + triangles[t + 2];
+    if (mirrored) std::swap(b, c);
+    scene_.indices.insert(scene_.indices.end(), {a, b, c});
+    scene_.triangleMaterial.push_back(material);
+    if (normals.empty()) {  // area-weighted vertex normals of this primitive
+      const glm::vec3 n = glm::cross(scene_.positions[b] - scene_.positions[a],
+                                     scene_.positions[c] - scene_.positions[a]);
+      scene_.normals[a] += n;
+      scene_.normals[b] += n;
+      scene_.normals[c] += n;
+    }
+  }
+  if (normals.empty()) {
+    for (size_t i = base; i < scene_.normals.size(); ++i) {
+      const float length = glm::length(scene_.normals[i]);
+      scene_.normals[i] = (length > 0.0f && std::isfinite(length)) ? scene_.normals[i] / length
+                                                                     : glm::vec3(0.0f, 0.0f, 1.0f);
+    }
+  }
+  return {};
+}
+
+/// Scene material for a glTF material index; missing or invalid indices get the glTF default
+/// material (white, opaque).
+uint32_t GltfSceneBuilder::materialIndex(int gltfMaterial) {
+  if (gltfMaterial < 0 || static_cast<size_t>(gltfMaterial) >= model_.materials.size())
+    gltfMaterial = -1;
+  if (auto it = materialMap_.find(gltfMaterial); it != materialMap_.end()) return it->second;
+
+  Material material;
+  material.name = "default";
+  material.alphaMode = AlphaMode::Opaque;
+  if (gltfMaterial >= 0) {
+    const tinygltf::Material& src = model_.materials[static_cast<size_t>(gltfMaterial)];
+    material.name = src.name;
+    const auto& factor = src.pbrMetallicRoughness.baseColorFactor;
+    if (factor.size() == 4)
+      material.baseColor = glm::vec4(static_cast<float>(factor[0]), static_cast<float>(factor[1]),
+                                     static_cast<float>(factor[2]), static_cast<float>(factor[3]));
+    material.baseColorTexture = textureIndex(src.pbrMetallicRoughness.baseColorTexture.index);
+    if (src.alphaMode == "MASK")
+      material.alphaMode = AlphaMode::Mask;
+    else if (src.alphaMode == "BLEND")
+      material.alphaMode = AlphaMode::Blend;
+    material.alphaCutoff = static_cast<float>(src.alphaCutoff);
+    if (auto ext = src.extensions.find("KHR_materials_transmission");
+        ext != src.extensions.end()) {
+      double transmission = 0.0;
+      if (ext->second.Has("transmissionFactor") &&
+          ext->second.Get("transmissionFactor").IsNumber())
+        transmission = ext->second.Get("transmissionFactor").GetNumberAsDouble();
+      const float t = std::clamp(static_cast<float>(transmission), 0.0f, 1.0f);
+      material.transmission = t;
+      material.baseColor.a *= std::max(options_.transmissionAlphaFloor, 1.0f - t);
+      material.alphaMode = AlphaMode::Blend;
+    }
+  }
+  const auto index = static_cast<uint32_t>(scene_.materials.size());
+  scene_.materials.push_back(std::move(material));
+  materialMap_.emplace(gltfMaterial, index);
+  return index;
+}
+
+/// Reserves a scene texture slot for a glTF texture's image (decoded later), or -1.
+int GltfSceneBuilder::textureIndex(int gltfTexture) {
+  if (gltfTexture < 0 || static_cast<size_t>(gltfTexture) >= model_.textures.size()) return -1;
+  const int image = model_.textures[static_cast<size_t>(gltfTexture)].source;
+  if (image < 0 || static_cast<size_t>(image) >= model_.images.size()) return -1;
+  if (auto it = imageMap_.find(image); it != imageMap_.end()) return it->second;
+  const int index = static_cast<int>(imageMap_.size());
+  imageMap_.emplace(image, index);
+  return index;
+}
+
+uint8_t toByte(const tinygltf::Image& image, size_t component) {
+  if (image.bits == 16) {
+    uint16_t v;
+    std::memcpy(&v, image.image.data() + 2 * component, 2);
+    return static_cast<uint8_t>((v * 255u + 32767u) / 65535u);
+  }
+  return image.image[component];
+}
+
+/// RGBA8 copy of a decoded image with 1 (grey), 2 (grey, alpha), 3 or 4 channels of 8 or 16 bits.
+Result<Texture> toRgba8(const tinygltf::Image& image) {
+  const int channels = image.component;
+  if (image.width <= 0 || image.height <= 0 || channels < 1 || channels > 4 ||
+      (image.bits != 8 && image.bits != 16))
+    return makeError("unsupported image layout");
+  const size_t pixels = static_cast<size_t>(image.width) * static_cast<size_t>(image.height);
+  if (image.image.size() < pixels * static_cast<size_t>(channels) * (image.bits / 8))
+    return makeError("truncated image data");
+  Texture texture;
+  texture.width = image.width;
+  texture.height = image.height;
+  texture.rgba.resize(pixels * 4);
+  for (size_t i = 0; i < pixels; ++i) {
+    const size_t src = i * static_cast<size_t>(channels);
+    uint8_t* dst = texture.rgba.data() + 4 * i;
+    if (channels <= 2) {
+      dst[0] = dst[1] = dst[2] = toByte(image, src);
+      dst[3] = channels == 2 ? toByte(image, src + 1) : 255;
+    } else {
+      for (size_t c = 0; c < 3; ++c) dst[c] = toByte(image, src + c);
+      dst[3] = channels == 4 ? toByte(image, src + 3) : 255;
+    }
+  }
+  return texture;
+}
+
+/// Decodes the images that base colour textures use, in parallel, with tinygltf's stb_image loader.
+Result<void> GltfSceneBuilder::decodeTextures() {
+  std::vector<int> images(imageMap_.size());
+  for (const auto& [image, slot] : imageMap_) images[static_cast<size_t>(slot)] = image;
+  std::vector<Result<Texture>> decoded(images.size(), makeError(""));
+  tbb::parallel_for(size_t{0}, images.size(), [&](size_t i) {
+    const auto imageIndex = static_cast<size_t>(images[i]);
+    const tinygltf::Image& source = model_.images[imageIndex];
+    const std::string name = "image " + std::to_string(imageIndex) +
+                             (source.uri.empty() ? "" : " ('" + source.uri + "')");
+    if (imageIndex >= images_.bytes.size() || images_.bytes[imageIndex].empty()) {
+      decoded[i] = fail(name + " could not be read");
+      return;
+    }
+    const std::vector<unsigned char>& bytes = images_.bytes[imageIndex];
+    tinygltf::Image image;
+    std::string err, warn;
+    if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max()) ||
+        !tinygltf::LoadImageData(&image, static_cast<int>(imageIndex), &err, &warn, 0, 0,
+                                 bytes.data(), static_cast<int>(bytes.size()), nullptr)) {
+      decoded[i] = fail(name + ": " + (err.empty() ? "cannot decode" : firstLine(err)));
+      return;
+    }
+    auto texture = toRgba8(image);
+    decoded[i] = texture ? std::move(texture) : Result<Texture>(fail(name + ": " + texture.error().message));
+  });
+  for (auto& texture : decoded) {
+    if (!texture) return texture.error();
+    scene_.textures.push_back(std::move(*texture));
+  }
+  return {};
+}
+
+/// Perspective cameras of the visited nodes: eye at the node origin looking down its -Z axis with
+/// +Y up. The target is put on the view axis at the depth of the scene centre so that orbits
+/// around it (see orbit()) circle the scene.
+void GltfSceneBuilder::addCameras() {
+  const Bounds bounds = sceneBounds(scene_);
+  for (const auto& [cameraIndex, world] : cameraNodes_) {
+    if (cameraIndex < 0 || static_cast<size_t>(cameraIndex) >= model_.cameras.size()) continue;
+    const tinygltf::Camera& src = model_.cameras[static_cast<size_t>(cameraIndex)];
+    if (src.type != "perspective") continue;
+    const glm::vec3 eye(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+    glm::dvec3 forward = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
+    glm::dvec3 up = glm::dmat3(world) * glm::dvec3(0.0, 1.0, 0.0);
+    if (!(glm::length(forward) > 0.0) || !(glm::length(up) > 0.0)) continue;
+    forward = glm::normalize(forward);
+    up = glm::normalize(up);
+    Camera camera;
+    camera.eye = eye;
+    float depth = glm::dot(bounds.center() - eye, glm::vec3(forward));
+    if (!(depth > 1e-6f)) depth = std::max(bounds.radius(), 1.0f);
+    camera.target = eye + glm::vec3(forward) * depth;
+    camera.up = glm::vec3(up);
+    camera.fovYDegrees = static_cast<float>(glm::degrees(src.perspective.yfov));
+    camera.zNear = std::max(0.0f, static_cast<float>(src.perspective.znear));
+    camera.zFar = std::max(0.0f, static_cast<float>(src.perspective.zfar));  // 0: infinite
+    if (!(camera.fovYDegrees > 0.0f && camera.fovYDegrees < 180.0f)) camera.fovYDegrees = 45.0f;
+    scene_.cameras.push_back(camera);
+  }
+}
+
+Result<Scene> GltfSceneBuilder::build() {
+  scene_.name = path_;
+  for (const std::string& extension : model_.extensionsRequired)
+    if (extension == "KHR_draco_mesh_compression" || extension == "EXT_meshopt_compression")
+      return fail("requires unsupported extension " + extension);
+  MFR_TRY(visitNodes());
+  MFR_TRY(decodeTextures());
+  if (!anyUvs_) scene_.uvs.clear();
+  addCameras();
+  MFR_TRY(validateScene(scene_));
+  return std::move(scene_);
+}
+
+}  // namespace
+
+Result<Scene> loadGltf(const std::string& path, const LoadOptions& options) {
+  try {
+    tinygltf::Model model;
+    EncodedImages images;
+    images.model = &model;
+    tinygltf::TinyGLTF loader;
+    loader.SetImageLoader(&keepEncodedImage, &images);
+    std::string err, warn;
+    const bool ok = startsWithGlbMagic(path) ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
+                                             : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    if (!ok) {
+      const std::string reason = firstLine(err);
+      return makeError(path + ": " + (reason.empty() ? "invalid glTF file" : reason));
+    }
+    return GltfSceneBuilder(model, images, path, options).build();
+  } catch (const std::bad_alloc&) {
+    return makeError(path + ": out of memory");
+  } catch (const std::exception& e) {
+    return makeError(path + ": " + e.what());
+  }
+}
+
+}  // namespace mfr

@@ -1,0 +1,178 @@
+// JSON scene files: a mesh (any loadable file or procedural spec) plus viewing overrides.
+//
+//   {"mesh": "path/relative/to/this/file.gltf" | "procedural:NAME?...",   (required)
+//    "cameras": [{"eye": [x,y,z], "target": [x,y,z], "up": [0,1,0], "fov": 45,
+//                 "near": 0, "far": 0}],          (optional; replaces the file's cameras)
+//    "background": [r, g, b],                     (optional; linear RGB in [0, 1])
+//    "alpha": 0.5,                                (optional; global alpha override in [0, 1])
+//    "transmission_alpha_floor": 0.1}             (optional; in [0, 1])
+//
+// Unknown keys, wrong types and out-of-range values are errors naming the key and the file.
+#include <cctype>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "mfr/scene/load.hpp"
+
+namespace mfr {
+namespace {
+
+using nlohmann::json;
+
+/// Error helper: every message is "<file>: '<key>' <problem>".
+struct Checker {
+  const std::string& path;
+  Error fail(const std::string& key, const std::string& problem) const {
+    return makeError(path + ": '" + key + "' " + problem);
+  }
+
+  Result<float> number(const json& value, const std::string& key, float min, float max) const {
+    if (!value.is_number()) return fail(key, "must be a number");
+    const double v = value.get<double>();
+    if (!(v >= min && v <= max))
+      return fail(key, "must be in [" + trim(min) + ", " + trim(max) + "], got " + trim(v));
+    return static_cast<float>(v);
+  }
+
+  Result<glm::vec3> vec3(const json& value, const std::string& key, float min, float max) const {
+    if (!value.is_array() || value.size() != 3) return fail(key, "must be an array of 3 numbers");
+    glm::vec3 v(0.0f);
+    for (int i = 0; i < 3; ++i) {
+      auto c = number(value[static_cast<size_t>(i)], key, min, max);
+      if (!c) return c.error();
+      v[i] = *c;
+    }
+    return v;
+  }
+
+  static std::string trim(double v) {
+    std::string s = std::to_string(v);
+    if (s.find('.') != std::string::npos) {
+      s.erase(s.find_last_not_of('0') + 1);
+      if (s.back() == '.') s.pop_back();
+    }
+    return s;
+  }
+};
+
+constexpr float kHuge = 3.0e38f;
+
+Result<Camera> parseCamera(const Checker& check, const json& value, const std::string& key) {
+  if (!value.is_object()) return check.fail(key, "must be an object");
+  Camera camera;
+  camera.zNear = 0.0f;
+  camera.zFar = 0.0f;
+  for (const auto& [name, item] : value.items()) {
+    const std::string field = key + "." + name;
+    if (name == "eye" || name == "target" || name == "up") {
+      auto v = check.vec3(item, field, -kHuge, kHuge);
+      if (!v) return v.error();
+      (name == "eye" ? camera.eye : name == "target" ? camera.target : camera.up) = *v;
+    } else if (name == "fov") {
+      auto v = check.number(item, field, 0.0f, 180.0f);
+      if (!v) return v.error();
+      if (*v <= 0.0f || *v >= 180.0f) return check.fail(field, "must be in (0, 180) degrees");
+      camera.fovYDegrees = *v;
+    } else if (name == "near" || name == "far") {
+      auto v = check.number(item, field, 0.0f, kHuge);
+      if (!v) return v.error();
+      (name == "near" ? camera.zNear : camera.zFar) = *v;
+    } else {
+      return check.fail(field, "is not a camera key (eye, target, up, fov, near, far)");
+    }
+  }
+  if (!value.contains("eye")) return check.fail(key + ".eye", "is required");
+  if (!value.contains("target")) return check.fail(key + ".target", "is required");
+  const glm::vec3 forward = camera.target - camera.eye;
+  if (!(glm::length(forward) > 0.0f)) return check.fail(key, "has eye == target");
+  if (!(glm::length(glm::cross(forward, camera.up)) > 0.0f))
+    return check.fail(key + ".up", "must not be zero or parallel to the view direction");
+  if (camera.zNear > 0.0f && camera.zFar > 0.0f && camera.zFar <= camera.zNear)
+    return check.fail(key + ".far", "must be greater than near");
+  return camera;
+}
+
+}  // namespace
+
+Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options) {
+  std::ifstream in(path);
+  if (!in) return makeError(path + ": cannot be read");
+  json root;
+  try {
+    root = json::parse(in);
+  } catch (const json::exception& e) {
+    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at ..."
+    if (what.rfind("[json.exception.", 0) == 0 && what.find("] ") != std::string::npos)
+      what = what.substr(what.find("] ") + 2);
+    return makeError(path + ": JSON error: " + what);
+  }
+  const Checker check{path};
+  if (!root.is_object()) return makeError(path + ": JSON error: top level must be an object");
+
+  std::string mesh;
+  std::optional<std::vector<Camera>> cameras;
+  std::optional<glm::vec3> background;
+  std::optional<float> alpha;
+  LoadOptions meshOptions = options;
+  for (const auto& [key, value] : root.items()) {
+    if (key == "mesh") {
+      if (!value.is_string() || value.get<std::string>().empty())
+        return check.fail(key, "must be a non-empty string");
+      mesh = value.get<std::string>();
+    } else if (key == "cameras") {
+      if (!value.is_array()) return check.fail(key, "must be an array of camera objects");
+      cameras.emplace();
+      for (size_t i = 0; i < value.size(); ++i) {
+        auto camera = parseCamera(check, value[i], "cameras[" + std::to_string(i) + "]");
+        if (!camera) return camera.error();
+        cameras->push_back(*camera);
+      }
+    } else if (key == "background") {
+      auto v = check.vec3(value, key, 0.0f, 1.0f);
+      if (!v) return v.error();
+      background = *v;
+    } else if (key == "alpha") {
+      auto v = check.number(value, key, 0.0f, 1.0f);
+      if (!v) return v.error();
+      alpha = *v;
+    } else if (key == "transmission_alpha_floor") {
+      auto v = check.number(value, key, 0.0f, 1.0f);
+      if (!v) return v.error();
+      meshOptions.transmissionAlphaFloor = *v;
+    } else {
+      return check.fail(key, "is not a scene key (mesh, cameras, background, alpha, "
+                             "transmission_alpha_floor)");
+    }
+  }
+  if (mesh.empty()) return check.fail("mesh", "is required");
+
+  // Files resolve against this file's directory; JSON scene files do not nest.
+  std::string source = mesh;
+  if (mesh.rfind("procedural:", 0) != 0) {
+    const std::filesystem::path meshPath(mesh);
+    std::string extension = meshPath.extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (extension == ".json")
+      return check.fail("mesh", "must not be another JSON scene file");
+    source = meshPath.is_absolute()
+                 ? mesh
+                 : (std::filesystem::path(path).parent_path() / meshPath).lexically_normal().string();
+  }
+  auto loaded = loadScene(source, meshOptions);
+  if (!loaded) return makeError(path + ": mesh: " + loaded.error().message);
+
+  Scene scene = std::move(*loaded);
+  scene.name = path;
+  if (cameras) scene.cameras = std::move(*cameras);
+  if (background) scene.background = *background;
+  if (alpha) scene.alphaOverride = *alpha;
+  MFR_TRY(validateScene(scene));
+  return scene;
+}
+
+}  // namespace mfr

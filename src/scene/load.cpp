@@ -1,0 +1,63 @@
+// Scene source dispatch (include/mfr/scene/load.hpp): "procedural:SPEC" goes to the procedural
+// scenes, files go to the loader for their (case-insensitive) extension. Every scene handed out
+// has vertex normals, passes validateScene and is named after the source string.
+#include "mfr/scene/load.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <fstream>
+#include <system_error>
+
+#include "mfr/scene/procedural.hpp"
+
+namespace mfr {
+
+namespace {
+
+constexpr const char* kProceduralPrefix = "procedural:";
+
+std::string lowercaseExtension(const std::string& path) {
+  std::string extension = std::filesystem::path(path).extension().string();
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return extension;
+}
+
+Result<Scene> loadFile(const std::string& path, const LoadOptions& options) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) return makeError(path + ": no such file");
+  if (std::filesystem::is_directory(status)) return makeError(path + ": is a directory");
+  if (!std::ifstream(path, std::ios::binary)) return makeError(path + ": cannot be read");
+
+  const std::string extension = lowercaseExtension(path);
+  if (extension == ".gltf" || extension == ".glb") return loadGltf(path, options);
+  if (extension == ".obj") return loadObj(path, options);
+  if (extension == ".ply") return loadPly(path, options);
+  if (extension == ".json") return loadJsonScene(path, options);
+  return makeError(path + ": unsupported scene format " +
+                   (extension.empty() ? "(no extension)" : "'" + extension + "'") +
+                   " (expected .gltf, .glb, .obj, .ply, .json)");
+}
+
+}  // namespace
+
+Result<Scene> loadScene(const std::string& source, const LoadOptions& options) {
+  const std::string prefix = kProceduralPrefix;
+  Result<Scene> loaded = source.rfind(prefix, 0) == 0
+                             ? makeProceduralScene(source.substr(prefix.size()), options.seed)
+                             : loadFile(source, options);
+  if (!loaded) {  // make sure the message names the source (procedural errors may not)
+    const std::string& message = loaded.error().message;
+    if (message.find(source) == std::string::npos) return makeError(source + ": " + message);
+    return loaded.error();
+  }
+  Scene scene = std::move(*loaded);
+  scene.name = source;
+  computeVertexNormals(scene);
+  MFR_TRY(validateScene(scene));
+  return scene;
+}
+
+}  // namespace mfr

@@ -1,0 +1,296 @@
+// Wavefront OBJ + MTL loader on top of tinyobjloader (polygons triangulated by tinyobjloader).
+//
+// Conventions:
+//  - Texture coordinates are flipped (uv.y = 1 - v): OBJ puts v = 0 at the bottom of the image,
+//    the scene (like glTF) at the top row.
+//  - Kd is the linear base colour; map_Kd is loaded with stb_image to RGBA8 (sRGB as stored),
+//    resolved relative to the directory of the MTL file that declared it. A missing or undecodable
+//    texture is an error naming it.
+//  - Alpha is tinyobjloader's `dissolve`: `d` when present, otherwise 1 - `Tr` (tinyobjloader
+//    already does this inversion, and ignores `Tr` when `d` is present). Alpha < 1 -> Blend, else
+//    Opaque. Faces without a (known) material use a default opaque white material.
+//  - Vertex normals are used when every face corner has one; otherwise all are recomputed.
+//  - tinyobjloader reads "nan"/"inf" coordinates as 0; those values are restored so that
+//    validateScene rejects them instead of the scene silently changing.
+#include <tiny_obj_loader.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <map>
+#include <new>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "mfr/scene/load.hpp"
+
+// A private copy of stb_image (static functions) for map_Kd textures.
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wunused-but-set-variable"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#endif
+#define STB_IMAGE_STATIC
+#define STB_IMAGE_IMPLEMENTATION
+#include <stb_image.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+
+namespace mfr {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// Reads the MTL files an OBJ names (relative to the OBJ's directory) and remembers which
+/// directory each material came from, so texture paths resolve against their own MTL file.
+class MtlReader : public tinyobj::MaterialReader {
+ public:
+  explicit MtlReader(fs::path objDirectory) : objDirectory_(std::move(objDirectory)) {}
+
+  bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
+                  std::map<std::string, int>* materialMap, std::string* warn,
+                  std::string* err) override {
+    const fs::path path = objDirectory_ / fs::path(name).lexically_normal();
+    std::ifstream stream(path);
+    if (!stream) {
+      if (warn) *warn += "material file '" + path.string() + "' not found\n";
+      return false;
+    }
+    tinyobj::LoadMtl(materialMap, materials, &stream, warn, err);
+    directories.resize(materials->size(), path.parent_path());
+    return true;
+  }
+
+  std::vector<fs::path> directories;  // by material index
+
+ private:
+  fs::path objDirectory_;
+};
+
+std::string firstLine(const std::string& text) {
+  const size_t begin = text.find_first_not_of(" \t\r\n");
+  if (begin == std::string::npos) return {};
+  const size_t end = text.find_first_of("\r\n", begin);
+  return text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+}
+
+/// First line of `text` containing one of `needles` (case-insensitively), or "".
+std::string lineContaining(const std::string& text, std::initializer_list<const char*> needles) {
+  std::string lower = text;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* needle : needles) {
+    const size_t at = lower.find(needle);
+    if (at == std::string::npos) continue;
+    const size_t begin = text.find_last_of('\n', at) == std::string::npos
+                             ? 0
+                             : text.find_last_of('\n', at) + 1;
+    return firstLine(text.substr(begin));
+  }
+  return {};
+}
+
+/// tinyobjloader parses "nan" and "inf" as 0: put the real (non-finite) values back.
+void restoreNonFiniteCoordinates(const std::string& path, std::vector<float>& vertices) {
+  std::ifstream in(path);
+  std::string line;
+  size_t vertex = 0;
+  while (std::getline(in, line)) {
+    const size_t start = line.find_first_not_of(" \t");
+    if (start == std::string::npos || line[start] != 'v' || start + 1 >= line.size() ||
+        (line[start + 1] != ' ' && line[start + 1] != '\t'))
+      continue;
+    const char* token = line.c_str() + start + 1;
+    for (size_t c = 0; c < 3; ++c) {
+      char* end = nullptr;
+      const float value = std::strtof(token, &end);
+      if (end == token) break;
+      if (!std::isfinite(value) && 3 * vertex + c < vertices.size())
+        vertices[3 * vertex + c] = value;
+      token = end;
+    }
+    ++vertex;
+  }
+}
+
+Result<Texture> loadTexture(const fs::path& file) {
+  int width = 0, height = 0, channels = 0;
+  stbi_uc* pixels = stbi_load(file.string().c_str(), &width, &height, &channels, 4);
+  if (!pixels) {
+    const char* reason = stbi_failure_reason();
+    return makeError("cannot load texture '" + file.string() + "'" +
+                     (reason ? std::string(": ") + reason : std::string()));
+  }
+  Texture texture;
+  texture.width = width;
+  texture.height = height;
+  texture.rgba.assign(pixels, pixels + static_cast<size_t>(width) * static_cast<size_t>(height) * 4);
+  stbi_image_free(pixels);
+  return texture;
+}
+
+struct CornerKey {
+  int v, n, t;
+  bool operator==(const CornerKey&) const = default;
+};
+struct CornerHash {
+  size_t operator()(const CornerKey& k) const {
+    uint64_t h = static_cast<uint32_t>(k.v);
+    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<uint32_t>(k.n);
+    h = h * 0x9E3779B97F4A7C15ull ^ static_cast<uint32_t>(k.t);
+    return static_cast<size_t>(h ^ (h >> 29));
+  }
+};
+
+Result<Scene> buildObjScene(const std::string& path) {
+  const fs::path objDirectory = fs::path(path).parent_path();
+  std::ifstream stream(path);
+  if (!stream) return makeError(path + ": cannot be read");
+  tinyobj::attrib_t attrib;
+  std::vector<tinyobj::shape_t> shapes;
+  std::vector<tinyobj::material_t> objMaterials;
+  std::string warn, err;
+  MtlReader mtlReader(objDirectory);
+  if (!tinyobj::LoadObj(&attrib, &shapes, &objMaterials, &warn, &err, &stream, &mtlReader,
+                        /*triangulate=*/true)) {
+    const std::string reason = firstLine(err);
+    return makeError(path + ": " + (reason.empty() ? "invalid OBJ file" : reason));
+  }
+  // tinyobjloader only warns about faces with out-of-range indices (and drops some of them).
+  if (const std::string bad = lineContaining(warn, {"out of bounds", "invalid vertex index"});
+      !bad.empty())
+    return makeError(path + ": " + bad);
+  restoreNonFiniteCoordinates(path, attrib.vertices);
+
+  Scene scene;
+  scene.name = path;
+
+  // Materials (plus a default one, appended when some face needs it).
+  std::map<std::string, int> textureByPath;
+  for (size_t m = 0; m < objMaterials.size(); ++m) {
+    const tinyobj::material_t& src = objMaterials[m];
+    Material material;
+    material.name = src.name;
+    const float alpha = std::clamp(static_cast<float>(src.dissolve), 0.0f, 1.0f);
+    material.baseColor = glm::vec4(src.diffuse[0], src.diffuse[1], src.diffuse[2], alpha);
+    material.alphaMode = alpha < 1.0f ? AlphaMode::Blend : AlphaMode::Opaque;
+    if (!src.diffuse_texname.empty()) {
+      std::string name = src.diffuse_texname;
+      std::replace(name.begin(), name.end(), '\\', '/');  // paths written on Windows
+      const fs::path directory =
+          m < mtlReader.directories.size() ? mtlReader.directories[m] : objDirectory;
+      const fs::path file = (directory / name).lexically_normal();
+      auto it = textureByPath.find(file.string());
+      if (it == textureByPath.end()) {
+        auto texture = loadTexture(file);
+        if (!texture) return makeError(path + ": " + texture.error().message);
+        it = textureByPath.emplace(file.string(), static_cast<int>(scene.textures.size())).first;
+        scene.textures.push_back(std::move(*texture));
+      }
+      material.baseColorTexture = it->second;
+    }
+    scene.materials.push_back(std::move(material));
+  }
+  uint32_t defaultMaterial = UINT32_MAX;
+  auto materialFor = [&](int id) -> uint32_t {
+    if (id >= 0 && static_cast<size_t>(id) < objMaterials.size()) return static_cast<uint32_t>(id);
+    if (defaultMaterial == UINT32_MAX) {
+      Material material;
+      material.name = "default";
+      material.alphaMode = AlphaMode::Opaque;
+      defaultMaterial = static_cast<uint32_t>(scene.materials.size());
+      scene.materials.push_back(std::move(material));
+    }
+    return defaultMaterial;
+  };
+
+  const size_t vertexCount = attrib.vertices.size() / 3;
+  const size_t normalCount = attrib.normals.size() / 3;
+  const size_t uvCount = attrib.texcoords.size() / 2;
+  bool allNormals = true, anyUvs = false;
+  for (const tinyobj::shape_t& shape : shapes)
+    for (const tinyobj::index_t& corner : shape.mesh.indices) {
+      if (corner.vertex_index < 0 || static_cast<size_t>(corner.vertex_index) >= vertexCount)
+        return makeError(path + ": face references vertex " +
+                         std::to_string(corner.vertex_index + 1) + " of " +
+                         std::to_string(vertexCount));
+      if (corner.normal_index >= 0 && static_cast<size_t>(corner.normal_index) >= normalCount)
+        return makeError(path + ": face references missing normal " +
+                         std::to_string(corner.normal_index + 1));
+      if (corner.texcoord_index >= 0 && static_cast<size_t>(corner.texcoord_index) >= uvCount)
+        return makeError(path + ": face references missing texture coordinate " +
+                         std::to_string(corner.texcoord_index + 1));
+      allNormals = allNormals && corner.normal_index >= 0;
+      anyUvs = anyUvs || corner.texcoord_index >= 0;
+    }
+
+  // One scene vertex per distinct (position, normal, uv) corner.
+  std::unordered_map<CornerKey, uint32_t, CornerHash> vertexOf;
+  for (const tinyobj::shape_t& shape : shapes) {
+    const tinyobj::mesh_t& mesh = shape.mesh;
+    size_t offset = 0;
+    for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
+      const size_t corners = mesh.num_face_vertices[f];
+      if (corners != 3 || offset + 3 > mesh.indices.size()) {  // not triangulated: skip
+        offset += corners;
+        continue;
+      }
+      for (size_t k = 0; k < 3; ++k) {
+        const tinyobj::index_t& corner = mesh.indices[offset + k];
+        const CornerKey key{corner.vertex_index, allNormals ? corner.normal_index : -1,
+                            corner.texcoord_index};
+        auto [it, inserted] = vertexOf.try_emplace(key, static_cast<uint32_t>(scene.positions.size()));
+        if (inserted) {
+          const auto v = static_cast<size_t>(key.v);
+          scene.positions.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
+                                       attrib.vertices[3 * v + 2]);
+          if (allNormals) {
+            const auto n = static_cast<size_t>(key.n);
+            const glm::vec3 normal(attrib.normals[3 * n], attrib.normals[3 * n + 1],
+                                   attrib.normals[3 * n + 2]);
+            const float length = glm::length(normal);
+            scene.normals.push_back(length > 0.0f ? normal / length : normal);
+          }
+          if (anyUvs) {
+            const auto t = static_cast<size_t>(key.t);
+            scene.uvs.push_back(key.t < 0 ? glm::vec2(0.0f)
+                                          : glm::vec2(attrib.texcoords[2 * t],
+                                                      1.0f - attrib.texcoords[2 * t + 1]));
+          }
+        }
+        scene.indices.push_back(it->second);
+      }
+      scene.triangleMaterial.push_back(
+          materialFor(f < mesh.material_ids.size() ? mesh.material_ids[f] : -1));
+      offset += 3;
+    }
+  }
+  if (scene.materials.empty()) materialFor(-1);  // no faces: still a well-formed material list
+
+  computeVertexNormals(scene);
+  MFR_TRY(validateScene(scene));
+  return scene;
+}
+
+}  // namespace
+
+Result<Scene> loadObj(const std::string& path, const LoadOptions& /*options*/) {
+  try {
+    return buildObjScene(path);
+  } catch (const std::bad_alloc&) {
+    return makeError(path + ": out of memory");
+  } catch (const std::exception& e) {
+    return makeError(path + ": " + e.what());
+  }
+}
+
+}  // namespace mfr
