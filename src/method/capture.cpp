@@ -20,9 +20,7 @@
 #include <atomic>
 #include <thread>
 
-#include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include <algorithm>
 
 #include "pipeline.hpp"
 
@@ -137,19 +135,25 @@ CaptureCounters runCapture(const RasterFrame& frame, const Allocation& alloc,
     for (const CaptureCounters& c : perTile) total.add(c);
     return total;
   }
+  // plain std::threads (not the TBB pool) pulling chunks of triangles from a shared cursor: any
+  // interleaving of fragments across pixels, and a pass ThreadSanitizer can follow end to end
   using Sink = CaptureSink<Hybrid, Occupancy, KPlus, AtomicAccess, SpinLock>;
-  tbb::enumerable_thread_specific<CaptureCounters> perThread;
   const size_t triangles = frame.setups().size();
-  tbb::task_arena arena(frame.threads());
-  arena.execute([&] {
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, triangles, 16),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                        Sink sink{alloc, occupancy, stores, {}};
-                        for (size_t t = r.begin(); t != r.end(); ++t)
-                          frame.rasterizeTriangle<ShadeMode::Full>(t, sink);
-                        perThread.local().add(sink.counters);
-                      });
-  });
+  constexpr size_t kChunk = 16;
+  std::atomic<size_t> cursor{0};
+  std::vector<CaptureCounters> perThread(static_cast<size_t>(frame.threads()));
+  std::vector<std::thread> workers;
+  for (int w = 0; w < frame.threads(); ++w)
+    workers.emplace_back([&, w] {
+      Sink sink{alloc, occupancy, stores, {}};
+      for (size_t begin = cursor.fetch_add(kChunk); begin < triangles;
+           begin = cursor.fetch_add(kChunk)) {
+        const size_t end = std::min(triangles, begin + kChunk);
+        for (size_t t = begin; t < end; ++t) frame.rasterizeTriangle<ShadeMode::Full>(t, sink);
+      }
+      perThread[w] = sink.counters;
+    });
+  for (std::thread& t : workers) t.join();
   for (const CaptureCounters& c : perThread) total.add(c);
   return total;
 }

@@ -3,15 +3,28 @@
 // importer ever looks at it. Triangulated, identical vertices joined; node transforms applied;
 // file normals used when every mesh has them (otherwise computed); vertex colours ignored.
 // PLY has no materials: everything gets one opaque light-grey material.
+//
+// assimp 5.2's PLY importer crashes or spins on malformed files (truncated bodies, corrupted
+// headers, huge element counts, out-of-range face indices), so every file is first checked
+// against the PLY format (http://paulbourke.net/dataformats/ply/) by checkPlyStructure below,
+// and assimp only ever sees structurally valid files.
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <new>
+#include <sstream>
 #include <string>
+#include <string_view>
+#include <system_error>
 #include <vector>
 
 #include <glm/gtc/type_ptr.hpp>
@@ -20,6 +33,247 @@
 
 namespace mfr {
 namespace {
+
+// ---------------------------------------------------------------------------------------------
+// PLY structure check.
+
+enum class PlyFormat { Ascii, BinaryLittleEndian, BinaryBigEndian };
+
+struct PlyType {
+  int size = 0;  // bytes; 0: unknown type name
+  bool integral = false;
+  bool isSigned = false;
+};
+
+struct PlyProperty {
+  std::string name;
+  PlyType type;       // of the scalar, or of each list item
+  PlyType countType;  // list properties only (size 0 for scalars)
+  bool isList() const { return countType.size > 0; }
+};
+
+struct PlyElement {
+  std::string name;
+  uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+PlyType plyType(const std::string& name) {
+  if (name == "char" || name == "int8") return {1, true, true};
+  if (name == "uchar" || name == "uint8") return {1, true, false};
+  if (name == "short" || name == "int16") return {2, true, true};
+  if (name == "ushort" || name == "uint16") return {2, true, false};
+  if (name == "int" || name == "int32") return {4, true, true};
+  if (name == "uint" || name == "uint32") return {4, true, false};
+  if (name == "float" || name == "float32") return {4, false, true};
+  if (name == "double" || name == "float64") return {8, false, true};
+  return {};
+}
+
+bool isFaceIndexList(const PlyElement& element, const PlyProperty& property) {
+  return element.name == "face" && property.isList() &&
+         (property.name == "vertex_indices" || property.name == "vertex_index");
+}
+
+/// An integer of the given type in the file's byte order, widened to 64 bits.
+int64_t readInteger(const unsigned char* p, const PlyType& type, bool bigEndian) {
+  uint64_t v = 0;
+  for (int i = 0; i < type.size; ++i)
+    v |= uint64_t{p[bigEndian ? i : type.size - 1 - i]} << (8 * (type.size - 1 - i));
+  const int bits = 8 * type.size;
+  if (type.isSigned && bits < 64 && (v >> (bits - 1)) != 0) v |= ~uint64_t{0} << bits;
+  return static_cast<int64_t>(v);
+}
+
+class PlyChecker {
+ public:
+  explicit PlyChecker(const std::vector<char>& bytes) : bytes_(bytes) {}
+
+  /// "" when the file is a well-formed PLY file with in-range face indices, else the problem.
+  std::string check() {
+    if (std::string problem = parseHeader(); !problem.empty()) return problem;
+    return format_ == PlyFormat::Ascii ? checkAsciiBody() : checkBinaryBody();
+  }
+
+ private:
+  bool nextLine(std::string_view& line) {
+    if (pos_ >= bytes_.size()) return false;
+    const char* begin = bytes_.data() + pos_;
+    const void* newline = std::memchr(begin, '\n', bytes_.size() - pos_);
+    const size_t length =
+        newline ? static_cast<size_t>(static_cast<const char*>(newline) - begin) : bytes_.size() - pos_;
+    pos_ += length + (newline ? 1 : 0);
+    line = std::string_view(begin, length);
+    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+    return true;
+  }
+
+  static std::vector<std::string> words(std::string_view line) {
+    std::istringstream in{std::string(line)};
+    std::vector<std::string> out;
+    for (std::string word; in >> word;) out.push_back(word);
+    return out;
+  }
+
+  std::string parseHeader() {
+    std::string_view line;
+    if (!nextLine(line) || line != "ply") return "not a PLY file (no 'ply' magic line)";
+    bool haveFormat = false;
+    while (true) {
+      if (!nextLine(line)) return "PLY header has no end_header line";
+      const std::vector<std::string> w = words(line);
+      if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
+      if (w[0] == "end_header") break;
+      if (w[0] == "format") {
+        if (w.size() != 3 || w[2] != "1.0") return "bad PLY format line";
+        if (w[1] == "ascii") format_ = PlyFormat::Ascii;
+        else if (w[1] == "binary_little_endian") format_ = PlyFormat::BinaryLittleEndian;
+        else if (w[1] == "binary_big_endian") format_ = PlyFormat::BinaryBigEndian;
+        else return "unknown PLY format '" + w[1] + "'";
+        haveFormat = true;
+      } else if (w[0] == "element") {
+        char* end = nullptr;
+        if (w.size() != 3) return "bad PLY element line";
+        const unsigned long long count = std::strtoull(w[2].c_str(), &end, 10);
+        if (*end != '\0' || w[2][0] == '-' || count > std::numeric_limits<uint32_t>::max())
+          return "bad PLY element count '" + w[2] + "'";
+        elements_.push_back({w[1], count, {}});
+      } else if (w[0] == "property") {
+        if (elements_.empty()) return "PLY property before any element";
+        PlyProperty property;
+        if (w.size() == 5 && w[1] == "list") {
+          property = {w[4], plyType(w[3]), plyType(w[2])};
+          if (!property.countType.integral || property.type.size == 0)
+            return "bad PLY list property";
+        } else if (w.size() == 3) {
+          property = {w[2], plyType(w[1]), {}};
+          if (property.type.size == 0) return "unknown PLY property type '" + w[1] + "'";
+        } else {
+          return "bad PLY property line";
+        }
+        elements_.back().properties.push_back(property);
+      } else {
+        return "unknown PLY header line '" + std::string(line.substr(0, 40)) + "'";
+      }
+    }
+    if (!haveFormat) return "PLY header has no format line";
+    bool x = false, y = false, z = false;
+    for (const PlyElement& element : elements_) {
+      if (element.name == "vertex") {
+        vertexCount_ = element.count;
+        for (const PlyProperty& p : element.properties) {
+          x = x || (p.name == "x" && !p.isList());
+          y = y || (p.name == "y" && !p.isList());
+          z = z || (p.name == "z" && !p.isList());
+        }
+      }
+      if (element.name == "face")
+        for (const PlyProperty& p : element.properties)
+          if (isFaceIndexList(element, p) && !p.type.integral)
+            return "PLY face indices are not integers";
+    }
+    if (!(x && y && z)) return "PLY file has no vertex element with x, y, z";
+    return {};
+  }
+
+  std::string faceProblem(int64_t count, const std::vector<int64_t>& indices) const {
+    if (count < 3) return "PLY face with fewer than 3 vertices";
+    for (int64_t index : indices)
+      if (index < 0 || static_cast<uint64_t>(index) >= vertexCount_)
+        return "PLY face index " + std::to_string(index) + " out of range (" +
+               std::to_string(vertexCount_) + " vertices)";
+    return {};
+  }
+
+  std::string checkBinaryBody() {
+    const bool bigEndian = format_ == PlyFormat::BinaryBigEndian;
+    const auto* data = reinterpret_cast<const unsigned char*>(bytes_.data());
+    const size_t size = bytes_.size();
+    const std::string truncated = "PLY file is truncated";
+    std::vector<int64_t> indices;
+    for (const PlyElement& element : elements_) {
+      for (uint64_t item = 0; item < element.count; ++item) {
+        for (const PlyProperty& property : element.properties) {
+          const auto itemSize = static_cast<size_t>(property.type.size);
+          if (!property.isList()) {
+            if (size - pos_ < itemSize) return truncated;
+            pos_ += itemSize;
+            continue;
+          }
+          const auto countSize = static_cast<size_t>(property.countType.size);
+          if (size - pos_ < countSize) return truncated;
+          const int64_t count = readInteger(data + pos_, property.countType, bigEndian);
+          pos_ += countSize;
+          if (count < 0) return "negative PLY list count";
+          if (static_cast<uint64_t>(count) > (size - pos_) / itemSize) return truncated;
+          if (isFaceIndexList(element, property)) {
+            indices.clear();
+            for (size_t i = 0; i < static_cast<size_t>(count); ++i)
+              indices.push_back(readInteger(data + pos_ + i * itemSize, property.type, bigEndian));
+            if (std::string problem = faceProblem(count, indices); !problem.empty()) return problem;
+          }
+          pos_ += static_cast<size_t>(count) * itemSize;
+        }
+      }
+    }
+    return {};
+  }
+
+  std::string checkAsciiBody() {
+    std::string_view line;
+    std::vector<int64_t> indices;
+    for (const PlyElement& element : elements_) {
+      for (uint64_t item = 0; item < element.count; ++item) {
+        do {
+          if (!nextLine(line)) return "PLY file is truncated (element '" + element.name + "')";
+        } while (line.find_first_not_of(" \t") == std::string_view::npos);
+        size_t next = 0;  // cursor in `line`
+        // The next whitespace-separated token of the line, parsed as a number.
+        auto number = [&](double* value) {
+          next = line.find_first_not_of(" \t", next);
+          if (next == std::string_view::npos) return false;
+          size_t end = line.find_first_of(" \t", next);
+          if (end == std::string_view::npos) end = line.size();
+          const char* first = line.data() + next + (line[next] == '+' ? 1 : 0);
+          const char* last = line.data() + end;
+          next = end;
+          const auto [ptr, ec] = std::from_chars(first, last, *value);
+          return ec == std::errc() && ptr == last;
+        };
+        for (const PlyProperty& property : element.properties) {
+          double value = 0.0;
+          if (!property.isList()) {
+            if (!number(&value)) return "bad PLY " + element.name + " line";
+            continue;
+          }
+          if (!number(&value) || value < 0 || value != std::floor(value) || value > 1e6)
+            return "bad PLY list count in " + element.name + " line";
+          const auto count = static_cast<int64_t>(value);
+          indices.clear();
+          for (int64_t i = 0; i < count; ++i) {
+            if (!number(&value)) return "bad PLY " + element.name + " line";
+            indices.push_back(value == std::floor(value) && std::abs(value) < 1e18
+                                  ? static_cast<int64_t>(value)
+                                  : -1);
+          }
+          if (isFaceIndexList(element, property))
+            if (std::string problem = faceProblem(count, indices); !problem.empty()) return problem;
+        }
+        if (line.find_first_not_of(" \t", next) != std::string_view::npos)
+          return "bad PLY " + element.name + " line (extra values)";
+      }
+    }
+    return {};
+  }
+
+  const std::vector<char>& bytes_;
+  size_t pos_ = 0;
+  PlyFormat format_ = PlyFormat::Ascii;
+  std::vector<PlyElement> elements_;
+  uint64_t vertexCount_ = 0;
+};
+
+// ---------------------------------------------------------------------------------------------
 
 glm::mat4 toGlm(const aiMatrix4x4& m) {
   return glm::transpose(glm::make_mat4(&m.a1));  // assimp matrices are row-major
@@ -76,11 +330,11 @@ Result<Scene> loadPly(const std::string& path, const LoadOptions& /*options*/) {
     const std::vector<char> bytes((std::istreambuf_iterator<char>(in)),
                                   std::istreambuf_iterator<char>());
     if (bytes.empty()) return makeError(path + ": empty file");
+    if (std::string problem = PlyChecker(bytes).check(); !problem.empty())
+      return makeError(path + ": " + problem);
 
     Assimp::Importer importer;
-    // assimp's PLY importer does not check face indices against the vertex count (a truncated
-    // binary file yields garbage indices), so the data structure is validated before any other
-    // post-processing step touches it.
+    // Belt and braces: assimp validates its own output before the other post-processing steps.
     const aiScene* ai = importer.ReadFileFromMemory(
         bytes.data(), bytes.size(),
         aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices,

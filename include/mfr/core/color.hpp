@@ -3,10 +3,14 @@
 // written sRGB-encoded.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 
 #include <glm/glm.hpp>
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
 
 namespace mfr {
 
@@ -17,7 +21,10 @@ float linearToSrgb(float linear);
 /// Table lookups for the hot paths.
 struct ColorTables {
   std::array<float, 256> srgb8ToLinear;  // decode of an 8-bit sRGB code
-  std::array<uint8_t, 65536> linear16ToSrgb8;  // encode of round(linear * 65535)
+  // encode: a coarse guess from round(linear * 4095), corrected by the exact code boundaries
+  // (lowerBound[c] = linear value of sRGB (c - 0.5) / 255); 5 KB, so it stays in L1
+  std::array<uint8_t, 4096> coarseSrgb8;
+  std::array<float, 257> lowerBound;
   static const ColorTables& get() {
     static const ColorTables tables = build();
     return tables;
@@ -27,25 +34,41 @@ struct ColorTables {
   static ColorTables build();
 };
 
-/// Linear [0, 1] (clamped; NaN -> 0) to an 8-bit sRGB code.
-inline uint8_t encodeSrgb8(float linear) {
-  const float c = linear > 0.0f ? (linear < 1.0f ? linear : 1.0f) : 0.0f;
-  return ColorTables::get().linear16ToSrgb8[static_cast<uint32_t>(c * 65535.0f + 0.5f)];
+/// Linear [0, 1] (clamped; NaN -> 0) to the correctly rounded 8-bit sRGB code.
+/// clamp(v, 0, 1) with NaN -> 0, as two min/max instructions.
+inline float saturate(float v) {
+#if defined(__SSE2__)
+  return _mm_cvtss_f32(_mm_min_ss(_mm_max_ss(_mm_set_ss(v), _mm_setzero_ps()), _mm_set_ss(1.0f)));
+#else
+  return std::min(std::max(0.0f, v), 1.0f);  // max(0, NaN) is 0
+#endif
 }
+
+inline uint8_t encodeSrgb8(const ColorTables& t, float linear) {
+  const float c = saturate(linear);
+  int32_t code = t.coarseSrgb8[static_cast<int32_t>(c * 4095.0f + 0.5f)];
+  code += c >= t.lowerBound[code + 1];
+  code -= c < t.lowerBound[code];
+  return static_cast<uint8_t>(code);
+}
+inline uint8_t encodeSrgb8(float linear) { return encodeSrgb8(ColorTables::get(), linear); }
 inline float decodeSrgb8(uint8_t code) { return ColorTables::get().srgb8ToLinear[code]; }
 
 inline uint8_t unorm8(float v) {
-  const float c = v > 0.0f ? (v < 1.0f ? v : 1.0f) : 0.0f;
-  return static_cast<uint8_t>(c * 255.0f + 0.5f);
+  const float c = saturate(v);
+  return static_cast<uint8_t>(static_cast<int32_t>(c * 255.0f + 0.5f));
 }
 
 /// Packs linear RGB + alpha into the fragment colour word: R in bits 0-7, G 8-15, B 16-23 (sRGB
 /// codes), A 24-31 (linear), i.e. the byte order of GL's packUnorm4x8 / RGBA8 in memory.
-inline uint32_t packFragmentColor(const glm::vec3& linearRgb, float alpha) {
-  return static_cast<uint32_t>(encodeSrgb8(linearRgb.r)) |
-         (static_cast<uint32_t>(encodeSrgb8(linearRgb.g)) << 8) |
-         (static_cast<uint32_t>(encodeSrgb8(linearRgb.b)) << 16) |
+inline uint32_t packFragmentColor(const ColorTables& t, const glm::vec3& linearRgb, float alpha) {
+  return static_cast<uint32_t>(encodeSrgb8(t, linearRgb.r)) |
+         (static_cast<uint32_t>(encodeSrgb8(t, linearRgb.g)) << 8) |
+         (static_cast<uint32_t>(encodeSrgb8(t, linearRgb.b)) << 16) |
          (static_cast<uint32_t>(unorm8(alpha)) << 24);
+}
+inline uint32_t packFragmentColor(const glm::vec3& linearRgb, float alpha) {
+  return packFragmentColor(ColorTables::get(), linearRgb, alpha);
 }
 
 /// Unpacks a fragment colour word to linear RGB and alpha.

@@ -16,6 +16,7 @@
 
 #include <glm/glm.hpp>
 
+#include "mfr/core/color.hpp"
 #include "mfr/core/result.hpp"
 #include "mfr/raster/fragment.hpp"
 #include "mfr/scene/scene.hpp"
@@ -119,6 +120,7 @@ class RasterFrame {
   std::vector<uint32_t> binned_;
   std::vector<uint32_t> binOffsets_;
   std::vector<ShadeMaterial> materials_;
+  const ColorTables* colorTables_ = &ColorTables::get();
   // view-ray reconstruction: direction of pixel centre (x, y) in view space is
   // (x * rayScaleX + rayBiasX, y * rayScaleY + rayBiasY, -1)
   float rayScaleX_ = 0, rayBiasX_ = 0, rayScaleY_ = 0, rayBiasY_ = 0;

@@ -80,14 +80,18 @@ template <ShadeMode Mode>
 
 [[gnu::always_inline]] inline void RasterFrame::shade(const TriangleSetup& t, float l0, float l1, float l2, int px,
                                int py, const glm::vec4& base, Fragment& f) const {
-  // headlight: the light sits at the eye, so diffuse = |n.v|
-  const glm::vec3 n = t.normalW[0] * l0 + t.normalW[1] * l1 + t.normalW[2] * l2;
-  const glm::vec3 d(static_cast<float>(px) * rayScaleX_ + rayBiasX_,
-                    static_cast<float>(py) * rayScaleY_ + rayBiasY_, -1.0f);
-  const float nn = glm::dot(n, n) * glm::dot(d, d);
-  const float ndotv = nn > 0.0f ? std::clamp(-glm::dot(n, d) / std::sqrt(nn), -1.0f, 1.0f) : 1.0f;
+  // headlight: the light sits at the eye, so diffuse = |n.v| (scalar code: glm's vec3 is not
+  // vectorised and this is the hottest loop of every capture pass)
+  const float nx = t.normalW[0].x * l0 + t.normalW[1].x * l1 + t.normalW[2].x * l2;
+  const float ny = t.normalW[0].y * l0 + t.normalW[1].y * l1 + t.normalW[2].y * l2;
+  const float nz = t.normalW[0].z * l0 + t.normalW[1].z * l1 + t.normalW[2].z * l2;
+  const float dx = static_cast<float>(px) * rayScaleX_ + rayBiasX_;
+  const float dy = static_cast<float>(py) * rayScaleY_ + rayBiasY_;
+  const float nn = (nx * nx + ny * ny + nz * nz) * (dx * dx + dy * dy + 1.0f);
+  const float ndotv =
+      nn > 0.0f ? std::clamp((nz - nx * dx - ny * dy) / std::sqrt(nn), -1.0f, 1.0f) : 1.0f;
   const float light = kAmbient + (1.0f - kAmbient) * std::fabs(ndotv);
-  f.rgba = packFragmentColor(glm::vec3(base) * light, base.a);
+  f.rgba = packFragmentColor(*colorTables_, glm::vec3(base) * light, base.a);
   f.ndotv = ndotv;
 }
 
