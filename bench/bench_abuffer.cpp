@@ -47,8 +47,7 @@ constexpr const char* kUsage =
     "  --reps N      runs per measurement, the median is reported (default 3; --quick: 1)\n"
     "  --quick       smoke run: smaller image, one run\n";
 
-// ---- command line (shared shape across the bench programs)
-// ---------------------------------------
+// ---- command line (the same options in every bench program) -----------------------------
 
 struct Args {
   std::string out = "bench-results";
@@ -111,8 +110,7 @@ bool parseArgs(int argc, char** argv, Args& a) {
   return true;
 }
 
-// ---- formatting: aligned tables on stdout, CSV files
-// ---------------------------------------------
+// ---- formatting: aligned tables on stdout, CSV files -------------------------------------------
 
 std::string fixed(double v, int decimals) {
   char buf[64];
@@ -164,9 +162,9 @@ class Table {
 
 class Csv {
  public:
-  Csv(const std::filesystem::path& path, const std::vector<std::string>& header)
-      : path_(path), file_(path) {
-    row(header);
+  // header: the column names, comma-separated
+  Csv(const std::filesystem::path& path, const std::string& header) : path_(path), file_(path) {
+    file_ << header << '\n';
   }
   bool ok() const { return static_cast<bool>(file_); }
   const std::filesystem::path& path() const { return path_; }
@@ -190,8 +188,7 @@ class Csv {
   std::ofstream file_;
 };
 
-// ---- measurement
-// ---------------------------------------------------------------------------------
+// ---- measurement -------------------------------------------------------------------------------
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -254,14 +251,11 @@ int main(int argc, char** argv) {
   if (!parseArgs(argc, argv, args)) return 2;
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
-  Csv csv(
-      std::filesystem::path(args.out) / "abuffer.csv",
-      {"scene",         "source",          "width",           "height",          "threads",
-       "reps",          "triangles",       "fragments",       "covered_pixels",  "max_depth",
-       "setup_ms",      "count_ms",        "alloc_ms",        "capture_ms",      "resolve_ms",
-       "total_ms",      "rc_ms",           "rc_mfrag_s",      "rc_ns_frag",      "count_mfrag_s",
-       "count_ns_frag", "capture_mfrag_s", "capture_ns_frag", "resolve_mfrag_s", "resolve_ns_frag",
-       "total_mfrag_s", "goal_mfrag_s"});
+  Csv csv(std::filesystem::path(args.out) / "abuffer.csv",
+          "scene,source,width,height,threads,reps,triangles,fragments,covered_pixels,max_depth,"
+          "setup_ms,count_ms,alloc_ms,capture_ms,resolve_ms,total_ms,rc_ms,rc_mfrag_s,"
+          "rc_ns_frag,count_mfrag_s,count_ns_frag,capture_mfrag_s,capture_ns_frag,"
+          "resolve_mfrag_s,resolve_ns_frag,total_mfrag_s,goal_mfrag_s");
   if (!csv.ok()) {
     std::fprintf(stderr, "bench_abuffer: cannot write %s\n", csv.path().c_str());
     return 1;

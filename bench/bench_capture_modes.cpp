@@ -44,8 +44,7 @@ constexpr const char* kUsage =
     "  --reps N      runs per measurement, the median is reported (default 3; --quick: 1)\n"
     "  --quick       smoke run: smaller image, one run\n";
 
-// ---- command line (shared shape across the bench programs)
-// ---------------------------------------
+// ---- command line (the same options in every bench program) -----------------------------
 
 struct Args {
   std::string out = "bench-results";
@@ -108,8 +107,7 @@ bool parseArgs(int argc, char** argv, Args& a) {
   return true;
 }
 
-// ---- formatting: aligned tables on stdout, CSV files
-// ---------------------------------------------
+// ---- formatting: aligned tables on stdout, CSV files -------------------------------------------
 
 std::string fixed(double v, int decimals) {
   char buf[64];
@@ -161,9 +159,9 @@ class Table {
 
 class Csv {
  public:
-  Csv(const std::filesystem::path& path, const std::vector<std::string>& header)
-      : path_(path), file_(path) {
-    row(header);
+  // header: the column names, comma-separated
+  Csv(const std::filesystem::path& path, const std::string& header) : path_(path), file_(path) {
+    file_ << header << '\n';
   }
   bool ok() const { return static_cast<bool>(file_); }
   const std::filesystem::path& path() const { return path_; }
@@ -187,8 +185,7 @@ class Csv {
   std::ofstream file_;
 };
 
-// ---- measurement
-// ---------------------------------------------------------------------------------
+// ---- measurement -------------------------------------------------------------------------------
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -259,10 +256,10 @@ int main(int argc, char** argv) {
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
   Csv csv(std::filesystem::path(args.out) / "capture_modes.csv",
-          {"scene", "method", "k", "fragments", "tile_capture_ms", "tile_mfrag_s",
-           "parallel_capture_ms", "parallel_mfrag_s", "tile_speedup", "tile_culled_kplus",
-           "parallel_culled_kplus", "tile_in_store", "parallel_in_store", "tile_captured",
-           "parallel_captured", "image_max_diff"});
+          "scene,method,k,width,height,threads,reps,fragments,tile_capture_ms,tile_mfrag_s,"
+          "parallel_capture_ms,parallel_mfrag_s,tile_speedup,tile_culled_kplus,"
+          "parallel_culled_kplus,tile_in_store,parallel_in_store,tile_captured,"
+          "parallel_captured,image_max_diff");
   if (!csv.ok()) {
     std::fprintf(stderr, "bench_capture_modes: cannot write %s\n", csv.path().c_str());
     return 1;
@@ -335,11 +332,25 @@ int main(int argc, char** argv) {
       const RenderStats& t = results[0]->stats;
       const RenderStats& p = results[1]->stats;
       const double tileMs = results[0]->pass("capture"), parMs = results[1]->pass("capture");
-      csv.row({sc.label, name, std::to_string(kK), num(t.fragmentsGenerated), fixed(tileMs, 3),
-               fixed(mfragPerS(t.fragmentsGenerated, tileMs), 3), fixed(parMs, 3),
+      csv.row({sc.label,
+               name,
+               std::to_string(kK),
+               num(frame->width()),
+               num(frame->height()),
+               num(frame->threads()),
+               num(args.reps),
+               num(t.fragmentsGenerated),
+               fixed(tileMs, 3),
+               fixed(mfragPerS(t.fragmentsGenerated, tileMs), 3),
+               fixed(parMs, 3),
                fixed(mfragPerS(p.fragmentsGenerated, parMs), 3),
-               fixed(tileMs > 0 ? parMs / tileMs : 0.0, 3), num(t.culledKPlus), num(p.culledKPlus),
-               num(t.rejectedInStore), num(p.rejectedInStore), num(t.captured), num(p.captured),
+               fixed(tileMs > 0 ? parMs / tileMs : 0.0, 3),
+               num(t.culledKPlus),
+               num(p.culledKPlus),
+               num(t.rejectedInStore),
+               num(p.rejectedInStore),
+               num(t.captured),
+               num(p.captured),
                fixed(diff, 6)});
     }
   }

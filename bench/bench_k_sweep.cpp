@@ -43,8 +43,7 @@ constexpr const char* kUsage =
     "  --reps N      runs per measurement, the median is reported (default 3; --quick: 1)\n"
     "  --quick       smoke run: smaller image, k in {4, 16, 64}, one run\n";
 
-// ---- command line (shared shape across the bench programs)
-// ---------------------------------------
+// ---- command line (the same options in every bench program) -----------------------------
 
 struct Args {
   std::string out = "bench-results";
@@ -107,8 +106,7 @@ bool parseArgs(int argc, char** argv, Args& a) {
   return true;
 }
 
-// ---- formatting: aligned tables on stdout, CSV files
-// ---------------------------------------------
+// ---- formatting: aligned tables on stdout, CSV files -------------------------------------------
 
 std::string fixed(double v, int decimals) {
   char buf[64];
@@ -160,9 +158,9 @@ class Table {
 
 class Csv {
  public:
-  Csv(const std::filesystem::path& path, const std::vector<std::string>& header)
-      : path_(path), file_(path) {
-    row(header);
+  // header: the column names, comma-separated
+  Csv(const std::filesystem::path& path, const std::string& header) : path_(path), file_(path) {
+    file_ << header << '\n';
   }
   bool ok() const { return static_cast<bool>(file_); }
   const std::filesystem::path& path() const { return path_; }
@@ -186,8 +184,7 @@ class Csv {
   std::ofstream file_;
 };
 
-// ---- measurement
-// ---------------------------------------------------------------------------------
+// ---- measurement -------------------------------------------------------------------------------
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -255,10 +252,10 @@ int main(int argc, char** argv) {
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
   Csv csv(std::filesystem::path(args.out) / "k_sweep.csv",
-          {"k", "n", "scene", "fragments", "covered_pixels", "culled_kplus", "captured",
-           "array_alloc_ms", "array_capture_ms", "array_resolve_ms", "array_total_ms",
-           "heap_alloc_ms", "heap_capture_ms", "heap_resolve_ms", "heap_total_ms",
-           "heap_speedup_capture", "heap_speedup_total", "winner_capture", "winner_total"});
+          "k,n,scene,width,height,threads,reps,fragments,covered_pixels,culled_kplus,captured,"
+          "array_alloc_ms,array_capture_ms,array_resolve_ms,array_total_ms,heap_alloc_ms,"
+          "heap_capture_ms,heap_resolve_ms,heap_total_ms,heap_speedup_capture,"
+          "heap_speedup_total,winner_capture,winner_total");
   if (!csv.ok()) {
     std::fprintf(stderr, "bench_k_sweep: cannot write %s\n", csv.path().c_str());
     return 1;
@@ -324,11 +321,29 @@ int main(int argc, char** argv) {
     table.add({std::to_string(k), fixed(n, 1), fixed(capA, 1), fixed(capH, 1),
                fixed(arr.pass("resolve"), 1), fixed(heap.pass("resolve"), 1), fixed(arr.totalMs, 1),
                fixed(heap.totalMs, 1), fixed(speedTotal, 2) + "x", winCapture, winTotal});
-    csv.row({std::to_string(k), fixed(n, 2), spec, num(s.fragmentsGenerated), num(s.coveredPixels),
-             num(s.culledKPlus), num(s.captured), fixed(allocMs(arr), 3), fixed(capA, 3),
-             fixed(arr.pass("resolve"), 3), fixed(arr.totalMs, 3), fixed(allocMs(heap), 3),
-             fixed(capH, 3), fixed(heap.pass("resolve"), 3), fixed(heap.totalMs, 3),
-             fixed(speedCapture, 3), fixed(speedTotal, 3), winCapture, winTotal});
+    csv.row({std::to_string(k),
+             fixed(n, 2),
+             spec,
+             num(frame->width()),
+             num(frame->height()),
+             num(frame->threads()),
+             num(args.reps),
+             num(s.fragmentsGenerated),
+             num(s.coveredPixels),
+             num(s.culledKPlus),
+             num(s.captured),
+             fixed(allocMs(arr), 3),
+             fixed(capA, 3),
+             fixed(arr.pass("resolve"), 3),
+             fixed(arr.totalMs, 3),
+             fixed(allocMs(heap), 3),
+             fixed(capH, 3),
+             fixed(heap.pass("resolve"), 3),
+             fixed(heap.totalMs, 3),
+             fixed(speedCapture, 3),
+             fixed(speedTotal, 3),
+             winCapture,
+             winTotal});
   }
   table.print();
   // the crossover: the smallest k from which the heap wins at every larger k of the sweep

@@ -46,8 +46,7 @@ constexpr const char* kUsage =
     "  --reps N      runs per measurement, the median is reported (default 3; --quick: 1)\n"
     "  --quick       smoke run: smaller image, d in {1, 4, 64}, one run\n";
 
-// ---- command line (shared shape across the bench programs)
-// ---------------------------------------
+// ---- command line (the same options in every bench program) -----------------------------
 
 struct Args {
   std::string out = "bench-results";
@@ -110,8 +109,7 @@ bool parseArgs(int argc, char** argv, Args& a) {
   return true;
 }
 
-// ---- formatting: aligned tables on stdout, CSV files
-// ---------------------------------------------
+// ---- formatting: aligned tables on stdout, CSV files -------------------------------------------
 
 std::string fixed(double v, int decimals) {
   char buf[64];
@@ -163,9 +161,9 @@ class Table {
 
 class Csv {
  public:
-  Csv(const std::filesystem::path& path, const std::vector<std::string>& header)
-      : path_(path), file_(path) {
-    row(header);
+  // header: the column names, comma-separated
+  Csv(const std::filesystem::path& path, const std::string& header) : path_(path), file_(path) {
+    file_ << header << '\n';
   }
   bool ok() const { return static_cast<bool>(file_); }
   const std::filesystem::path& path() const { return path_; }
@@ -189,8 +187,7 @@ class Csv {
   std::ofstream file_;
 };
 
-// ---- measurement
-// ---------------------------------------------------------------------------------
+// ---- measurement -------------------------------------------------------------------------------
 
 double msSince(Clock::time_point start) {
   return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
@@ -263,27 +260,11 @@ int main(int argc, char** argv) {
   if (!parseArgs(argc, argv, args)) return 2;
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
-  Csv csv(std::filesystem::path(args.out) / "occupancy.csv", {"d",
-                                                              "buckets",
-                                                              "fragments",
-                                                              "culled_occupancy",
-                                                              "culled_kplus",
-                                                              "rejected_in_store",
-                                                              "inserted",
-                                                              "evicted",
-                                                              "captured",
-                                                              "occupancy_pct",
-                                                              "kplus_pct",
-                                                              "in_store_pct",
-                                                              "rejected_pct",
-                                                              "bytes_used",
-                                                              "occupancy_passes_ms",
-                                                              "capture_ms",
-                                                              "resolve_ms",
-                                                              "total_ms",
-                                                              "speedup_capture",
-                                                              "speedup_total",
-                                                              "image_max_diff"});
+  Csv csv(std::filesystem::path(args.out) / "occupancy.csv",
+          "d,buckets,width,height,threads,reps,fragments,culled_occupancy,culled_kplus,"
+          "rejected_in_store,inserted,evicted,captured,occupancy_pct,kplus_pct,in_store_pct,"
+          "rejected_pct,bytes_used,occupancy_passes_ms,capture_ms,resolve_ms,total_ms,"
+          "speedup_capture,speedup_total,image_max_diff");
   if (!csv.ok()) {
     std::fprintf(stderr, "bench_occupancy: cannot write %s\n", csv.path().c_str());
     return 1;
@@ -350,6 +331,10 @@ int main(int argc, char** argv) {
                fixed(speedTotal, 2) + "x", same ? "yes" : "NO (max diff " + fixed(diff, 4) + ")"});
     csv.row({std::to_string(d),
              std::to_string(32 * d),
+             num(frame->width()),
+             num(frame->height()),
+             num(frame->threads()),
+             num(args.reps),
              num(gen),
              num(s.culledOccupancy),
              num(s.culledKPlus),

@@ -47,8 +47,7 @@ constexpr const char* kUsage =
     "  --budget M    memory budget, e.g. 20MB (default 20 MiB at 1024x1024, scaled with the pixel\n"
     "                count at other sizes so the bytes per pixel stay the same)\n";
 
-// ---- command line (shared shape across the bench programs)
-// ---------------------------------------
+// ---- command line (the same options in every bench program) -----------------------------
 
 struct Args {
   std::string out = "bench-results";
@@ -111,8 +110,7 @@ bool parseArgs(int argc, char** argv, Args& a) {
   return true;
 }
 
-// ---- formatting: aligned tables on stdout, CSV files
-// ---------------------------------------------
+// ---- formatting: aligned tables on stdout, CSV files -------------------------------------------
 
 std::string fixed(double v, int decimals) {
   char buf[64];
@@ -164,9 +162,9 @@ class Table {
 
 class Csv {
  public:
-  Csv(const std::filesystem::path& path, const std::vector<std::string>& header)
-      : path_(path), file_(path) {
-    row(header);
+  // header: the column names, comma-separated
+  Csv(const std::filesystem::path& path, const std::string& header) : path_(path), file_(path) {
+    file_ << header << '\n';
   }
   bool ok() const { return static_cast<bool>(file_); }
   const std::filesystem::path& path() const { return path_; }
@@ -190,8 +188,7 @@ class Csv {
   std::ofstream file_;
 };
 
-// ---- measurement
-// ---------------------------------------------------------------------------------
+// ---- measurement -------------------------------------------------------------------------------
 
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -279,10 +276,9 @@ int main(int argc, char** argv) {
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
   Csv csv(std::filesystem::path(args.out) / "presets.csv",
-          {"scene",        "scene_index", "method",       "method_index", "width",      "height",
-           "budget_bytes", "max_depth",   "status",       "k_min",        "k_max",      "global_k",
-           "bytes_used",   "fragments",   "captured",     "lost",         "loss_pct",   "total_ms",
-           "count_ms",     "alloc_ms",    "occupancy_ms", "capture_ms",   "resolve_ms", "error"});
+          "scene,scene_index,method,method_index,width,height,budget_bytes,max_depth,status,"
+          "k_min,k_max,global_k,bytes_used,fragments,captured,lost,loss_pct,total_ms,count_ms,"
+          "alloc_ms,occupancy_ms,capture_ms,resolve_ms,error");
   if (!csv.ok()) {
     std::fprintf(stderr, "bench_presets: cannot write %s\n", csv.path().c_str());
     return 1;

@@ -66,7 +66,7 @@ int run(const SceneOptions& o) {
     return 0;
   }
   if (o.quiet) return 0;
-  std::fprintf(stderr, "\r\033[K");
+  progress.clear();
   std::printf("scene       %s\n", o.source.c_str());
   std::printf("triangles   %zu (%zu vertices)\n", scene.triangleCount(), scene.vertexCount());
   std::printf("materials   %zu (%zu blend, %zu mask, %zu opaque), %zu textures\n",

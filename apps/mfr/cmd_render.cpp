@@ -120,8 +120,9 @@ int run(const RenderArgs& a) {
     allStats.push_back(stats);
     if (!a.scene.quiet && !a.scene.json) {
       const RenderStats& s = result->stats;
+      progress.clear();
       std::fprintf(stderr,
-                   "\r\033[K%s: %s  %llu fragments, %llu captured (%.2f%% lost), k %u-%u, %s, "
+                   "%s: %s  %llu fragments, %llu captured (%.2f%% lost), k %u-%u, %s, "
                    "%.1f ms\n",
                    method->name.c_str(), out.c_str(),
                    static_cast<unsigned long long>(s.fragmentsGenerated),

@@ -111,6 +111,12 @@ void Progress::set(const std::string& stage, int done, int total) {
   total_ = total;
 }
 
+void Progress::clear() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (printed_) std::fprintf(stderr, "\r\033[K");
+  printed_ = false;
+}
+
 void Progress::loop() {
   const auto start = std::chrono::steady_clock::now();
   static const char spinner[] = "|/-\\";

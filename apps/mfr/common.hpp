@@ -52,6 +52,8 @@ class Progress {
   explicit Progress(bool enabled);
   ~Progress();
   void set(const std::string& stage, int done = -1, int total = -1);
+  /// Erases the progress line (if one was drawn) so a normal line can be printed.
+  void clear();
 
  private:
   void loop();

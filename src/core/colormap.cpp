@@ -84,8 +84,8 @@ std::string label(float v) {
 
 Image8 colorMapWithLegend(const std::vector<float>& values, int width, int height, float maxValue,
                           const std::string& title, Colormap map) {
-  const int scale = std::max(1, width / 512);
-  const int legendHeight = 34 * scale;
+  const int scale = std::max(2, width / 384);
+  const int legendHeight = 40 * scale;
   Image8 img;
   img.width = width;
   img.height = height + legendHeight;
@@ -100,7 +100,7 @@ Image8 colorMapWithLegend(const std::vector<float>& values, int width, int heigh
   const int titleW = textWidth(title, scale) + 8 * scale;
   drawText(img, 4 * scale, barY + scale, title, scale, ink);
   const int barX0 = std::min(width - 1, titleW + 4 * scale);
-  const int barX1 = std::max(barX0 + 1, width - 12 * scale);
+  const int barX1 = std::max(barX0 + 1, width - 24 * scale);
   for (int x = barX0; x < barX1; ++x) {
     const glm::vec3 c = colormap(map, static_cast<float>(x - barX0) / (barX1 - barX0 - 1));
     for (int y = barY; y < barY + barH; ++y) putPixel(img, x, y, c);
@@ -109,7 +109,8 @@ Image8 colorMapWithLegend(const std::vector<float>& values, int width, int heigh
   for (float m : marks) {
     const std::string text = label(m * maxValue);
     const int cx = barX0 + static_cast<int>(m * (barX1 - barX0 - 1));
-    const int tx = std::clamp(cx - textWidth(text, scale) / 2, 0, std::max(0, width - textWidth(text, scale)));
+    const int tw = textWidth(text, scale) + 2 * scale;
+    const int tx = std::clamp(cx - tw / 2, 0, std::max(0, width - tw));
     for (int y = barY + barH; y < barY + barH + 3 * scale; ++y) putPixel(img, cx, y, ink);
     drawText(img, tx, barY + barH + 4 * scale, text, scale, ink);
   }
