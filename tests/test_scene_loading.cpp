@@ -63,7 +63,8 @@ std::string base64(const std::string& bytes) {
   std::string out;
   size_t i = 0;
   for (; i + 2 < bytes.size(); i += 3) {
-    const uint32_t v = (uint8_t(bytes[i]) << 16) | (uint8_t(bytes[i + 1]) << 8) | uint8_t(bytes[i + 2]);
+    const uint32_t v =
+        (uint8_t(bytes[i]) << 16) | (uint8_t(bytes[i + 1]) << 8) | uint8_t(bytes[i + 2]);
     for (int s = 18; s >= 0; s -= 6) out += table[(v >> s) & 63];
   }
   if (i < bytes.size()) {
@@ -208,8 +209,9 @@ class GltfDoc {
   std::string gltfText() const {
     json out = doc;
     if (!bin.empty())
-      out["buffers"] = json::array({{{"byteLength", bin.size()},
-                                     {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
+      out["buffers"] =
+          json::array({{{"byteLength", bin.size()},
+                        {"uri", "data:application/octet-stream;base64," + base64(bin)}}});
     return out.dump();
   }
   std::string glbBytes() const {
@@ -332,19 +334,22 @@ TEST_F(SceneLoading, GltfMirroringNodeKeepsTrianglesFrontFacing) {
 TEST_F(SceneLoading, GltfAlphaModesCutoffAndBaseColorFactorAreRead) {
   GltfDoc gltf;
   const int opaque = gltf.addMaterial({{"name", "opaque"}});
-  const int mask = gltf.addMaterial({{"name", "mask"}, {"alphaMode", "MASK"}, {"alphaCutoff", 0.3}});
+  const int mask =
+      gltf.addMaterial({{"name", "mask"}, {"alphaMode", "MASK"}, {"alphaCutoff", 0.3}});
   const int maskDefault = gltf.addMaterial({{"name", "maskDefault"}, {"alphaMode", "MASK"}});
-  const int blend = gltf.addMaterial(
-      {{"name", "blend"},
-       {"alphaMode", "BLEND"},
-       {"pbrMetallicRoughness", {{"baseColorFactor", {0.2, 0.4, 0.6, 0.5}}}}});
+  const int blend =
+      gltf.addMaterial({{"name", "blend"},
+                        {"alphaMode", "BLEND"},
+                        {"pbrMetallicRoughness", {{"baseColorFactor", {0.2, 0.4, 0.6, 0.5}}}}});
   gltf.addNode({{"mesh", gltf.addMesh(json::array(
                              {quadPrimitive(gltf, opaque), quadPrimitive(gltf, mask),
                               quadPrimitive(gltf, maskDefault), quadPrimitive(gltf, blend)}))}});
   auto scene = mfr::loadScene(dir.write("alpha.gltf", gltf.gltfText()));
   ASSERT_LOADED(scene);
   ASSERT_EQ(scene->triangleCount(), 8u);
-  auto materialOf = [&](size_t triangle) { return scene->materials[scene->triangleMaterial[triangle]]; };
+  auto materialOf = [&](size_t triangle) {
+    return scene->materials[scene->triangleMaterial[triangle]];
+  };
   EXPECT_EQ(materialOf(0).name, "opaque");
   EXPECT_EQ(materialOf(0).alphaMode, mfr::AlphaMode::Opaque);
   EXPECT_EQ(materialOf(2).alphaMode, mfr::AlphaMode::Mask);
@@ -366,9 +371,9 @@ TEST_F(SceneLoading, GltfTransmissionBecomesBlendAlphaWithFloor) {
   const int partial = gltf.addMaterial(transmissive(0.4, 0.5));
   const int noFactor = gltf.addMaterial(
       {{"alphaMode", "MASK"}, {"extensions", {{"KHR_materials_transmission", json::object()}}}});
-  gltf.addNode({{"mesh", gltf.addMesh(json::array({quadPrimitive(gltf, clear),
-                                                   quadPrimitive(gltf, partial),
-                                                   quadPrimitive(gltf, noFactor)}))}});
+  gltf.addNode(
+      {{"mesh", gltf.addMesh(json::array({quadPrimitive(gltf, clear), quadPrimitive(gltf, partial),
+                                          quadPrimitive(gltf, noFactor)}))}});
   const std::string path = dir.write("transmission.gltf", gltf.gltfText());
 
   auto scene = mfr::loadScene(path);
@@ -394,8 +399,9 @@ TEST_F(SceneLoading, GltfTransmissionBecomesBlendAlphaWithFloor) {
 
 TEST_F(SceneLoading, GltfPrimitiveWithoutOrWithInvalidMaterialGetsOpaqueWhiteDefault) {
   GltfDoc gltf;
-  gltf.addNode({{"mesh", gltf.addMesh(json::array(
-                             {quadPrimitive(gltf), quadPrimitive(gltf, 7 /* no such material */)}))}});
+  gltf.addNode(
+      {{"mesh", gltf.addMesh(json::array(
+                    {quadPrimitive(gltf), quadPrimitive(gltf, 7 /* no such material */)}))}});
   auto scene = mfr::loadScene(dir.write("default.gltf", gltf.gltfText()));
   ASSERT_LOADED(scene);
   ASSERT_EQ(scene->materials.size(), 1u);
@@ -408,15 +414,17 @@ TEST_F(SceneLoading, GltfQuantizedNormalizedNonIndexedAndSparseAccessorsAreDecod
   GltfDoc gltf;
   // KHR_mesh_quantization style: SHORT positions (not normalized), normalized BYTE normals,
   // normalized UNSIGNED_BYTE texture coordinates, no indices.
-  const int positions =
-      gltf.addAccessor(bytesOf(std::vector<int16_t>{0, 0, 0, 0, 4, 0, 0, 0, 0, -3, 0, 0, 0, 0, 0, 0}),
-                       5122, 3, "VEC3");
-  gltf.doc["bufferViews"][gltf.doc["accessors"][static_cast<size_t>(positions)]["bufferView"].get<size_t>()]
-          ["byteStride"] = 8;  // padded to 4-byte aligned elements (xyz + 1 unused short)
-  const int normals = gltf.addAccessor(
-      bytesOf(std::vector<int8_t>{0, 0, 127, 0, 0, 0, -128, 0, 0, 0, 127, 0}), 5120, 3, "VEC3", true);
-  gltf.doc["bufferViews"][gltf.doc["accessors"][static_cast<size_t>(normals)]["bufferView"].get<size_t>()]
-          ["byteStride"] = 4;
+  const int positions = gltf.addAccessor(
+      bytesOf(std::vector<int16_t>{0, 0, 0, 0, 4, 0, 0, 0, 0, -3, 0, 0, 0, 0, 0, 0}), 5122, 3,
+      "VEC3");
+  gltf.doc["bufferViews"][gltf.doc["accessors"][static_cast<size_t>(positions)]["bufferView"]
+                              .get<size_t>()]["byteStride"] =
+      8;  // padded to 4-byte aligned elements (xyz + 1 unused short)
+  const int normals =
+      gltf.addAccessor(bytesOf(std::vector<int8_t>{0, 0, 127, 0, 0, 0, -128, 0, 0, 0, 127, 0}),
+                       5120, 3, "VEC3", true);
+  gltf.doc["bufferViews"][gltf.doc["accessors"][static_cast<size_t>(normals)]["bufferView"]
+                              .get<size_t>()]["byteStride"] = 4;
   const int uvs = gltf.addAccessor(bytesOf(std::vector<uint8_t>{0, 255, 255, 0, 51, 102}), 5121, 3,
                                    "VEC2", true);
   gltf.doc["extensionsUsed"] = {"KHR_mesh_quantization"};
@@ -424,16 +432,17 @@ TEST_F(SceneLoading, GltfQuantizedNormalizedNonIndexedAndSparseAccessorsAreDecod
   // A sparse accessor: positions of a second triangle = base with vertex 2 replaced.
   const int sparseIndices = gltf.addView(bytesOf(std::vector<uint8_t>{2, 0, 0, 0}));
   const int sparseValues = gltf.addView(bytesOf(std::vector<float>{7, 8, 9}));
-  const int base = gltf.addAccessor(bytesOf(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}), 5126, 3,
-                                    "VEC3");
+  const int base =
+      gltf.addAccessor(bytesOf(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0}), 5126, 3, "VEC3");
   gltf.doc["accessors"][static_cast<size_t>(base)]["sparse"] = {
       {"count", 1},
       {"indices", {{"bufferView", sparseIndices}, {"componentType", 5121}}},
       {"values", {{"bufferView", sparseValues}}}};
-  gltf.addNode({{"mesh", gltf.addMesh(json::array(
-                             {{{"attributes", {{"POSITION", positions}, {"NORMAL", normals},
-                                               {"TEXCOORD_0", uvs}}}},
-                              {{"attributes", {{"POSITION", base}}}}}))}});
+  gltf.addNode(
+      {{"mesh",
+        gltf.addMesh(json::array(
+            {{{"attributes", {{"POSITION", positions}, {"NORMAL", normals}, {"TEXCOORD_0", uvs}}}},
+             {{"attributes", {{"POSITION", base}}}}}))}});
   auto scene = mfr::loadScene(dir.write("quantized.gltf", gltf.gltfText()));
   ASSERT_LOADED(scene);
   ASSERT_EQ(scene->vertexCount(), 6u);
@@ -447,7 +456,7 @@ TEST_F(SceneLoading, GltfQuantizedNormalizedNonIndexedAndSparseAccessorsAreDecod
   EXPECT_NEAR(scene->uvs[2].y, 0.4f, 1e-6f);
   EXPECT_EQ(scene->positions[3 + 1], glm::vec3(1, 0, 0));
   EXPECT_EQ(scene->positions[3 + 2], glm::vec3(7, 8, 9));  // sparse substitution
-  EXPECT_EQ(scene->uvs[3], glm::vec2(0.0f));  // no TEXCOORD_0: zeros
+  EXPECT_EQ(scene->uvs[3], glm::vec2(0.0f));               // no TEXCOORD_0: zeros
 }
 
 TEST_F(SceneLoading, GltfStripsAndFansAreTriangulatedAndPointsAndLinesSkipped) {
@@ -455,7 +464,8 @@ TEST_F(SceneLoading, GltfStripsAndFansAreTriangulatedAndPointsAndLinesSkipped) {
   // Five vertices on a convex arc; strip -> 3 triangles, fan -> 3 triangles.
   const std::vector<float> xyz = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 2, 0};
   json primitives = json::array();
-  for (int mode : {0, 1, 3, 4, 5, 6}) primitives.push_back({{"attributes", {{"POSITION", gltf.addPositions(xyz)}}}, {"mode", mode}});
+  for (int mode : {0, 1, 3, 4, 5, 6})
+    primitives.push_back({{"attributes", {{"POSITION", gltf.addPositions(xyz)}}}, {"mode", mode}});
   gltf.addNode({{"mesh", gltf.addMesh(primitives)}});
   auto scene = mfr::loadScene(dir.write("modes.gltf", gltf.gltfText()));
   ASSERT_LOADED(scene);
@@ -479,10 +489,12 @@ TEST_F(SceneLoading, GltfBaseColorTexturesOfAnyChannelCountAndDepthBecomeRgba8) 
   json primitives = json::array();
   for (const Case& c : cases) {
     gltf.doc["images"].push_back(
-        {{"uri", "data:image/png;base64," + base64(encodePng(1, 1, c.colorType, c.bitDepth, c.samples))}});
+        {{"uri",
+          "data:image/png;base64," + base64(encodePng(1, 1, c.colorType, c.bitDepth, c.samples))}});
     gltf.doc["textures"].push_back({{"source", gltf.doc["images"].size() - 1}});
-    const int material = gltf.addMaterial(
-        {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", gltf.doc["textures"].size() - 1}}}}}});
+    const int material =
+        gltf.addMaterial({{"pbrMetallicRoughness",
+                           {{"baseColorTexture", {{"index", gltf.doc["textures"].size() - 1}}}}}});
     primitives.push_back(quadPrimitive(gltf, material));
   }
   gltf.addNode({{"mesh", gltf.addMesh(primitives)}});
@@ -503,7 +515,8 @@ TEST_F(SceneLoading, GltfBaseColorTexturesOfAnyChannelCountAndDepthBecomeRgba8) 
 
 TEST_F(SceneLoading, GltfBinaryGlbLoadsLikeText) {
   GltfDoc gltf;
-  gltf.addNode({{"mesh", gltf.addMesh(json::array({quadPrimitive(gltf)}))}, {"translation", {0, 0, 3}}});
+  gltf.addNode(
+      {{"mesh", gltf.addMesh(json::array({quadPrimitive(gltf)}))}, {"translation", {0, 0, 3}}});
   auto scene = mfr::loadScene(dir.write("quad.glb", gltf.glbBytes()));
   ASSERT_LOADED(scene);
   EXPECT_EQ(scene->triangleCount(), 2u);
@@ -514,7 +527,8 @@ TEST_F(SceneLoading, GltfExternalBufferAndImageResolveRelativeToTheGltfFile) {
   GltfDoc gltf;
   gltf.doc["images"] = {{{"uri", "images/red.png"}}};
   gltf.doc["textures"] = {{{"source", 0}}};
-  const int material = gltf.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+  const int material =
+      gltf.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
   gltf.addNode({{"mesh", gltf.addMesh(json::array({quadPrimitive(gltf, material)}))}});
   json doc = gltf.doc;
   doc["buffers"] = {{{"byteLength", gltf.bin.size()}, {"uri", "data/quad.bin"}}};
@@ -532,7 +546,8 @@ TEST_F(SceneLoading, GltfMissingBaseColorImageIsAnErrorNamingIt) {
   GltfDoc gltf;
   gltf.doc["images"] = {{{"uri", "missing.png"}}};
   gltf.doc["textures"] = {{{"source", 0}}};
-  const int material = gltf.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
+  const int material =
+      gltf.addMaterial({{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}});
   gltf.addNode({{"mesh", gltf.addMesh(json::array({quadPrimitive(gltf, material)}))}});
   const std::string path = dir.write("missing_image.gltf", gltf.gltfText());
   EXPECT_TRUE(isErrorNaming(mfr::loadScene(path), path, "missing.png"));
@@ -541,10 +556,11 @@ TEST_F(SceneLoading, GltfMissingBaseColorImageIsAnErrorNamingIt) {
 TEST_F(SceneLoading, GltfCameraNodeGivesPerspectiveCamera) {
   GltfDoc gltf;
   gltf.addNode({{"mesh", gltf.addMesh(json::array({quadPrimitive(gltf)}))}});
-  gltf.doc["cameras"] = {{{"type", "perspective"},
-                          {"perspective", {{"yfov", 0.5}, {"znear", 0.25}, {"aspectRatio", 1.5}}}},
-                         {{"type", "orthographic"},
-                          {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}}};
+  gltf.doc["cameras"] = {
+      {{"type", "perspective"},
+       {"perspective", {{"yfov", 0.5}, {"znear", 0.25}, {"aspectRatio", 1.5}}}},
+      {{"type", "orthographic"},
+       {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.1}, {"zfar", 10}}}}};
   // Placed at (0.5, 0.5, 5) under a parent turned 180 degrees about y: ends up at
   // (-0.5, 0.5, -5) looking down +z, towards the quad.
   const int cameraNode = gltf.addNode({{"camera", 0}, {"translation", {0.5, 0.5, 5}}}, false);
@@ -631,8 +647,9 @@ TEST_F(SceneLoading, ObjMaterialsTakeKdAndAlphaFromDissolveOrInvertedTr) {
 }
 
 TEST_F(SceneLoading, ObjMapKdIsLoadedRelativeToItsMtlFile) {
-  dir.write("assets/tex/checker.png", encodePng(2, 2, 6, 8, {255, 0, 0, 255, 0, 255, 0, 128,  //
-                                                             0, 0, 255, 255, 9, 9, 9, 0}));
+  dir.write("assets/tex/checker.png", encodePng(2, 2, 6, 8,
+                                                {255, 0, 0, 255, 0, 255, 0, 128,  //
+                                                 0, 0, 255, 255, 9, 9, 9, 0}));
   dir.write("assets/look.mtl", "newmtl textured\nKd 1 1 1\nmap_Kd tex/checker.png\n");
   const std::string path = dir.write("mesh.obj",
                                      "mtllib assets/look.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\n"
@@ -719,7 +736,8 @@ std::string writeTransmissiveQuad(const TempDir& dir, const std::string& name) {
   const int material = gltf.addMaterial(
       {{"extensions", {{"KHR_materials_transmission", {{"transmissionFactor", 1.0}}}}}});
   gltf.addNode({{"mesh", gltf.addMesh(json::array({quadPrimitive(gltf, material)}))}});
-  gltf.doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}}}}};
+  gltf.doc["cameras"] = {
+      {{"type", "perspective"}, {"perspective", {{"yfov", 0.7}, {"znear", 0.1}}}}};
   gltf.addNode({{"camera", 0}, {"translation", {0, 0, 4}}});
   return dir.write(name, gltf.gltfText());
 }
@@ -773,7 +791,8 @@ TEST_F(SceneLoading, JsonSceneWithWrongTypeOrOutOfRangeValueNamesTheKey) {
   writeTransmissiveQuad(dir, "quad.gltf");
   const std::string alpha = dir.write("alpha.json", R"({"mesh": "quad.gltf", "alpha": 1.5})");
   EXPECT_TRUE(isErrorNaming(mfr::loadScene(alpha), alpha, "'alpha'"));
-  const std::string background = dir.write("bg.json", R"({"mesh": "quad.gltf", "background": "red"})");
+  const std::string background =
+      dir.write("bg.json", R"({"mesh": "quad.gltf", "background": "red"})");
   EXPECT_TRUE(isErrorNaming(mfr::loadScene(background), background, "'background'"));
   const std::string camera = dir.write(
       "camera.json", R"({"mesh": "quad.gltf", "cameras": [{"eye": [0, 0, 1], "zoom": 2}]})");
@@ -821,7 +840,8 @@ TEST_F(SceneLoading, MalformedGltfAccessorBeyondItsBufferIsAnError) {
   GltfDoc gltf;
   const int positions = gltf.addPositions({0, 0, 0, 1, 0, 0, 0, 1, 0});
   gltf.doc["accessors"][static_cast<size_t>(positions)]["count"] = 1000000;  // buffer holds 3
-  gltf.addNode({{"mesh", gltf.addMesh(json::array({{{"attributes", {{"POSITION", positions}}}}}))}});
+  gltf.addNode(
+      {{"mesh", gltf.addMesh(json::array({{{"attributes", {{"POSITION", positions}}}}}))}});
   const std::string path = dir.write("overflow.gltf", gltf.gltfText());
   EXPECT_TRUE(isErrorNaming(mfr::loadScene(path), path, "past the end"));
 }
@@ -849,7 +869,8 @@ TEST_F(SceneLoading, TruncatedGlbIsAnErrorAtEveryLength) {
   gltf.addNode({{"mesh", gltf.addMesh(json::array({quadPrimitive(gltf)}))}});
   const std::string glb = gltf.glbBytes();
   for (size_t length = 0; length < glb.size(); length += 5) {
-    const std::string path = dir.write("truncated_" + std::to_string(length) + ".glb", glb.substr(0, length));
+    const std::string path =
+        dir.write("truncated_" + std::to_string(length) + ".glb", glb.substr(0, length));
     EXPECT_TRUE(isErrorNaming(mfr::loadScene(path), path)) << "length " << length;
   }
 }
@@ -860,9 +881,11 @@ TEST_F(SceneLoading, MalformedObjIsAnError) {
 }
 
 TEST_F(SceneLoading, ObjFaceReferencingMissingVertexIsAnError) {
-  const std::string quad = dir.write("missing_vertex_quad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 9\n");
+  const std::string quad =
+      dir.write("missing_vertex_quad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 9\n");
   EXPECT_TRUE(isErrorNaming(mfr::loadScene(quad), quad));
-  const std::string path = dir.write("missing_vertex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 7\n");
+  const std::string path =
+      dir.write("missing_vertex.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nf 1 2 7\n");
   EXPECT_TRUE(isErrorNaming(mfr::loadScene(path), path, "vertex"));
 }
 
@@ -887,9 +910,29 @@ TEST_F(SceneLoading, MalformedPlyTruncatedBinaryIsAnError) {
   EXPECT_TRUE(isErrorNaming(mfr::loadScene(path), path));
 }
 
+TEST_F(SceneLoading, PlyFaceIndexBeyondTheVerticesIsAnError) {
+  std::string ply = binaryPlyTriangle();
+  const int32_t bad = 3;  // only vertices 0..2 exist
+  std::memcpy(ply.data() + ply.size() - 4, &bad, 4);
+  const std::string path = dir.write("bad_index.ply", ply);
+  EXPECT_TRUE(isErrorNaming(mfr::loadScene(path), path, "index 3"));
+}
+
+TEST_F(SceneLoading, PlyWithHugeElementCountFailsFast) {
+  const std::string path = dir.write("huge_count.ply",
+                                     "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                     "property float y\nproperty float z\nelement face 487683372\n"
+                                     "property list uchar int vertex_indices\nend_header\n"
+                                     "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+  const auto start = std::chrono::steady_clock::now();
+  EXPECT_TRUE(isErrorNaming(mfr::loadScene(path), path, "truncated"));
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), 1.0);
+}
+
 TEST_F(SceneLoading, JsonWithUnknownKeyIsAnError) {
   writeTransmissiveQuad(dir, "quad.gltf");
-  const std::string path = dir.write("unknown.json", R"({"mesh": "quad.gltf", "colour": [1, 0, 0]})");
+  const std::string path =
+      dir.write("unknown.json", R"({"mesh": "quad.gltf", "colour": [1, 0, 0]})");
   EXPECT_TRUE(isErrorNaming(mfr::loadScene(path), path, "'colour'"));
 }
 
@@ -918,7 +961,8 @@ struct RealScene {
 };
 
 const RealScene kRealScenes[] = {
-    {"IridescentDishWithOlives", "khronos/IridescentDishWithOlives/glTF/IridescentDishWithOlives.gltf", 24448},
+    {"IridescentDishWithOlives",
+     "khronos/IridescentDishWithOlives/glTF/IridescentDishWithOlives.gltf", 24448},
     {"StainedGlassLamp", "khronos/StainedGlassLamp/glTF-JPG-PNG/StainedGlassLamp.gltf", 35132},
     {"GlassVaseFlowers", "khronos/GlassVaseFlowers/glTF-Binary/GlassVaseFlowers.glb", 14036},
     {"TransmissionTest", "khronos/TransmissionTest/glTF-Binary/TransmissionTest.glb", 128775},
@@ -950,7 +994,9 @@ class SceneLoadingRealDetails : public ::testing::Test {
   void SetUp() override {
     if (!fs::is_directory(root)) GTEST_SKIP() << "scenes folder absent: " << root.string();
   }
-  mfr::Result<mfr::Scene> load(const std::string& file) { return mfr::loadScene((root / file).string()); }
+  mfr::Result<mfr::Scene> load(const std::string& file) {
+    return mfr::loadScene((root / file).string());
+  }
   fs::path root = MFR_SCENES_DIR;
 };
 
@@ -983,10 +1029,11 @@ TEST_F(SceneLoadingRealDetails, TransmissionScenesFoldTransmissionIntoAlphaAndKe
   auto scene = load(kRealScenes[3].file);
   ASSERT_LOADED(scene);
   EXPECT_EQ(scene->cameras.size(), 1u);
-  EXPECT_TRUE(std::any_of(scene->materials.begin(), scene->materials.end(), [](const mfr::Material& m) {
-    return m.transmission && *m.transmission > 0.5f && m.alphaMode == mfr::AlphaMode::Blend &&
-           m.baseColor.a < 1.0f;
-  }));
+  EXPECT_TRUE(
+      std::any_of(scene->materials.begin(), scene->materials.end(), [](const mfr::Material& m) {
+        return m.transmission && *m.transmission > 0.5f && m.alphaMode == mfr::AlphaMode::Blend &&
+               m.baseColor.a < 1.0f;
+      }));
   auto dish = load(kRealScenes[0].file);
   ASSERT_LOADED(dish);
   EXPECT_EQ(dish->cameras.size(), 1u);

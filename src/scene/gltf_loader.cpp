@@ -20,10 +20,10 @@
 #include <utility>
 #include <vector>
 
+#include <tbb/parallel_for.h>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
-#include <tbb/parallel_for.h>
 
 #include "mfr/scene/load.hpp"
 
@@ -34,7 +34,7 @@ namespace {
 // Image bytes kept by the tinygltf callback.
 
 struct EncodedImages {
-  const tinygltf::Model* model = nullptr;  // the model tinygltf is filling in
+  const tinygltf::Model* model = nullptr;         // the model tinygltf is filling in
   std::vector<std::vector<unsigned char>> bytes;  // by image index; empty: not available
 };
 
@@ -83,22 +83,31 @@ bool startsWithGlbMagic(const std::string& path) {
 size_t componentSize(int componentType) {
   switch (componentType) {
     case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: return 1;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return 1;
     case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return 2;
     case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT: return 4;
-    default: return 0;  // INT and DOUBLE are not valid glTF 2.0 accessor component types
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return 4;
+    default:
+      return 0;  // INT and DOUBLE are not valid glTF 2.0 accessor component types
   }
 }
 
 int componentCount(int type) {
   switch (type) {
-    case TINYGLTF_TYPE_SCALAR: return 1;
-    case TINYGLTF_TYPE_VEC2: return 2;
-    case TINYGLTF_TYPE_VEC3: return 3;
-    case TINYGLTF_TYPE_VEC4: return 4;
-    default: return 0;  // matrices are never read here
+    case TINYGLTF_TYPE_SCALAR:
+      return 1;
+    case TINYGLTF_TYPE_VEC2:
+      return 2;
+    case TINYGLTF_TYPE_VEC3:
+      return 3;
+    case TINYGLTF_TYPE_VEC4:
+      return 4;
+    default:
+      return 0;  // matrices are never read here
   }
 }
 
@@ -194,14 +203,15 @@ Result<ElementRange> GltfSceneBuilder::elementRange(int bufferViewIndex, size_t 
     return fail(what + ": buffer " + std::to_string(view.buffer) + " does not exist");
   const std::vector<unsigned char>& data = model_.buffers[static_cast<size_t>(view.buffer)].data;
   if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset)
-    return fail(what + ": bufferView " + std::to_string(bufferViewIndex) +
-                " lies outside buffer " + std::to_string(view.buffer));
+    return fail(what + ": bufferView " + std::to_string(bufferViewIndex) + " lies outside buffer " +
+                std::to_string(view.buffer));
   const size_t stride = (allowStride && view.byteStride != 0) ? view.byteStride : elementSize;
   if (count > 0) {
     // byteOffset + stride * (count - 1) + elementSize <= byteLength, without overflow.
     const size_t length = view.byteLength;
-    const bool fits = byteOffset <= length && elementSize <= length - byteOffset &&
-                      (count - 1) <= (length - byteOffset - elementSize) / std::max<size_t>(stride, 1);
+    const bool fits =
+        byteOffset <= length && elementSize <= length - byteOffset &&
+        (count - 1) <= (length - byteOffset - elementSize) / std::max<size_t>(stride, 1);
     if (!fits)
       return fail(what + ": reads past the end of bufferView " + std::to_string(bufferViewIndex));
   }
@@ -224,8 +234,8 @@ Result<std::vector<double>> GltfSceneBuilder::readAccessor(int index, int expect
 
   std::vector<double> values;
   if (accessor.bufferView >= 0) {
-    auto range = elementRange(accessor.bufferView, accessor.byteOffset, accessor.count,
-                              elementSize, true, where);
+    auto range = elementRange(accessor.bufferView, accessor.byteOffset, accessor.count, elementSize,
+                              true, where);
     if (!range) return range.error();
     values.resize(accessor.count * components);
     for (size_t i = 0; i < accessor.count; ++i)
@@ -248,22 +258,22 @@ Result<std::vector<double>> GltfSceneBuilder::readAccessor(int index, int expect
         sparse.indices.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT || indexSize == 0 ||
         sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0)
       return fail(where + ": invalid sparse accessor");
-    auto indexRange = elementRange(sparse.indices.bufferView,
-                                   static_cast<size_t>(sparse.indices.byteOffset), count,
-                                   indexSize, false, where + " sparse indices");
+    auto indexRange =
+        elementRange(sparse.indices.bufferView, static_cast<size_t>(sparse.indices.byteOffset),
+                     count, indexSize, false, where + " sparse indices");
     if (!indexRange) return indexRange.error();
-    auto valueRange = elementRange(sparse.values.bufferView,
-                                   static_cast<size_t>(sparse.values.byteOffset), count,
-                                   elementSize, false, where + " sparse values");
+    auto valueRange =
+        elementRange(sparse.values.bufferView, static_cast<size_t>(sparse.values.byteOffset), count,
+                     elementSize, false, where + " sparse values");
     if (!valueRange) return valueRange.error();
     for (size_t i = 0; i < count; ++i) {
-      const auto target = static_cast<size_t>(readComponent(
-          indexRange->data + i * indexSize, sparse.indices.componentType, false));
+      const auto target = static_cast<size_t>(
+          readComponent(indexRange->data + i * indexSize, sparse.indices.componentType, false));
       if (target >= accessor.count) return fail(where + ": sparse index out of range");
       for (size_t c = 0; c < components; ++c)
         values[target * components + c] =
-            readComponent(valueRange->data + i * elementSize + c * csize,
-                          accessor.componentType, accessor.normalized);
+            readComponent(valueRange->data + i * elementSize + c * csize, accessor.componentType,
+                          accessor.normalized);
     }
   }
   return values;
@@ -454,7 +464,7 @@ Result<void> GltfSceneBuilder::addPrimitive(const tinygltf::Primitive& primitive
     for (size_t i = base; i < scene_.normals.size(); ++i) {
       const float length = glm::length(scene_.normals[i]);
       scene_.normals[i] = (length > 0.0f && std::isfinite(length)) ? scene_.normals[i] / length
-                                                                     : glm::vec3(0.0f, 0.0f, 1.0f);
+                                                                   : glm::vec3(0.0f, 0.0f, 1.0f);
     }
   }
   return {};
@@ -483,11 +493,9 @@ uint32_t GltfSceneBuilder::materialIndex(int gltfMaterial) {
     else if (src.alphaMode == "BLEND")
       material.alphaMode = AlphaMode::Blend;
     material.alphaCutoff = static_cast<float>(src.alphaCutoff);
-    if (auto ext = src.extensions.find("KHR_materials_transmission");
-        ext != src.extensions.end()) {
+    if (auto ext = src.extensions.find("KHR_materials_transmission"); ext != src.extensions.end()) {
       double transmission = 0.0;
-      if (ext->second.Has("transmissionFactor") &&
-          ext->second.Get("transmissionFactor").IsNumber())
+      if (ext->second.Has("transmissionFactor") && ext->second.Get("transmissionFactor").IsNumber())
         transmission = ext->second.Get("transmissionFactor").GetNumberAsDouble();
       const float t = std::clamp(static_cast<float>(transmission), 0.0f, 1.0f);
       material.transmission = t;
@@ -572,7 +580,8 @@ Result<void> GltfSceneBuilder::decodeTextures() {
       return;
     }
     auto texture = toRgba8(image);
-    decoded[i] = texture ? std::move(texture) : Result<Texture>(fail(name + ": " + texture.error().message));
+    decoded[i] =
+        texture ? std::move(texture) : Result<Texture>(fail(name + ": " + texture.error().message));
   });
   for (auto& texture : decoded) {
     if (!texture) return texture.error();

@@ -145,8 +145,9 @@ Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options)
       if (!v) return v.error();
       meshOptions.transmissionAlphaFloor = *v;
     } else {
-      return check.fail(key, "is not a scene key (mesh, cameras, background, alpha, "
-                             "transmission_alpha_floor)");
+      return check.fail(key,
+                        "is not a scene key (mesh, cameras, background, alpha, "
+                        "transmission_alpha_floor)");
     }
   }
   if (mesh.empty()) return check.fail("mesh", "is required");
@@ -157,11 +158,11 @@ Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options)
     const std::filesystem::path meshPath(mesh);
     std::string extension = meshPath.extension().string();
     for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (extension == ".json")
-      return check.fail("mesh", "must not be another JSON scene file");
-    source = meshPath.is_absolute()
-                 ? mesh
-                 : (std::filesystem::path(path).parent_path() / meshPath).lexically_normal().string();
+    if (extension == ".json") return check.fail("mesh", "must not be another JSON scene file");
+    source =
+        meshPath.is_absolute()
+            ? mesh
+            : (std::filesystem::path(path).parent_path() / meshPath).lexically_normal().string();
   }
   auto loaded = loadScene(source, meshOptions);
   if (!loaded) return makeError(path + ": mesh: " + loaded.error().message);

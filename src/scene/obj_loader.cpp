@@ -29,21 +29,7 @@
 
 #include "mfr/scene/load.hpp"
 
-// A private copy of stb_image (static functions) for map_Kd textures.
-#if defined(__GNUC__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-#pragma GCC diagnostic ignored "-Wsign-compare"
-#pragma GCC diagnostic ignored "-Wunused-but-set-variable"
-#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
-#endif
-#define STB_IMAGE_STATIC
-#define STB_IMAGE_IMPLEMENTATION
-#include <stb_image.h>
-#if defined(__GNUC__)
-#pragma GCC diagnostic pop
-#endif
+#include <stb_image.h>  // Debian libstb (linked by the library)
 
 namespace mfr {
 namespace {
@@ -91,9 +77,8 @@ std::string lineContaining(const std::string& text, std::initializer_list<const 
   for (const char* needle : needles) {
     const size_t at = lower.find(needle);
     if (at == std::string::npos) continue;
-    const size_t begin = text.find_last_of('\n', at) == std::string::npos
-                             ? 0
-                             : text.find_last_of('\n', at) + 1;
+    const size_t begin =
+        text.find_last_of('\n', at) == std::string::npos ? 0 : text.find_last_of('\n', at) + 1;
     return firstLine(text.substr(begin));
   }
   return {};
@@ -133,7 +118,8 @@ Result<Texture> loadTexture(const fs::path& file) {
   Texture texture;
   texture.width = width;
   texture.height = height;
-  texture.rgba.assign(pixels, pixels + static_cast<size_t>(width) * static_cast<size_t>(height) * 4);
+  texture.rgba.assign(pixels,
+                      pixels + static_cast<size_t>(width) * static_cast<size_t>(height) * 4);
   stbi_image_free(pixels);
   return texture;
 }
@@ -248,7 +234,8 @@ Result<Scene> buildObjScene(const std::string& path) {
         const tinyobj::index_t& corner = mesh.indices[offset + k];
         const CornerKey key{corner.vertex_index, allNormals ? corner.normal_index : -1,
                             corner.texcoord_index};
-        auto [it, inserted] = vertexOf.try_emplace(key, static_cast<uint32_t>(scene.positions.size()));
+        auto [it, inserted] =
+            vertexOf.try_emplace(key, static_cast<uint32_t>(scene.positions.size()));
         if (inserted) {
           const auto v = static_cast<size_t>(key.v);
           scene.positions.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
@@ -262,9 +249,9 @@ Result<Scene> buildObjScene(const std::string& path) {
           }
           if (anyUvs) {
             const auto t = static_cast<size_t>(key.t);
-            scene.uvs.push_back(key.t < 0 ? glm::vec2(0.0f)
-                                          : glm::vec2(attrib.texcoords[2 * t],
-                                                      1.0f - attrib.texcoords[2 * t + 1]));
+            scene.uvs.push_back(
+                key.t < 0 ? glm::vec2(0.0f)
+                          : glm::vec2(attrib.texcoords[2 * t], 1.0f - attrib.texcoords[2 * t + 1]));
           }
         }
         scene.indices.push_back(it->second);

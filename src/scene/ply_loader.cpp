@@ -6,11 +6,11 @@
 //
 // assimp 5.2's PLY importer crashes or spins on malformed files (truncated bodies, corrupted
 // headers, huge element counts, out-of-range face indices), so every file is first checked
-// against the PLY format (http://paulbourke.net/dataformats/ply/) by checkPlyStructure below,
-// and assimp only ever sees structurally valid files.
-#include <assimp/Importer.hpp>
+// against the PLY format (http://paulbourke.net/dataformats/ply/) by PlyChecker below, and
+// assimp only ever sees structurally valid files.
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
+#include <assimp/Importer.hpp>
 
 #include <charconv>
 #include <cmath>
@@ -100,8 +100,8 @@ class PlyChecker {
     if (pos_ >= bytes_.size()) return false;
     const char* begin = bytes_.data() + pos_;
     const void* newline = std::memchr(begin, '\n', bytes_.size() - pos_);
-    const size_t length =
-        newline ? static_cast<size_t>(static_cast<const char*>(newline) - begin) : bytes_.size() - pos_;
+    const size_t length = newline ? static_cast<size_t>(static_cast<const char*>(newline) - begin)
+                                  : bytes_.size() - pos_;
     pos_ += length + (newline ? 1 : 0);
     line = std::string_view(begin, length);
     if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
@@ -126,10 +126,14 @@ class PlyChecker {
       if (w[0] == "end_header") break;
       if (w[0] == "format") {
         if (w.size() != 3 || w[2] != "1.0") return "bad PLY format line";
-        if (w[1] == "ascii") format_ = PlyFormat::Ascii;
-        else if (w[1] == "binary_little_endian") format_ = PlyFormat::BinaryLittleEndian;
-        else if (w[1] == "binary_big_endian") format_ = PlyFormat::BinaryBigEndian;
-        else return "unknown PLY format '" + w[1] + "'";
+        if (w[1] == "ascii")
+          format_ = PlyFormat::Ascii;
+        else if (w[1] == "binary_little_endian")
+          format_ = PlyFormat::BinaryLittleEndian;
+        else if (w[1] == "binary_big_endian")
+          format_ = PlyFormat::BinaryBigEndian;
+        else
+          return "unknown PLY format '" + w[1] + "'";
         haveFormat = true;
       } else if (w[0] == "element") {
         char* end = nullptr;
