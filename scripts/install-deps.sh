@@ -15,6 +15,7 @@ packages=(
   libassimp-dev         # PLY loader
   libgtest-dev libgmock-dev
   libbenchmark-dev
+  gnuplot-nox           # benchmark plots (scripts/bench.sh)
 )
 
 missing=()

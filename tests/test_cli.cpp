@@ -1,0 +1,163 @@
+// The command line end to end: bad input is one line on stderr naming the input and a non-zero
+// exit (never a crash); good input writes the promised files with the promised keys.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exitCode = -1;
+  bool signaled = false;
+  std::string err;
+  std::string out;
+};
+
+fs::path tempDir() {
+  static const fs::path dir = [] {
+    fs::path d = fs::temp_directory_path() / ("mfr_cli_test_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+CliRun runCli(const std::string& args) {
+  const fs::path err = tempDir() / "stderr.txt", out = tempDir() / "stdout.txt";
+  const std::string cmd = std::string(MFR_CLI_PATH) + " " + args + " >" + out.string() + " 2>" +
+                          err.string() + " </dev/null";
+  const int status = std::system(cmd.c_str());
+  CliRun r;
+  r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) >= 128);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(err), o(out);
+  std::stringstream es, os;
+  es << e.rdbuf();
+  os << o.rdbuf();
+  r.err = es.str();
+  r.out = os.str();
+  return r;
+}
+
+std::string write(const std::string& name, const std::string& content) {
+  const fs::path p = tempDir() / name;
+  std::ofstream(p, std::ios::binary) << content;
+  return p.string();
+}
+
+// One line on stderr, naming `needle`, exit code 1, no signal, no image written.
+void expectCleanFailure(const std::string& args, const std::string& needle) {
+  const fs::path image = tempDir() / "never.png";
+  fs::remove(image);
+  const CliRun r = runCli(args + " -o " + image.string());
+  EXPECT_FALSE(r.signaled) << args;
+  EXPECT_EQ(r.exitCode, 1) << args << "\n" << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\n" << r.err;
+  EXPECT_FALSE(fs::exists(image)) << args;
+}
+
+TEST(Cli, MissingFileIsAnErrorNamingIt) {
+  expectCleanFailure("render /nonexistent/scene.glb -q", "/nonexistent/scene.glb");
+}
+
+TEST(Cli, MalformedGltfIsAnErrorNamingIt) {
+  const std::string path = write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [");
+  expectCleanFailure("render " + path + " -q", path);
+}
+
+TEST(Cli, MalformedObjIsAnErrorNamingIt) {
+  const std::string path = write("broken.obj", "v 0 0 0\nv 1 0 0\nf 1 2 9\n");
+  expectCleanFailure("render " + path + " -q", path);
+}
+
+TEST(Cli, MalformedPlyIsAnErrorNamingIt) {
+  const std::string path = write("broken.ply", "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n");
+  expectCleanFailure("render " + path + " -q", path);
+}
+
+TEST(Cli, NaNVertexIsAnErrorNamingTheFile) {
+  const std::string path = write("nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n");
+  expectCleanFailure("render " + path + " -q", path);
+}
+
+TEST(Cli, EmptySceneIsAnErrorNamingTheFile) {
+  const std::string path = write("empty.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+  expectCleanFailure("render " + path + " -q", path);
+}
+
+TEST(Cli, UnknownProceduralSceneAndParameterAreErrors) {
+  expectCleanFailure("render procedural:teapot -q", "teapot");
+  expectCleanFailure("render 'procedural:layers?depth=3' -q", "depth");
+  expectCleanFailure("render 'procedural:layers?k=abc' -q", "abc");
+}
+
+TEST(Cli, ZeroNegativeAndAbsurdSizesAreErrors) {
+  expectCleanFailure("render procedural:spheres --width 0 -q", "0x1024");
+  expectCleanFailure("render procedural:spheres --height -5 -q", "-5");
+  expectCleanFailure("render procedural:spheres --width 16385 -q", "16385");
+}
+
+TEST(Cli, BadBudgetsAreErrors) {
+  expectCleanFailure("render procedural:spheres --method fkb --budget 12XB -q", "12XB");
+  expectCleanFailure("render procedural:spheres --method fkb --budget 1KB --width 64 --height 64 -q",
+                     "1024 B");
+  expectCleanFailure("render procedural:spheres --method kplus-heap -q", "budget");
+}
+
+TEST(Cli, UnknownMethodAndNonFiniteCameraAreErrors) {
+  expectCleanFailure("render procedural:spheres --method kbuffer9 -q", "kbuffer9");
+  expectCleanFailure("render procedural:spheres --camera nan,0,5,0,0,0 -q", "--camera");
+}
+
+TEST(Cli, RenderWritesImageMapsAndStatsWithTheDocumentedKeys) {
+  const fs::path dir = tempDir() / "render";
+  fs::create_directories(dir);
+  const CliRun r = runCli("render procedural:spheres --width 96 --height 80 --method kplus-sb --budget 400KB "
+                       "--composite hybrid -q -o " + (dir / "img.png").string() + " --k-map " +
+                       (dir / "k.png").string() + " --depth-complexity " + (dir / "n.png").string() +
+                       " --stats-json " + (dir / "stats.json").string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (const char* f : {"img.png", "k.png", "n.png", "stats.json"}) EXPECT_TRUE(fs::exists(dir / f)) << f;
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "stats.json"));
+  for (const char* key : {"method", "budget_bytes", "bytes_used", "fragments_generated",
+                          "fragments_captured", "fragments_lost", "k_min", "k_max", "time_ms"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["method"], "kplus-sb");
+  EXPECT_EQ(j["budget_bytes"].get<uint64_t>(), 400u * 1024u);
+  EXPECT_LE(j["bytes_used"].get<uint64_t>(), 400u * 1024u);
+  EXPECT_EQ(j["fragments_captured"].get<uint64_t>() + j["fragments_lost"].get<uint64_t>(),
+            j["fragments_generated"].get<uint64_t>());
+  EXPECT_TRUE(j["time_ms"].contains("capture"));
+  EXPECT_TRUE(j["time_ms"].contains("count"));
+}
+
+TEST(Cli, InfoReportsTrianglesAndDepthComplexity) {
+  const CliRun r = runCli("info procedural:spheres?count=3 --width 64 --height 64 --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GT(j["triangles"].get<uint64_t>(), 0u);
+  EXPECT_EQ(j["views"][0]["max_depth_complexity"].get<uint32_t>(), 6u);
+  // A-buffer bytes: 8 B per pixel (counter + offset) + 8 B per fragment
+  EXPECT_EQ(j["views"][0]["abuffer_bytes"].get<uint64_t>(),
+            64u * 64u * 8u + j["views"][0]["fragments"].get<uint64_t>() * 8u);
+}
+
+TEST(Cli, OrbitWritesOneImagePerView) {
+  const fs::path dir = tempDir() / "orbit";
+  fs::create_directories(dir);
+  const CliRun r = runCli("render procedural:bottles --width 32 --height 32 --orbit 3 -q -o " +
+                       (dir / "o.png").string());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (const char* f : {"o_v000.png", "o_v001.png", "o_v002.png"}) EXPECT_TRUE(fs::exists(dir / f)) << f;
+}
+
+}  // namespace
