@@ -1,5 +1,7 @@
 // mfr render: one method on a scene, with images, maps and statistics.
+#include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 
@@ -27,6 +29,12 @@ struct RenderArgs {
   std::string composite = "kbuffer";
   int occupancyD = 1;
   std::string capture = "tile";
+  // variable k-buffer
+  std::string importanceMap;
+  std::string importanceFactors;
+  ImportanceParams importance;
+  std::vector<double> fovea;
+  bool noDepthTerm = false, noPeripheryTerm = false, noFresnelTerm = false, noNoise = false;
 };
 
 Result<MethodDesc> buildMethod(const RenderArgs& a) {
@@ -44,6 +52,27 @@ Result<MethodDesc> buildMethod(const RenderArgs& a) {
   auto compositing = parseCompositing(a.composite);
   if (!compositing) return makeError("--composite: " + compositing.error().message);
   m.compositing = compositing.value();
+  if (m.allocation == AllocationPolicy::Importance) {
+    ImportanceParams ip = a.importance;
+    if (!(ip.alpha >= 0.0f && ip.alpha <= 1.0f)) return makeError("--importance-alpha: must be in [0, 1]");
+    if (!(ip.nLimit >= 1.0f && ip.nLimit <= 1e6f)) return makeError("--n-limit: must be in [1, 1e6]");
+    if (!(ip.peripheryExponent > 0.0f && ip.peripheryExponent <= 100.0f))
+      return makeError("--periphery-d: must be in (0, 100]");
+    if (!(ip.noise >= 0.0f && ip.noise <= 1.0f)) return makeError("--noise: must be in [0, 1]");
+    if (!a.fovea.empty()) {
+      if (a.fovea.size() != 2 || !std::isfinite(a.fovea[0]) || !std::isfinite(a.fovea[1]))
+        return makeError("--fovea: expected two finite pixel coordinates X,Y");
+      ip.fovea = glm::vec2(a.fovea[0], a.fovea[1]);
+    }
+    ip.seed = a.scene.seed;
+    ip.useDepth = !a.noDepthTerm;
+    ip.usePeriphery = !a.noPeripheryTerm;
+    ip.useFresnel = !a.noFresnelTerm;
+    ip.useNoise = !a.noNoise;
+    m.importance = ip;
+  } else if (!a.importanceMap.empty() || !a.importanceFactors.empty()) {
+    return makeError("--importance-map/--importance-factors: only for importance methods (vkb, vkb-fill)");
+  }
   if (m.occupancyWords > 0) {
     if (a.occupancyD < 1 || a.occupancyD > 64) return makeError("--occupancy-d: must be in [1, 64]");
     m.occupancyWords = a.occupancyD;
@@ -51,10 +80,11 @@ Result<MethodDesc> buildMethod(const RenderArgs& a) {
   return m;
 }
 
-void writeMap(const std::string& path, const std::vector<uint32_t>& values, int w, int h,
+template <class T>
+void writeMap(const std::string& path, const std::vector<T>& values, int w, int h,
               const std::string& title) {
   std::vector<float> v(values.begin(), values.end());
-  float maxValue = 1.0f;
+  float maxValue = std::is_integral_v<T> ? 1.0f : 0.0f;
   for (float x : v) maxValue = std::max(maxValue, x);
   auto written = writePng(path, colorMapWithLegend(v, w, h, maxValue, title));
   if (!written) throw std::runtime_error(written.error().message);
@@ -83,6 +113,7 @@ int run(const RenderArgs& a) {
   options.background = scene.background;
   const int views = static_cast<int>(prepared->cameras.size());
   nlohmann::json allStats = nlohmann::json::array();
+  std::vector<float> previousCosine;  // importance methods: nearest |n.v| of the previous view
   for (int v = 0; v < views; ++v) {
     progress.set("rendering " + method->name, v, views);
     RasterOptions ro;
@@ -91,8 +122,10 @@ int run(const RenderArgs& a) {
     ro.threads = a.scene.threads;
     auto frame = RasterFrame::build(scene, prepared->cameras[v], ro);
     if (!frame) return fail(a.scene.source + ": " + frame.error().message);
+    options.previousNearestCosine = previousCosine.empty() ? nullptr : &previousCosine;
     auto result = render(frame.value(), method.value(), options);
     if (!result) return fail(a.scene.source + ": " + result.error().message);
+    previousCosine = result->nearestCosine;
     const std::string out = viewPath(a.out, v, views);
     auto written = writePng(out, encodeSrgb(result->image));
     if (!written) return fail(written.error().message);
@@ -106,6 +139,25 @@ int run(const RenderArgs& a) {
       }
       if (!a.kMap.empty())
         writeMap(viewPath(a.kMap, v, views), result->kMap, ro.width, ro.height, "k(p)");
+      const ImportanceMaps& imp = result->importance;
+      if (!a.importanceMap.empty() && !imp.importance.empty())
+        writeMap(viewPath(a.importanceMap, v, views), imp.importance, ro.width, ro.height,
+                 "importance I(p)");
+      if (!a.importanceFactors.empty() && !imp.importance.empty()) {
+        const std::filesystem::path dir(a.importanceFactors);
+        char suffix[32];
+        std::snprintf(suffix, sizeof suffix, views > 1 ? "_v%03d.png" : ".png", v);
+        const std::pair<const char*, const std::vector<float>*> factors[] = {
+            {"importance", &imp.importance}, {"depth", &imp.depth}, {"periphery", &imp.periphery},
+            {"fresnel", &imp.fresnel}};
+        for (const auto& [name, values] : factors)
+          writeMap((dir / (std::string(name) + suffix)).string(), *values, ro.width, ro.height,
+                   std::string("I_") + name);
+        std::vector<float> noise(imp.noise.size());
+        for (size_t i = 0; i < noise.size(); ++i) noise[i] = imp.noise[i] + 0.05f;
+        writeMap((dir / (std::string("noise") + suffix)).string(), noise, ro.width, ro.height,
+                 "noise + 0.05");
+      }
     } catch (const std::exception& e) {
       return fail(e.what());
     }
@@ -152,14 +204,29 @@ Runner addRenderCommand(CLI::App& app) {
   cmd->add_option("--k-map", args->kMap, "Write the per-pixel k as a colour-mapped PNG");
   cmd->add_option("--stats-json", args->statsJson, "Write the run's statistics as JSON");
   cmd->add_option("--method,-m", args->method,
-                  "zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic "
-                  "(+occupancy)");
+                  "zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, vkb, "
+                  "vkb-fill (+occupancy)");
   cmd->add_option("--budget,-M", args->budget, "Memory budget, e.g. 20MB (MB = 2^20 bytes)");
   cmd->add_option("--k", args->k, "Explicit k (otherwise derived from the budget)");
   cmd->add_option("--composite", args->composite, "kbuffer or hybrid");
   cmd->add_option("--occupancy-d", args->occupancyD, "Occupancy map: 32*d buckets (default 1)");
   cmd->add_option("--capture", args->capture,
                   "tile (tile-owned, lock-free) or parallel (fragment-parallel, spin-locks)");
+  cmd->add_option("--importance-map", args->importanceMap,
+                  "vkb: write the importance map I(p) (colour-mapped PNG)");
+  cmd->add_option("--importance-factors", args->importanceFactors,
+                  "vkb: write each importance factor as a PNG into this folder");
+  cmd->add_option("--importance-alpha", args->importance.alpha, "vkb Eq. 3 alpha (default 0.375)");
+  cmd->add_option("--n-limit", args->importance.nLimit, "vkb Eq. 3 N_limit (default 20)");
+  cmd->add_option("--periphery-d", args->importance.peripheryExponent, "vkb Eq. 4 d (default 3)");
+  cmd->add_option("--fovea", args->fovea, "vkb Eq. 4 centre o in pixels X,Y (default: image centre)")
+      ->delimiter(',')
+      ->expected(2);
+  cmd->add_option("--noise", args->importance.noise, "vkb Eq. 6 lambda (default 0.1)");
+  cmd->add_flag("--no-depth-term", args->noDepthTerm, "vkb: switch off I_d");
+  cmd->add_flag("--no-periphery-term", args->noPeripheryTerm, "vkb: switch off I_per");
+  cmd->add_flag("--no-fresnel-term", args->noFresnelTerm, "vkb: switch off I_f");
+  cmd->add_flag("--no-noise", args->noNoise, "vkb: switch off the noise of Eq. 6");
   return [args] { return run(*args); };
 }
 

@@ -10,5 +10,6 @@ namespace mfr::cli {
 using Runner = std::function<int()>;
 Runner addRenderCommand(CLI::App& app);
 Runner addInfoCommand(CLI::App& app);
+Runner addMetricsCommand(CLI::App& app);
 
 }  // namespace mfr::cli

@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "mfr 0.1.0");
   const mfr::cli::Runner render = mfr::cli::addRenderCommand(app);
   const mfr::cli::Runner info = mfr::cli::addInfoCommand(app);
+  const mfr::cli::Runner metrics = mfr::cli::addMetricsCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -19,6 +20,7 @@ int main(int argc, char** argv) {
   try {
     if (app.got_subcommand("render")) return render();
     if (app.got_subcommand("info")) return info();
+    if (app.got_subcommand("metrics")) return metrics();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mfr: error: %s\n", e.what());
     return 1;

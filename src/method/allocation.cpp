@@ -5,10 +5,14 @@
 //                 for fixed k unless explicit;
 //   dynamic k     the largest global k whose exact memory fits M, read off the depth-complexity
 //                 histogram (dynamic k-buffer, [VPF15] as summarised by the variable k-buffer paper);
+//   importance    k(p) = floor(P(p) F(M)), P(p) = I(p) / sum I (variable k-buffer, Eqs. 1-2); the
+//                 fill variant caps k(p) at n(p) and hands freed and remainder slots to the pixels
+//                 with the largest unmet importance;
 //   unbounded     k(p) = n(p) (A-buffer / S-buffer).
 // Offsets are an exclusive prefix sum of k(p) in tile-major order (the S-buffer's clustering of
 // pixels by tiles, for locality).
 #include <algorithm>
+#include <cmath>
 #include <string>
 
 #include "pipeline.hpp"
@@ -34,9 +38,51 @@ StoreKind pickStore(StoreChoice choice, uint32_t n, uint32_t k) {
 
 }  // namespace
 
+// Water-filling for vkb-fill: k(p) <= n(p), sum k(p) <= slots, extra slots in proportion to the
+// importance of the pixels still short of n(p), the last few one each by descending importance.
+void fillByImportance(const std::vector<uint32_t>& n, const std::vector<float>& importance,
+                      uint64_t slots, std::vector<uint64_t>& k) {
+  uint64_t used = 0;
+  for (size_t p = 0; p < n.size(); ++p) used += k[p];
+  for (int round = 0; round < 64 && used < slots; ++round) {
+    double unmetImportance = 0.0;
+    for (size_t p = 0; p < n.size(); ++p)
+      if (k[p] < n[p]) unmetImportance += importance[p];
+    if (unmetImportance <= 0.0) break;
+    const uint64_t spare = slots - used;
+    uint64_t given = 0;
+    for (size_t p = 0; p < n.size(); ++p) {
+      if (k[p] >= n[p]) continue;
+      const uint64_t extra = std::min<uint64_t>(
+          n[p] - k[p], static_cast<uint64_t>(spare * (importance[p] / unmetImportance)));
+      k[p] += extra;
+      given += extra;
+    }
+    used += given;
+    if (given == 0) break;
+  }
+  if (used >= slots) return;
+  std::vector<uint32_t> order;
+  for (size_t p = 0; p < n.size(); ++p)
+    if (k[p] < n[p]) order.push_back(static_cast<uint32_t>(p));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](uint32_t a, uint32_t b) { return importance[a] > importance[b]; });
+  while (used < slots && !order.empty()) {  // one each, most important first, until exhausted
+    size_t kept = 0;
+    for (uint32_t p : order) {
+      if (used < slots && k[p] < n[p]) {
+        ++k[p];
+        ++used;
+      }
+      if (k[p] < n[p]) order[kept++] = p;
+    }
+    order.resize(kept);
+  }
+}
+
 Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
                             const MemoryModel& memory, std::optional<uint64_t> budget,
-                            const std::vector<uint32_t>& n) {
+                            const std::vector<uint32_t>& n, const std::vector<float>& importance) {
   const uint64_t pixels = frame.pixelCount();
   const uint64_t overhead = memory.overhead(pixels);
   const std::string& name = method.name;
@@ -126,7 +172,35 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
         a.capacity[p] = static_cast<uint32_t>(std::min<uint64_t>(n[p], k));
       break;
     }
+    case AllocationPolicy::Importance: {
+      if (!budget) return makeError(name + ": needs a budget");
+      if (slotsInBudget < covered)
+        return makeError("budget " + bytesText(*budget) + ": too small for one fragment per "
+                         "covered pixel with " + name + " at " + sizeText(frame) + " (needs " +
+                         bytesText(overhead + covered * kNodeBytes) + ")");
+      double total = 0.0;
+      for (float i : importance) total += i;
+      std::vector<uint64_t> k(pixels, 0);
+      if (total > 0.0)
+        for (size_t p = 0; p < pixels; ++p)
+          k[p] = static_cast<uint64_t>(std::floor(importance[p] / total *
+                                                  static_cast<double>(slotsInBudget)));
+      if (method.fillUnusedSlots) {
+        for (size_t p = 0; p < pixels; ++p) k[p] = std::min<uint64_t>(k[p], n[p]);
+        fillByImportance(n, importance, slotsInBudget, k);
+      }
+      a.reservedK.resize(pixels);
+      for (size_t p = 0; p < pixels; ++p) {
+        a.reservedSlots += k[p];
+        a.reservedK[p] = static_cast<uint32_t>(std::min<uint64_t>(k[p], UINT32_MAX));
+        a.capacity[p] = static_cast<uint32_t>(std::min<uint64_t>(k[p], n[p]));
+        a.slots += a.capacity[p];
+      }
+      MFR_CHECK(a.reservedSlots <= slotsInBudget);
+      break;
+    }
   }
+  if (a.reservedK.empty()) a.reservedSlots = a.slots;
 
   for (size_t p = 0; p < pixels; ++p)
     a.kind[p] = pickStore(method.store, n.empty() ? a.capacity[p] + 1 : n[p], a.capacity[p]);

@@ -11,6 +11,7 @@ MemoryModel MemoryModel::of(const MethodDesc& method) {
   m.lock = method.perPixelLock ? 4 : 0;
   m.occupancy = method.occupancyWords > 0 ? OccupancyMap::bytesPerPixel(method.occupancyWords) : 0;
   m.tail = method.compositing == Compositing::Hybrid ? 20 : 0;
+  m.previous = method.allocation == AllocationPolicy::Importance ? 1 : 0;
   m.image = method.allocation == AllocationPolicy::DynamicK ? kHistogramBins * 4 : 0;
   return m;
 }
@@ -23,6 +24,7 @@ std::map<std::string, uint64_t> MemoryModel::breakdown(uint64_t pixels, uint64_t
   if (lock) bytes["locks"] = pixels * lock;
   if (occupancy) bytes["occupancy"] = pixels * occupancy;
   if (tail) bytes["tail"] = pixels * tail;
+  if (previous) bytes["previous_frame"] = pixels * previous;
   if (image) bytes["histogram"] = image;
   return bytes;
 }

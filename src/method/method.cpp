@@ -3,7 +3,8 @@
 namespace mfr {
 
 std::vector<std::string> presetNames() {
-  return {"zbuffer", "abuffer", "fkb", "kplus-array", "kplus-heap", "kplus-sb", "kplus-dynamic"};
+  return {"zbuffer",  "abuffer",       "fkb", "kplus-array", "kplus-heap",
+          "kplus-sb", "kplus-dynamic", "vkb", "vkb-fill"};
 }
 
 Result<MethodDesc> methodPreset(const std::string& fullName) {
@@ -39,6 +40,12 @@ Result<MethodDesc> methodPreset(const std::string& fullName) {
     m.store = StoreChoice::PerPixel;
     m.culling = CullingTest::KPlus;
     m.perPixelLock = true;
+  } else if (name == "vkb" || name == "vkb-fill") {
+    m.allocation = AllocationPolicy::Importance;
+    m.store = StoreChoice::PerPixel;
+    m.culling = CullingTest::KPlus;
+    m.perPixelLock = true;
+    m.fillUnusedSlots = name == "vkb-fill";
   } else {
     std::string known;
     for (const std::string& n : presetNames()) known += (known.empty() ? "" : ", ") + n;
@@ -58,7 +65,8 @@ const char* toString(AllocationPolicy a) {
     case AllocationPolicy::Unbounded: return "unbounded";
     case AllocationPolicy::FixedK: return "fixed-k";
     case AllocationPolicy::CountedK: return "counted-k";
-    default: return "dynamic-k";
+    case AllocationPolicy::DynamicK: return "dynamic-k";
+    default: return "importance";
   }
 }
 const char* toString(StoreChoice s) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -17,14 +18,19 @@ struct Allocation {
   std::vector<uint32_t> capacity;  // k(p)
   std::vector<uint64_t> offsets;   // first slot of pixel p
   std::vector<StoreKind> kind;     // store used by pixel p
-  uint64_t slots = 0;              // total nodes
+  uint64_t slots = 0;              // total nodes materialised
   std::optional<uint32_t> globalK;
+  // Importance allocation: the paper's k(p) may exceed n(p); those slots are reserved (and
+  // accounted for) but never filled, so the engine materialises only min(k(p), n(p)).
+  std::vector<uint32_t> reservedK;  // k(p) as allocated (empty: same as capacity)
+  uint64_t reservedSlots = 0;       // sum of k(p): the nodes the memory model charges
 };
 
 /// Turns the policy, the budget and (when a count pass ran) n(p) into k(p) and offsets.
 Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
                             const MemoryModel& memory, std::optional<uint64_t> budget,
-                            const std::vector<uint32_t>& fragmentCounts);
+                            const std::vector<uint32_t>& fragmentCounts,
+                            const std::vector<float>& importance);
 
 struct CaptureCounters {
   uint64_t generated = 0, culledOccupancy = 0, culledKPlus = 0, rejected = 0, inserted = 0,
@@ -39,8 +45,26 @@ struct CaptureCounters {
   }
 };
 
+/// Fixed-size array that is not zero-filled on allocation: the node pool is written before it is
+/// read (slots at and above a pixel's count are never read), so clearing it would only cost time.
+template <class T>
+class UninitializedBuffer {
+ public:
+  void allocate(size_t n) {
+    data_.reset(n ? new T[n] : nullptr);
+    size_ = n;
+  }
+  T* data() { return data_.get(); }
+  const T* data() const { return data_.get(); }
+  size_t size() const { return size_; }
+
+ private:
+  std::unique_ptr<T[]> data_;
+  size_t size_ = 0;
+};
+
 struct Stores {
-  std::vector<FragmentNode> nodes;
+  UninitializedBuffer<FragmentNode> nodes;
   std::vector<uint32_t> counts;
   std::vector<uint32_t> locks;
   std::vector<HybridTail> tails;  // empty unless hybrid

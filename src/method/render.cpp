@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
@@ -103,6 +104,23 @@ double RenderStats::totalMs() const {
   return total;
 }
 
+std::vector<float> nearestCosine(const RasterFrame& frame) {
+  std::vector<FragmentNode> nearest(frame.pixelCount(), kFarNode);
+  std::vector<float> cosine(frame.pixelCount(), 0.0f);
+  frame.forEachTile([&](int tile) {
+    frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
+                                           const FragmentNode node = makeNode(f);
+                                           if (node < nearest[f.pixel]) {
+                                             nearest[f.pixel] = node;
+                                             cosine[f.pixel] = std::fabs(f.ndotv);
+                                           }
+                                         }});
+  });
+  // the previous-frame buffer keeps |n.v| as unorm8 (1 byte per pixel in the memory model)
+  for (float& c : cosine) c = static_cast<float>(unorm8(c)) / 255.0f;
+  return cosine;
+}
+
 std::vector<uint32_t> countFragments(const RasterFrame& frame) {
   std::vector<uint32_t> counts(frame.pixelCount(), 0);
   frame.forEachTile([&](int tile) {
@@ -132,9 +150,24 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   if (method.allocation != AllocationPolicy::FixedK)
     out.depthComplexity = timer.run("count", [&] { return countFragments(frame); });
 
+  // importance (variable k-buffer): the previous frame's nearest |n.v| (a preceding frame from
+  // the same camera unless the caller hands one over), then the map
+  if (method.allocation == AllocationPolicy::Importance) {
+    out.nearestCosine = timer.run("nearest_normal", [&] { return nearestCosine(frame); });
+    const std::vector<float>& previous =
+        options.previousNearestCosine && options.previousNearestCosine->size() == pixels
+            ? *options.previousNearestCosine
+            : out.nearestCosine;
+    out.importance = timer.run("importance", [&] {
+      return computeImportance(frame.width(), frame.height(), out.depthComplexity, previous,
+                               method.importance);
+    });
+  }
+
   // allocate
   auto allocated = timer.run("allocate", [&] {
-    return detail::allocate(frame, method, memory, options.budgetBytes, out.depthComplexity);
+    return detail::allocate(frame, method, memory, options.budgetBytes, out.depthComplexity,
+                            out.importance.importance);
   });
   if (!allocated) return allocated.error();
   detail::Allocation& alloc = allocated.value();
@@ -142,7 +175,9 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   // buffers
   detail::Stores stores;
   timer.run("clear", [&] {
-    stores.nodes.resize(alloc.slots);
+    stores.nodes.allocate(alloc.slots);
+    if (options.keepStores)  // unused slots are handed out: make them defined
+      std::fill(stores.nodes.data(), stores.nodes.data() + alloc.slots, FragmentNode{0});
     stores.counts.assign(pixels, 0);
     if (options.capture == CaptureMode::FragmentParallel) stores.locks.assign(pixels, 0);
     if (method.compositing == Compositing::Hybrid) stores.tails.assign(pixels, HybridTail{});
@@ -167,8 +202,8 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   });
 
   // statistics
-  stats.fragmentSlots = alloc.slots;
-  stats.bytesByCategory = memory.breakdown(pixels, alloc.slots);
+  stats.fragmentSlots = alloc.reservedSlots;
+  stats.bytesByCategory = memory.breakdown(pixels, alloc.reservedSlots);
   for (const auto& [category, bytes] : stats.bytesByCategory) stats.bytesUsed += bytes;
   if (options.budgetBytes) MFR_CHECK(stats.bytesUsed <= *options.budgetBytes);
   stats.fragmentsGenerated = counters.generated;
@@ -187,8 +222,9 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
         out.depthComplexity.empty() ? stores.counts[p] > 0 : out.depthComplexity[p] > 0;
     if (!covered) continue;
     ++stats.coveredPixels;
-    kMin = std::min(kMin, alloc.capacity[p]);
-    kMax = std::max(kMax, alloc.capacity[p]);
+    const uint32_t k = alloc.reservedK.empty() ? alloc.capacity[p] : alloc.reservedK[p];
+    kMin = std::min(kMin, k);
+    kMax = std::max(kMax, k);
     if (!out.depthComplexity.empty()) {
       sumN += out.depthComplexity[p];
       maxN = std::max(maxN, out.depthComplexity[p]);
@@ -202,9 +238,9 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
     stats.meanDepthComplexity =
         stats.coveredPixels ? static_cast<double>(sumN) / stats.coveredPixels : 0.0;
   }
-  out.kMap = std::move(alloc.capacity);
+  out.kMap = alloc.reservedK.empty() ? std::move(alloc.capacity) : std::move(alloc.reservedK);
   if (options.keepStores) {
-    out.nodes = std::move(stores.nodes);
+    out.nodes.assign(stores.nodes.data(), stores.nodes.data() + stores.nodes.size());
     out.offsets = std::move(alloc.offsets);
     out.counts = std::move(stores.counts);
   }

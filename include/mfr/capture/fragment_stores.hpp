@@ -50,14 +50,17 @@ struct AtomicAccess {
 
 enum class InsertOutcome : uint8_t { Inserted, Replaced, Rejected };
 
-/// The k+ culling test: false when the store is full and the node is not nearer than the maximum.
+/// The k+ culling test: false when the store is full and the node is not nearer than the maximum
+/// (a pixel with no slots, capacity 0, rejects everything).
 template <class Access = PlainAccess>
 inline bool passesKPlusTest(const FragmentNode* slots, const uint32_t& count, uint32_t capacity,
                             FragmentNode node) {
-  return Access::load(count) < capacity || node < Access::load(slots[0]);
+  const uint32_t n = Access::load(count);
+  return n < capacity || (n > 0 && node < Access::load(slots[0]));
 }
 
-/// Append (S-buffer / A-buffer): capacity is the pixel's exact fragment count.
+/// Append (S-buffer / A-buffer): capacity is the pixel's exact fragment count, so it never
+/// overflows.
 inline InsertOutcome appendInsert(FragmentNode* slots, uint32_t& count, FragmentNode node) {
   slots[count++] = node;
   return InsertOutcome::Inserted;
@@ -81,7 +84,7 @@ inline InsertOutcome maxArrayInsert(FragmentNode* slots, uint32_t& count, uint32
     Access::store(count, n + 1);
     return InsertOutcome::Inserted;
   }
-  if (!(node < slots[0])) return InsertOutcome::Rejected;
+  if (n == 0 || !(node < slots[0])) return InsertOutcome::Rejected;
   evicted = slots[0];
   uint32_t maxIndex = 0;
   FragmentNode maxNode = node;
@@ -119,7 +122,7 @@ inline InsertOutcome maxHeapInsert(FragmentNode* slots, uint32_t& count, uint32_
     Access::store(count, n + 1);
     return InsertOutcome::Inserted;
   }
-  if (!(node < slots[0])) return InsertOutcome::Rejected;
+  if (n == 0 || !(node < slots[0])) return InsertOutcome::Rejected;
   evicted = slots[0];
   uint32_t i = 0;  // down-heap: move the larger child up into the hole
   for (;;) {

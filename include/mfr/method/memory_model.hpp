@@ -9,7 +9,10 @@
 //   lock      4 B  spin-lock semaphore                                       k+-buffer family
 //   occupancy 12 + 4d B  zn, zf, k-th bucket, 32d-bit bitmap                 +occupancy
 //   tail      20 B  hybrid tail: sum(alpha * rgb) 3 x f32, sum(alpha) f32, count u32   hybrid
+//   previous  1 B  |n.v| of the previous frame's nearest fragment, unorm8    vkb (Fresnel term)
 //   image     4096 B  depth-complexity histogram, 1024 x u32                 kplus-dynamic
+// The variable k-buffer's importance map lives in the offset word (importance, then k(p), then the
+// prefix sum, computed in place), so it costs no extra bytes; the count pass's n(p) is the counter.
 #pragma once
 
 #include <cstdint>
@@ -24,11 +27,11 @@ inline constexpr uint64_t kNodeBytes = 8;
 inline constexpr uint64_t kHistogramBins = 1024;
 
 struct MemoryModel {
-  uint64_t counter = 4, offset = 0, lock = 0, occupancy = 0, tail = 0;  // bytes per pixel
+  uint64_t counter = 4, offset = 0, lock = 0, occupancy = 0, tail = 0, previous = 0;  // per pixel
   uint64_t image = 0;                                                   // bytes per image
 
   static MemoryModel of(const MethodDesc& method);
-  uint64_t perPixel() const { return counter + offset + lock + occupancy + tail; }
+  uint64_t perPixel() const { return counter + offset + lock + occupancy + tail + previous; }
   uint64_t overhead(uint64_t pixels) const { return pixels * perPixel() + image; }
   /// F(M): fragment slots a budget buys (0 when the overhead alone exceeds it).
   uint64_t fragmentSlots(uint64_t budget, uint64_t pixels) const {

@@ -10,6 +10,7 @@
 
 #include "mfr/capture/fragment_stores.hpp"
 #include "mfr/core/result.hpp"
+#include "mfr/method/importance.hpp"
 
 namespace mfr {
 
@@ -19,6 +20,7 @@ enum class AllocationPolicy : uint8_t {
   FixedK,     // the same k pre-allocated for every pixel (k-buffer, k+-buffer)
   CountedK,   // count pass capped at k, prefix-sum offsets, exact memory (K+B-SB)
   DynamicK,   // largest global k whose exact memory fits the budget, from the histogram
+  Importance, // k(p) = floor(P(p) F(M)) from an importance map (variable k-buffer)
 };
 
 /// Which store holds a pixel's fragments.
@@ -48,10 +50,14 @@ struct MethodDesc {
   int occupancyWords = 0;     // 0: no occupancy culling; d > 0: 32*d buckets
   Compositing compositing = Compositing::KBuffer;
   std::optional<uint32_t> k;  // explicit k (otherwise derived from the budget)
+  ImportanceParams importance;  // Importance allocation only
+  /// Importance allocation: cap k(p) at n(p) and hand the freed and the floor() remainder slots to
+  /// the pixels with the largest unmet importance (vkb-fill), instead of the paper's exact rule.
+  bool fillUnusedSlots = false;
 };
 
-/// Preset names: zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, each
-/// optionally followed by "+occupancy".
+/// Preset names: zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, vkb,
+/// vkb-fill, each bounded one optionally followed by "+occupancy".
 std::vector<std::string> presetNames();
 
 /// Looks up a preset ("kplus-heap", "fkb+occupancy", ...). Errors list the known names.

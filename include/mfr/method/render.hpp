@@ -12,6 +12,7 @@
 
 #include "mfr/core/image.hpp"
 #include "mfr/core/result.hpp"
+#include "mfr/method/importance.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/raster/raster_frame.hpp"
 
@@ -28,6 +29,10 @@ struct RenderOptions {
   CaptureMode capture = CaptureMode::TileOwned;
   glm::vec3 background{1.0f};  // linear RGB
   bool keepStores = false;     // keep the captured nodes in the output (tests, tools)
+  /// Importance allocation: |n.v| of each pixel's nearest fragment in the previous frame of a
+  /// sequence (RenderOutput::nearestCosine of that frame). When absent, a preceding frame from the
+  /// same camera is used.
+  const std::vector<float>* previousNearestCosine = nullptr;
 };
 
 struct PassTime {
@@ -65,6 +70,8 @@ struct RenderOutput {
   ImageRGB image;                       // linear RGB, composited over the background
   std::vector<uint32_t> kMap;           // slots per pixel
   std::vector<uint32_t> depthComplexity;  // n(p), when a count pass ran (else empty)
+  ImportanceMaps importance;              // importance allocation only
+  std::vector<float> nearestCosine;       // importance allocation: this frame's nearest |n.v|
   RenderStats stats;
   // with keepStores: pixel p's captured nodes are nodes[offsets[p] .. offsets[p] + counts[p]),
   // unsorted, as the store left them
@@ -78,5 +85,8 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
 
 /// Per-pixel fragment counts n(p) (a Coverage count pass).
 std::vector<uint32_t> countFragments(const RasterFrame& frame);
+
+/// |n.v| of each pixel's nearest fragment (0 where none), quantised to 8 bits.
+std::vector<float> nearestCosine(const RasterFrame& frame);
 
 }  // namespace mfr
