@@ -4,11 +4,11 @@
 
 namespace mfr {
 
-MemoryModel MemoryModel::of(const MethodDesc& method) {
+MemoryModel MemoryModel::of(const MethodDesc& method, bool fragmentParallel) {
   MemoryModel m;
   const bool prefixSum = method.allocation != AllocationPolicy::FixedK;
   m.offset = prefixSum ? 4 : 0;
-  m.lock = method.perPixelLock ? 4 : 0;
+  m.lock = method.perPixelLock || fragmentParallel ? 4 : 0;
   m.occupancy = method.occupancyWords > 0 ? OccupancyMap::bytesPerPixel(method.occupancyWords) : 0;
   m.tail = method.compositing == Compositing::Hybrid ? 20 : 0;
   m.previous = method.allocation == AllocationPolicy::Importance ? 1 : 0;

@@ -144,7 +144,8 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   stats.budgetBytes = options.budgetBytes;
   PassTimer timer(stats.passes);
   const size_t pixels = frame.pixelCount();
-  const MemoryModel memory = MemoryModel::of(method);
+  const MemoryModel memory =
+      MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
 
   // count pass
   if (method.allocation != AllocationPolicy::FixedK)

@@ -12,15 +12,17 @@
 //     the thread count (the tool sums in float; the difference is ~1e-6 on large images).
 //
 // Pipeline (per image, reference and test alike, then compared):
-//   1. sRGB8 -> linear RGB (IEC 61966-2-1, threshold 0.04045) -> XYZ (D65) -> YCxCz (opponent space,
+//   1. sRGB8 -> linear RGB (IEC 61966-2-1, threshold 0.04045) -> XYZ (D65) -> YCxCz (opponent
+//   space,
 //      normalised by the D65 white).
 //   2. Colour: each YCxCz channel is filtered by its contrast sensitivity function (a Gaussian
-//      a sqrt(pi / b) exp(-pi^2 x^2 / b) in degrees, sampled at 1 / ppd), back to linear RGB, clamped
-//      to [0, 1], to CIELAB, Hunt-adjusted (a, b scaled by 0.01 L), compared with HyAB (|dL| +
+//      a sqrt(pi / b) exp(-pi^2 x^2 / b) in degrees, sampled at 1 / ppd), back to linear RGB,
+//      clamped to [0, 1], to CIELAB, Hunt-adjusted (a, b scaled by 0.01 L), compared with HyAB
+//      (|dL| +
 //      ||d(a, b)||), raised to qc and remapped to [0, 1] with a knee at (pc cmax, pt).
 //   3. Features: on luminance in [0, 1] ((Y + 16) / 116 of YCxCz), first- and second-derivative-of-
-//      Gaussian filters (sigma = w ppd / 2) give edge and point strengths; the feature difference is
-//      (max(|edge diff|, |point diff|) / sqrt 2)^qf.
+//      Gaussian filters (sigma = w ppd / 2) give edge and point strengths; the feature difference
+//      is (max(|edge diff|, |point diff|) / sqrt 2)^qf.
 //   4. FLIP = colour difference ^ (1 - feature difference).
 #include "mfr/metrics/flip.hpp"
 
@@ -41,11 +43,11 @@ namespace {
 // --- Constants of the published algorithm -------------------------------------------------------
 
 constexpr float kPi = 3.14159265358979f;
-constexpr float kQc = 0.7f;    // colour difference exponent
-constexpr float kPc = 0.4f;    // knee position, as a fraction of cmax
-constexpr float kPt = 0.95f;   // knee value
-constexpr float kW = 0.082f;   // feature filter width in degrees
-constexpr float kQf = 0.5f;    // feature difference exponent
+constexpr float kQc = 0.7f;   // colour difference exponent
+constexpr float kPc = 0.4f;   // knee position, as a fraction of cmax
+constexpr float kPt = 0.95f;  // knee value
+constexpr float kW = 0.082f;  // feature filter width in degrees
+constexpr float kQf = 0.5f;   // feature difference exponent
 
 // Contrast sensitivity functions of the achromatic (Y), red-green (Cx) and blue-yellow (Cz)
 // channels: a1 G(b1) + a2 G(b2); only Cz has a second Gaussian.
@@ -109,10 +111,14 @@ Col xyzToLab(Col c) {
   return {116.0f * fy - 16.0f, 500.0f * (fx - fy), 200.0f * (fy - fz)};
 }
 
-float clamp01(float v) { return std::min(std::max(v, 0.0f), 1.0f); }
+float clamp01(float v) {
+  return std::min(std::max(v, 0.0f), 1.0f);
+}
 
 // Lab with the Hunt adjustment: chroma scales with lightness (0.01 L).
-Col huntLab(Col lab) { return {lab.x, 0.01f * lab.x * lab.y, 0.01f * lab.x * lab.z}; }
+Col huntLab(Col lab) {
+  return {lab.x, 0.01f * lab.x * lab.y, 0.01f * lab.x * lab.z};
+}
 
 // HyAB: city-block distance in lightness plus Euclidean distance in (a, b).
 float hyab(Col a, Col b) {
@@ -277,8 +283,8 @@ YCxCzPlanes toYCxCz(const Image8& image, const std::array<float, 256>& decode) {
   const size_t n = static_cast<size_t>(image.width) * image.height;
   YCxCzPlanes p{Plane(n), Plane(n), Plane(n)};
   forRows(image.height, [&](int y) {
-    for (size_t i = static_cast<size_t>(y) * image.width; i < static_cast<size_t>(y + 1) * image.width;
-         ++i) {
+    for (size_t i = static_cast<size_t>(y) * image.width;
+         i < static_cast<size_t>(y + 1) * image.width; ++i) {
       const uint8_t* px = &image.rgba[i * 4];
       const Col linear{clamp01(decode[px[0]]), clamp01(decode[px[1]]), clamp01(decode[px[2]])};
       const Col c = xyzToYCxCz(linearRgbToXyz(linear));
@@ -299,7 +305,8 @@ std::string sizeText(const Image8& image) {
 
 }  // namespace
 
-Result<FlipResult> computeFlip(const Image8& reference, const Image8& test, double pixelsPerDegree) {
+Result<FlipResult> computeFlip(const Image8& reference, const Image8& test,
+                               double pixelsPerDegree) {
   if (reference.width != test.width || reference.height != test.height) {
     std::string message = "FLIP needs images of the same size: reference is ";
     message += sizeText(reference);
@@ -412,8 +419,8 @@ Result<FlipResult> computeFlip(const Image8& reference, const Image8& test, doub
     std::vector<float> acc(static_cast<size_t>(w) * 8);
     for (int i = 0; i < 2; ++i) {
       float* b = acc.data() + static_cast<size_t>(4 * i) * w;
-      convolveColumn(rows[4 * i + 0], ff.g, w, h, y, b);          // dx
-      convolveColumn(rows[4 * i + 1], ff.g, w, h, y, b + w);      // ddx
+      convolveColumn(rows[4 * i + 0], ff.g, w, h, y, b);            // dx
+      convolveColumn(rows[4 * i + 1], ff.g, w, h, y, b + w);        // ddx
       convolveColumn(rows[4 * i + 2], ff.dg, w, h, y, b + 2 * w);   // dy
       convolveColumn(rows[4 * i + 2], ff.ddg, w, h, y, b + 3 * w);  // ddy
     }
@@ -451,7 +458,8 @@ double flipPercentile(const FlipResult& result, double fraction) {
   const double f = std::clamp(std::isfinite(fraction) ? fraction : 0.0, 0.0, 1.0);
   const size_t rank = static_cast<size_t>(std::ceil(f * static_cast<double>(sorted.size())));
   const size_t index = rank == 0 ? 0 : rank - 1;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(index), sorted.end());
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(index),
+                   sorted.end());
   return sorted[index];
 }
 

@@ -143,7 +143,9 @@ constexpr std::array<std::array<float, 3>, 256> kMagma = {{
 
 }  // namespace
 
-const std::array<std::array<float, 3>, 256>& magmaTable() { return kMagma; }
+const std::array<std::array<float, 3>, 256>& magmaTable() {
+  return kMagma;
+}
 
 int magmaIndex(float t) {
   if (!(t > 0.0f)) return 0;  // also NaN
@@ -169,7 +171,8 @@ Image8 magmaImage(const std::vector<float>& values, int width, int height, float
   image.rgba.resize(values.size() * 4);
   const float inv = 1.0f / scale;
   for (size_t i = 0; i < values.size(); ++i) {
-    const auto& c = lut[static_cast<size_t>(magmaIndex(scale == 1.0f ? values[i] : values[i] * inv))];
+    const auto& c =
+        lut[static_cast<size_t>(magmaIndex(scale == 1.0f ? values[i] : values[i] * inv))];
     uint8_t* p = &image.rgba[i * 4];
     p[0] = c[0];
     p[1] = c[1];

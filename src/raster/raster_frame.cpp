@@ -18,6 +18,8 @@ int resolveThreads(int threads) {
   return hw > 0 ? static_cast<int>(hw) : 1;
 }
 
+int RasterFrame::arenaThreads() const { return std::min(threads_, resolveThreads(0)); }
+
 namespace {
 
 struct ClipVertex {
@@ -183,7 +185,7 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   frame.rayScaleY_ = -2.0f * tanHalf / static_cast<float>(options.height);
   frame.rayBiasY_ = (1.0f - 1.0f / static_cast<float>(options.height)) * tanHalf;
 
-  tbb::task_arena arena(frame.threads_);
+  tbb::task_arena arena(frame.arenaThreads());
   // vertex transform
   const size_t vertexCount = scene.positions.size();
   std::vector<ClipVertex> vertices(vertexCount);

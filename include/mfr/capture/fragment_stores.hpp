@@ -36,9 +36,14 @@ struct PlainAccess {
   static T load(const T& v) { return v; }
   template <class T>
   static void store(T& v, T x) { v = x; }
+  static uint32_t loadCount(const uint32_t& c) { return c; }
+  static void publishCount(uint32_t& c, uint32_t x) { c = x; }
 };
 
-/// Relaxed atomic access of the words read outside the critical section.
+/// Atomic access of the words read outside the critical section. The counter is published with
+/// release after slot 0 is written and read with acquire before slot 0 is read, so a reader that
+/// sees a full store also sees the slot 0 of that full store (never an older, smaller maximum
+/// that would cull a fragment wrongly on weakly ordered machines).
 struct AtomicAccess {
   template <class T>
   static T load(const T& v) {
@@ -46,6 +51,12 @@ struct AtomicAccess {
   }
   template <class T>
   static void store(T& v, T x) { std::atomic_ref<T>(v).store(x, std::memory_order_relaxed); }
+  static uint32_t loadCount(const uint32_t& c) {
+    return std::atomic_ref<uint32_t>(const_cast<uint32_t&>(c)).load(std::memory_order_acquire);
+  }
+  static void publishCount(uint32_t& c, uint32_t x) {
+    std::atomic_ref<uint32_t>(c).store(x, std::memory_order_release);
+  }
 };
 
 enum class InsertOutcome : uint8_t { Inserted, Replaced, Rejected };
@@ -55,7 +66,7 @@ enum class InsertOutcome : uint8_t { Inserted, Replaced, Rejected };
 template <class Access = PlainAccess>
 inline bool passesKPlusTest(const FragmentNode* slots, const uint32_t& count, uint32_t capacity,
                             FragmentNode node) {
-  const uint32_t n = Access::load(count);
+  const uint32_t n = Access::loadCount(count);
   return n < capacity || (n > 0 && node < Access::load(slots[0]));
 }
 
@@ -81,7 +92,7 @@ inline InsertOutcome maxArrayInsert(FragmentNode* slots, uint32_t& count, uint32
     } else {
       slots[n] = node;
     }
-    Access::store(count, n + 1);
+    Access::publishCount(count, n + 1);
     return InsertOutcome::Inserted;
   }
   if (n == 0 || !(node < slots[0])) return InsertOutcome::Rejected;
@@ -119,7 +130,7 @@ inline InsertOutcome maxHeapInsert(FragmentNode* slots, uint32_t& count, uint32_
       Access::store(slots[0], node);
     else
       slots[i] = node;
-    Access::store(count, n + 1);
+    Access::publishCount(count, n + 1);
     return InsertOutcome::Inserted;
   }
   if (n == 0 || !(node < slots[0])) return InsertOutcome::Rejected;

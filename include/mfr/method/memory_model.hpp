@@ -30,7 +30,10 @@ struct MemoryModel {
   uint64_t counter = 4, offset = 0, lock = 0, occupancy = 0, tail = 0, previous = 0;  // per pixel
   uint64_t image = 0;                                                   // bytes per image
 
-  static MemoryModel of(const MethodDesc& method);
+  /// `fragmentParallel`: methods without a lock word of their own (fkb, abuffer) need one per
+  /// pixel when fragments of a pixel arrive from several threads (it stands in for the GPU's
+  /// atomic insertion), and it is charged.
+  static MemoryModel of(const MethodDesc& method, bool fragmentParallel = false);
   uint64_t perPixel() const { return counter + offset + lock + occupancy + tail + previous; }
   uint64_t overhead(uint64_t pixels) const { return pixels * perPixel() + image; }
   /// F(M): fragment slots a budget buys (0 when the overhead alone exceeds it).

@@ -13,7 +13,8 @@ namespace mfr {
 
 /// Pixels per degree of visual angle for the FLIP tool's default observer: 0.7 m from a 0.7 m
 /// wide display 3840 pixels across (about 67.02).
-inline constexpr double kFlipDefaultPixelsPerDegree = 0.7 * (3840.0 / 0.7) * (3.14159265358979 / 180.0);
+inline constexpr double kFlipDefaultPixelsPerDegree =
+    0.7 * (3840.0 / 0.7) * (3.14159265358979 / 180.0);
 
 struct FlipResult {
   double mean = 0.0;            // arithmetic mean of errorMap (accumulated in double)

@@ -78,6 +78,9 @@ class RasterFrame {
   int height() const { return height_; }
   size_t pixelCount() const { return static_cast<size_t>(width_) * height_; }
   int threads() const { return threads_; }
+  /// Workers of the tile passes: the requested threads, at most the hardware's (more would only
+  /// queue; the fragment-parallel capture uses the full requested count on its own threads).
+  int arenaThreads() const;
   const Camera& camera() const { return camera_; }
 
   int tileCount() const { return tilesX_ * tilesY_; }

@@ -21,7 +21,7 @@ inline TileRect RasterFrame::tileRect(int tile) const {
 
 template <class Fn>
 void RasterFrame::forEachTile(Fn&& fn) const {
-  tbb::task_arena arena(threads_);
+  tbb::task_arena arena(arenaThreads());
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, tileCount(), 1),
                       [&](const tbb::blocked_range<int>& r) {
