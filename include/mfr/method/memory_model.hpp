@@ -5,14 +5,32 @@
 // image-level overhead S_i are paid. Per-pixel words by component:
 //
 //   counter   4 B  fragments stored so far (also the count pass's counter)    every method
-//   offset    4 B  first slot of the pixel's region (prefix sum)            abuffer, kplus-sb, dynamic
-//   lock      4 B  spin-lock semaphore                                       k+-buffer family
+//   offset    4 B  first slot of the pixel's region (prefix sum)        abuffer, kplus-sb, dynamic, vkb
+//   lock      4 B  spin-lock semaphore                k+-buffer family, vkb; any method captured
+//                  fragment-parallel (it stands in for fkb's / the A-buffer's GPU atomics)
 //   occupancy 12 + 4d B  zn, zf, k-th bucket, 32d-bit bitmap                 +occupancy
 //   tail      20 B  hybrid tail: sum(alpha * rgb) 3 x f32, sum(alpha) f32, count u32   hybrid
 //   previous  1 B  |n.v| of the previous frame's nearest fragment, unorm8    vkb (Fresnel term)
 //   image     4096 B  depth-complexity histogram, 1024 x u32                 kplus-dynamic
 // The variable k-buffer's importance map lives in the offset word (importance, then k(p), then the
 // prefix sum, computed in place), so it costs no extra bytes; the count pass's n(p) is the counter.
+//
+// The node pool, per allocation policy (pixels in tile-major order, 8 B per slot):
+//
+//   fixed k (fkb, kplus-array/heap, zbuffer): every pixel owns k slots at offset p * k
+//     +---------------+---------------+---------------+-----+---------------+
+//     | pixel 0: k    | pixel 1: k    | pixel 2: k    | ... | pixel P-1: k  |   P * k * 8 B
+//     +---------------+---------------+---------------+-----+---------------+
+//   exact (abuffer: k(p) = n(p); kplus-sb / dynamic: k(p) = min(n(p), k); vkb: k(p) = I-based)
+//     +-----+-----------+++-------+-----+     offsets[p] = sum of k(q) for q before p
+//     | p0  | p1        ||| p3    | ... |     (an empty pixel has k(p) = 0 and no slots)
+//     +-----+-----------+++-------+-----+     sum k(p) * 8 B
+//   Per pixel, beside the pool (each a full-screen buffer of 4 B words unless noted):
+//     counter | [offset] | [lock] | [occupancy: zn zf j_k bitmap] | [tail: 5 words] | [prev 1 B]
+//
+// Worked example, 1024 x 1024, M = 20 MiB (20,971,520 B): fkb pays 4 B/pixel -> F = 2,097,152,
+// k = 2; kplus-sb pays 12 B/pixel -> F = 1,048,576; kplus-dynamic also pays the 4 KiB histogram;
+// hybrid compositing adds 20 B/pixel, more than fkb's whole share of such a budget.
 #pragma once
 
 #include <cstdint>
