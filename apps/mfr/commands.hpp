@@ -11,5 +11,6 @@ using Runner = std::function<int()>;
 Runner addRenderCommand(CLI::App& app);
 Runner addInfoCommand(CLI::App& app);
 Runner addMetricsCommand(CLI::App& app);
+Runner addCompareCommand(CLI::App& app);
 
 }  // namespace mfr::cli

@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   const mfr::cli::Runner render = mfr::cli::addRenderCommand(app);
   const mfr::cli::Runner info = mfr::cli::addInfoCommand(app);
   const mfr::cli::Runner metrics = mfr::cli::addMetricsCommand(app);
+  const mfr::cli::Runner compare = mfr::cli::addCompareCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -21,6 +22,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("render")) return render();
     if (app.got_subcommand("info")) return info();
     if (app.got_subcommand("metrics")) return metrics();
+    if (app.got_subcommand("compare")) return compare();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mfr: error: %s\n", e.what());
     return 1;

@@ -1,6 +1,8 @@
 #include "mfr/core/image.hpp"
 
+#include <algorithm>
 #include <filesystem>
+#include <fstream>
 
 #include "mfr/core/color.hpp"
 
@@ -44,6 +46,13 @@ Result<void> writePng(const std::string& path, const Image8& image) {
 
 Result<Image8> readPng(const std::string& path) {
   if (!std::filesystem::exists(path)) return makeError(path + ": no such file");
+  {
+    static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+    unsigned char head[8] = {};
+    std::ifstream file(path, std::ios::binary);
+    if (!file.read(reinterpret_cast<char*>(head), 8) || !std::equal(head, head + 8, kSignature))
+      return makeError(path + ": not a PNG file");
+  }
   int w = 0, h = 0, n = 0;
   if (!stbi_info(path.c_str(), &w, &h, &n)) return makeError(path + ": not a readable image");
   unsigned char* data = stbi_load(path.c_str(), &w, &h, &n, 4);

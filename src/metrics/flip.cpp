@@ -9,20 +9,18 @@
 //     passes whose 1D weights are normalised together so the 2D kernel sums to 1;
 //   - clamp-to-edge borders for every filter, any image size;
 //   - the mean is accumulated in double per row, then over rows in order, so it does not depend on
-//     the thread count (the tool sums in float; the difference is ~1e-6 on large images).
+//     the thread count (the tool sums in float, which moves its printed mean by up to ~2e-5).
 //
 // Pipeline (per image, reference and test alike, then compared):
 //   1. sRGB8 -> linear RGB (IEC 61966-2-1, threshold 0.04045) -> XYZ (D65) -> YCxCz (opponent
-//   space,
-//      normalised by the D65 white).
+//      space, normalised by the D65 white).
 //   2. Colour: each YCxCz channel is filtered by its contrast sensitivity function (a Gaussian
 //      a sqrt(pi / b) exp(-pi^2 x^2 / b) in degrees, sampled at 1 / ppd), back to linear RGB,
 //      clamped to [0, 1], to CIELAB, Hunt-adjusted (a, b scaled by 0.01 L), compared with HyAB
-//      (|dL| +
-//      ||d(a, b)||), raised to qc and remapped to [0, 1] with a knee at (pc cmax, pt).
-//   3. Features: on luminance in [0, 1] ((Y + 16) / 116 of YCxCz), first- and second-derivative-of-
-//      Gaussian filters (sigma = w ppd / 2) give edge and point strengths; the feature difference
-//      is (max(|edge diff|, |point diff|) / sqrt 2)^qf.
+//      (|dL| + |d(a, b)|), raised to qc and remapped to [0, 1] with a knee at (pc cmax, pt).
+//   3. Features: on luminance in [0, 1] ((Y + 16) / 116 of YCxCz), first- and second-derivative-
+//      of-Gaussian filters (sigma = w ppd / 2) give edge and point strengths; the feature
+//      difference is (max(|edge diff|, |point diff|) / sqrt 2)^qf.
 //   4. FLIP = colour difference ^ (1 - feature difference).
 #include "mfr/metrics/flip.hpp"
 
@@ -224,7 +222,7 @@ FeatureFilters makeFeatureFilters(float ppd) {
     f.ddg[i] = ddg;
   }
   // The Gaussian sums to 1; the positive and the negative lobes of each derivative sum to +1 and -1
-  // separately (so a constant image gives exactly no response).
+  // separately (so a constant image gives no response, up to float rounding).
   for (int i = 0; i < n; ++i) {
     f.g[i] = f.g[i] / gSum;
     f.dg[i] = f.dg[i] / (f.dg[i] > 0.0f ? dgPos : dgNeg);
