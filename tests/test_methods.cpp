@@ -411,9 +411,10 @@ Expected expectedAllocation(const std::string& base, const Layout& layout, uint6
   } else if (base == "kplus-sb") {
     e.k = static_cast<uint32_t>(std::max<uint64_t>(1, F / pixels));
     e.slots = sumCapped(n, *e.k);
-  } else {  // kplus-dynamic: the largest k <= 1023 whose exact memory fits
+  } else {  // kplus-dynamic: the largest k <= min(1023, max n(p)) whose exact memory fits
     uint64_t sum = 0, best = 0, bestSlots = 0;
-    for (uint64_t k = 1; k <= 1023; ++k) {
+    const uint64_t maxN = std::max<uint64_t>(1, *std::max_element(n.begin(), n.end()));
+    for (uint64_t k = 1; k <= std::min<uint64_t>(1023, maxN); ++k) {
       for (const uint32_t c : n) sum += c >= k;
       if (sum > F) break;
       best = k;

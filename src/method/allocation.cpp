@@ -92,8 +92,8 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
 
   if (budget && *budget < overhead + kNodeBytes)
     return makeError("budget " + bytesText(*budget) + ": too small for " + name + " at " +
-                     sizeText(frame) + " (its per-pixel buffers alone need " +
-                     bytesText(overhead) + ")");
+                     sizeText(frame) + " (its per-pixel buffers take " + bytesText(overhead) +
+                     ", leaving no room for a fragment)");
   const uint64_t slotsInBudget = budget ? memory.fragmentSlots(*budget, pixels) : UINT64_MAX;
 
   auto sumCapped = [&](uint64_t k) {
@@ -148,8 +148,11 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
         // from high to low; exact because k never exceeds the last bin
         std::vector<uint64_t> histogram(kHistogramBins, 0);
         for (uint32_t c : n) ++histogram[std::min<uint64_t>(c, kHistogramBins - 1)];
-        const uint64_t kLimit = std::min<uint64_t>(method.k.value_or(kHistogramBins - 1),
-                                                   kHistogramBins - 1);
+        // never above the largest n(p): a larger k buys nothing
+        uint64_t maxN = 1;
+        for (uint32_t c : n) maxN = std::max<uint64_t>(maxN, c);
+        const uint64_t kLimit = std::min<uint64_t>(
+            {method.k.value_or(kHistogramBins - 1), kHistogramBins - 1, maxN});
         for (uint64_t candidate = kLimit; candidate >= 1 && k == 0; --candidate) {
           uint64_t need = 0;
           for (uint64_t bin = 1; bin < kHistogramBins; ++bin)

@@ -68,6 +68,7 @@ struct TileRect {
   int x0, y0, x1, y1;  // inclusive
 };
 
+/// A frame refers to the scene's textures: the Scene must outlive the RasterFrame built from it.
 class RasterFrame {
  public:
   /// Validates the size, fits the clip planes to the scene, transforms, clips and bins.

@@ -31,6 +31,21 @@ void RasterFrame::forEachTile(Fn&& fn) const {
 }
 
 namespace detail {
+// Integer quotients for the row spans. A double division gives the quotient to within one (the
+// operands stay below 2^51), an exact integer check fixes it: much cheaper than a 64-bit idiv.
+inline int64_t floorDivPositive(int64_t a, int64_t b) {  // a >= 0, b > 0
+  int64_t q = static_cast<int64_t>(static_cast<double>(a) / static_cast<double>(b));
+  while (q * b > a) --q;
+  while ((q + 1) * b <= a) ++q;
+  return q;
+}
+inline int64_t ceilDivPositive(int64_t a, int64_t b) {  // a > 0, b > 0
+  int64_t q = static_cast<int64_t>(static_cast<double>(a) / static_cast<double>(b));
+  while (q * b < a) ++q;
+  while (q > 0 && (q - 1) * b >= a) --q;
+  return q;
+}
+
 /// Bilinear sample with repeat wrapping; returns linear RGB and alpha.
 inline glm::vec4 sampleTexture(const Texture& tex, glm::vec2 uv) {
   const ColorTables& t = ColorTables::get();
@@ -123,27 +138,36 @@ inline void RasterFrame::rasterizeRect(const TriangleSetup& t, int x0, int y0, i
   f.rgba = 0;
   f.ndotv = 0.0f;
   for (int y = y0; y <= y1; ++y) {
-    int64_t w0 = row[0], w1 = row[1], w2 = row[2];
-    const uint32_t rowPixel = static_cast<uint32_t>(y) * static_cast<uint32_t>(width_);
-    for (int x = x0; x <= x1; ++x) {
-      if ((w0 | w1 | w2) >= 0) {
-        const float l1 = static_cast<float>(w1 - bias[1]) * t.invArea;
-        const float l2 = static_cast<float>(w2 - bias[2]) * t.invArea;
-        const float l0 = 1.0f - l1 - l2;
-        glm::vec4 base;
-        if (surface<Mode>(t, material, l0, l1, l2, base)) {
-          const float z = t.z[0] + l1 * dz1 + l2 * dz2;
-          f.depth = z > 0.0f ? (z < 1.0f ? z : 1.0f) : 0.0f;
-          f.pixel = rowPixel + static_cast<uint32_t>(x);
-          if (sink.accept(f.pixel, f.depth)) {
-            if constexpr (Mode == ShadeMode::Full) shade(t, l0, l1, l2, x, y, base, f);
-            sink.emit(f);
-          }
-        }
+    // the span of this row where all three edge functions are >= 0 (exact integer bounds; an
+    // edge that is non-negative at both ends of the row cannot cut it, by linearity), so thin
+    // triangles cost their pixels, not their bounding boxes
+    int xs = x0, xe = x1;
+    for (int i = 0; i < 3 && xs <= xe; ++i) {
+      const int64_t r = row[i], st = stepX[i];
+      if (r >= 0 && r + st * (x1 - x0) >= 0) continue;
+      if (st > 0) {  // r < 0 here: the first x with w >= 0
+        xs = static_cast<int>(std::max<int64_t>(xs, x0 + detail::ceilDivPositive(-r, st)));
+      } else if (st < 0 && r >= 0) {  // the last x with w >= 0
+        xe = static_cast<int>(std::min<int64_t>(xe, x0 + detail::floorDivPositive(r, -st)));
+      } else {
+        xe = xs - 1;  // st <= 0 and r < 0: nothing on this row
       }
-      w0 += stepX[0];
-      w1 += stepX[1];
-      w2 += stepX[2];
+    }
+    const int64_t skip = xs - x0;
+    int64_t w1 = row[1] + skip * stepX[1], w2 = row[2] + skip * stepX[2];
+    const uint32_t rowPixel = static_cast<uint32_t>(y) * static_cast<uint32_t>(width_);
+    for (int x = xs; x <= xe; ++x, w1 += stepX[1], w2 += stepX[2]) {
+      const float l1 = static_cast<float>(w1 - bias[1]) * t.invArea;
+      const float l2 = static_cast<float>(w2 - bias[2]) * t.invArea;
+      const float l0 = 1.0f - l1 - l2;
+      glm::vec4 base;
+      if (!surface<Mode>(t, material, l0, l1, l2, base)) continue;  // alpha test
+      const float z = t.z[0] + l1 * dz1 + l2 * dz2;
+      f.depth = z > 0.0f ? (z < 1.0f ? z : 1.0f) : 0.0f;
+      f.pixel = rowPixel + static_cast<uint32_t>(x);
+      if (!sink.accept(f.pixel, f.depth)) continue;  // early test before shading
+      if constexpr (Mode == ShadeMode::Full) shade(t, l0, l1, l2, x, y, base, f);
+      sink.emit(f);
     }
     row[0] += stepY[0];
     row[1] += stepY[1];

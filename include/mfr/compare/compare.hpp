@@ -1,0 +1,115 @@
+// Side-by-side comparison of methods under memory budgets against the exact A-buffer: renders the
+// ground truth once, then every method at every budget, and measures each image against the
+// ground truth (MSE and PSNR on linear and on sRGB values, mean LDR-FLIP) together with the run's
+// memory, fragment and timing statistics. Everything needed to write the images, results.json,
+// results.csv and the HTML report is returned; nothing is printed or written here.
+//
+// Metrics are computed on the sRGB8 images exactly as they are written to PNG, so recomputing them
+// from the files with the metrics API gives the same numbers.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mfr/core/image.hpp"
+#include "mfr/core/result.hpp"
+#include "mfr/method/method.hpp"
+#include "mfr/method/render.hpp"
+#include "mfr/metrics/flip.hpp"
+#include "mfr/raster/raster_frame.hpp"
+
+namespace mfr {
+
+struct CompareOptions {
+  std::vector<std::string> methods;  // preset names (methodPreset), at least one, no duplicates
+  std::vector<uint64_t> budgets;  // bytes, at least one, no duplicates; budgets[0] is "the" budget
+  Compositing compositing = Compositing::KBuffer;  // of the bounded methods (ground truth: exact)
+  CaptureMode capture = CaptureMode::TileOwned;
+  glm::vec3 background{1.0f};  // linear RGB
+  std::string scene;           // the scene's name or source, for the results
+  double flipPixelsPerDegree = kFlipDefaultPixelsPerDegree;
+  /// Importance methods (vkb, vkb-fill): seed of the noise term (Eq. 6).
+  uint64_t seed = 1;
+  /// Called before each step: (what, steps done, steps in all). May be empty.
+  std::function<void(const std::string& stage, int done, int total)> progress;
+};
+
+/// Error of one image against the ground truth (both sRGB8 as written).
+struct CompareMetrics {
+  double mseLinear = 0.0;   // on decoded linear-light values in [0, 1]
+  double mseSrgb = 0.0;     // on sRGB code / 255
+  double psnrLinear = 0.0;  // dB, peak 1; +infinity when the MSE is 0
+  double psnrSrgb = 0.0;
+  double flipMean = 0.0;  // mean LDR-FLIP
+};
+
+/// One method at one budget (or the ground truth).
+struct CompareRun {
+  std::string method;                   // preset name
+  std::optional<uint64_t> budgetBytes;  // none for the ground truth
+  std::optional<std::string> error;     // the render failed (e.g. budget too small): no data below
+  RenderStats stats;
+  uint64_t budgetSlots = 0;  // F(M) of the method's memory model (0 without a budget)
+  CompareMetrics metrics;
+  // images (sRGB8, as written), file names relative to the output folder
+  Image8 image, flipMap, kMap, importanceMap;  // importanceMap: importance methods only
+  std::string imageFile, flipFile, kMapFile, importanceFile;
+
+  bool ok() const { return !error; }
+  /// captured / F(M); captured / allocated slots when there is no budget.
+  double memoryUtilisation() const;
+};
+
+struct CompareBudget {
+  uint64_t budgetBytes = 0;
+  std::string label;             // "20MB", "400KB", "1000B"
+  std::vector<CompareRun> runs;  // in CompareOptions::methods order
+};
+
+struct CompareResult {
+  std::string scene;
+  int width = 0, height = 0;
+  Compositing compositing = Compositing::KBuffer;
+  CaptureMode capture = CaptureMode::TileOwned;
+  double flipPixelsPerDegree = kFlipDefaultPixelsPerDegree;
+  CompareRun groundTruth;     // abuffer, no budget, metrics against itself (all 0, PSNR infinite)
+  Image8 depthComplexityMap;  // colour-mapped n(p) with legend
+  std::string depthComplexityFile;
+  float kMapScale = 1.0f;              // the k-maps share one colour scale, 0 .. kMapScale
+  std::vector<CompareBudget> budgets;  // in CompareOptions::budgets order
+};
+
+/// Renders the ground truth and every method at every budget. Errors: an empty method or budget
+/// list, an unknown or duplicated method, a duplicated or zero budget, or a failed ground truth.
+/// A method failing at a budget is not an error: its run carries the message.
+Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptions& options);
+
+/// "20MB" for whole MiB, "400KB" for whole KiB, else "12345B" (file-name safe).
+std::string budgetLabel(uint64_t bytes);
+
+/// results.json: scene, width, height, compositing, capture, flip_pixels_per_degree,
+/// budget_bytes (the first budget), ground_truth {name, image, depth_complexity_image, ...stats},
+/// methods (the first budget's runs), budgets [{budget_bytes, budget_label, methods}], and each
+/// run's keys (see README, "mfr compare"). `mfrVersion` is recorded as mfr_version when not empty.
+nlohmann::json compareToJson(const CompareResult& result, const std::string& mfrVersion = "");
+
+/// results.csv: a header and one row per run (ground truth first), budgets in order.
+std::string compareToCsv(const CompareResult& result);
+
+struct ReportInfo {
+  std::string mfrVersion;   // "mfr 0.1.0"
+  std::string commandLine;  // as typed, shown verbatim
+  std::string generated;    // optional date/time text
+};
+
+/// The self-contained HTML page (inline CSS, inline SVG plots, no scripts) that shows the results
+/// table, the images next to it (referenced by their relative file names) and, with several
+/// budgets, error vs budget plots.
+std::string compareReportHtml(const CompareResult& result, const ReportInfo& info);
+
+}  // namespace mfr

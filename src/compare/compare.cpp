@@ -1,0 +1,321 @@
+// mfr compare: the ground truth and every method at every budget, with image metrics, and the
+// results as JSON and CSV (the HTML page is in report_html.cpp).
+#include "mfr/compare/compare.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <sstream>
+
+#include "mfr/core/colormap.hpp"
+#include "mfr/method/memory_model.hpp"
+#include "mfr/method/stats_json.hpp"
+#include "mfr/metrics/image_metrics.hpp"
+
+namespace mfr {
+namespace {
+
+// file-name safe form of a method name ("fkb+occupancy" -> "fkb-occupancy")
+std::string fileStem(const std::string& name) {
+  std::string s = name;
+  for (char& c : s) {
+    const bool safe = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '-' || c == '_' || c == '.';
+    if (!safe) c = '-';
+  }
+  return s;
+}
+
+Image8 colourMap(const std::vector<float>& values, int w, int h, float maxValue,
+                 const std::string& title) {
+  return colorMapWithLegend(values, w, h, std::max(maxValue, 1e-6f), title);
+}
+
+template <class T>
+float maxOf(const std::vector<T>& values) {
+  float m = 0.0f;
+  for (const T& v : values) m = std::max(m, static_cast<float>(v));
+  return m;
+}
+
+nlohmann::json finiteOrNull(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+}
+
+const char* captureName(CaptureMode c) {
+  return c == CaptureMode::TileOwned ? "tile" : "parallel";
+}
+
+nlohmann::json runToJson(const CompareRun& run, Compositing compositing) {
+  nlohmann::json j;
+  j["name"] = run.method;
+  j["budget_bytes"] = run.budgetBytes ? nlohmann::json(*run.budgetBytes) : nlohmann::json(nullptr);
+  j["compositing"] = toString(compositing);
+  if (run.error) {
+    j["error"] = *run.error;
+    return j;
+  }
+  nlohmann::json stats = statsToJson(run.stats);
+  stats.erase("method");
+  stats.erase("budget_bytes");
+  j.update(stats);
+  j["image"] = run.imageFile;
+  if (!run.flipFile.empty()) j["flip_image"] = run.flipFile;
+  if (!run.kMapFile.empty()) j["k_map_image"] = run.kMapFile;
+  if (!run.importanceFile.empty()) j["importance_image"] = run.importanceFile;
+  j["fm_slots"] = run.budgetBytes ? nlohmann::json(run.budgetSlots) : nlohmann::json(nullptr);
+  j["memory_utilisation"] = run.memoryUtilisation();
+  const CompareMetrics& m = run.metrics;
+  j["mse"] = m.mseLinear;
+  j["psnr"] = finiteOrNull(m.psnrLinear);
+  j["mse_linear"] = m.mseLinear;
+  j["psnr_linear"] = finiteOrNull(m.psnrLinear);
+  j["mse_srgb"] = m.mseSrgb;
+  j["psnr_srgb"] = finiteOrNull(m.psnrSrgb);
+  j["flip_mean"] = m.flipMean;
+  return j;
+}
+
+std::string csvField(const std::string& s) {
+  if (s.find_first_of(",\"\n\r") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"') q += '"';
+    q += c;
+  }
+  q += '"';
+  return q;
+}
+
+std::string number(double v, const char* format = "%.9g") {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, format, v);
+  return buffer;
+}
+
+}  // namespace
+
+double CompareRun::memoryUtilisation() const {
+  const uint64_t slots = budgetBytes ? budgetSlots : stats.fragmentSlots;
+  return slots ? static_cast<double>(stats.captured) / static_cast<double>(slots) : 0.0;
+}
+
+std::string budgetLabel(uint64_t bytes) {
+  std::string s;
+  if (bytes > 0 && bytes % (1ull << 20) == 0) {
+    s = std::to_string(bytes >> 20);
+    s += "MB";
+  } else if (bytes > 0 && bytes % (1ull << 10) == 0) {
+    s = std::to_string(bytes >> 10);
+    s += "KB";
+  } else {
+    s = std::to_string(bytes);
+    s += "B";
+  }
+  return s;
+}
+
+Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptions& options) {
+  if (options.methods.empty()) return makeError("--methods: the method list is empty");
+  if (options.budgets.empty()) return makeError("--budget: no budget given");
+  std::vector<MethodDesc> methods;
+  std::set<std::string> seenMethods;
+  for (const std::string& name : options.methods) {
+    auto preset = methodPreset(name);
+    if (!preset) return preset.error();
+    if (!seenMethods.insert(name).second) return makeError("method '" + name + "': listed twice");
+    MethodDesc m = preset.value();
+    m.compositing = options.compositing;
+    m.importance.seed = options.seed;
+    methods.push_back(m);
+  }
+  std::set<uint64_t> seenBudgets;
+  for (uint64_t b : options.budgets) {
+    if (b == 0) return makeError("budget 0 B: must be at least 1 byte");
+    if (!seenBudgets.insert(b).second)
+      return makeError("budget " + budgetLabel(b) + ": listed twice");
+  }
+  if (!(options.flipPixelsPerDegree > 0.0 && std::isfinite(options.flipPixelsPerDegree)))
+    return makeError("FLIP pixels per degree: must be finite and positive");
+
+  const int w = frame.width(), h = frame.height();
+  const uint64_t pixels = frame.pixelCount();
+  const int totalSteps = 1 + static_cast<int>(methods.size() * options.budgets.size());
+  int step = 0;
+  const auto progress = [&](const std::string& stage) {
+    if (options.progress) options.progress(stage, step, totalSteps);
+  };
+
+  CompareResult result;
+  result.scene = options.scene;
+  result.width = w;
+  result.height = h;
+  result.compositing = options.compositing;
+  result.capture = options.capture;
+  result.flipPixelsPerDegree = options.flipPixelsPerDegree;
+
+  RenderOptions renderOptions;
+  renderOptions.capture = options.capture;
+  renderOptions.background = options.background;
+
+  // ground truth: the exact A-buffer, every fragment, sorted and composited
+  progress("rendering the ground truth (abuffer)");
+  auto abuffer = methodPreset("abuffer");
+  if (!abuffer) return abuffer.error();
+  auto truth = render(frame, abuffer.value(), renderOptions);
+  if (!truth) return makeError("ground truth (abuffer): " + truth.error().message);
+  ++step;
+  CompareRun& gt = result.groundTruth;
+  gt.method = "abuffer";
+  gt.stats = std::move(truth->stats);
+  gt.image = encodeSrgb(truth->image);
+  gt.imageFile = "ground_truth.png";
+  gt.metrics.psnrLinear = gt.metrics.psnrSrgb = psnrFromMse(0.0);
+  result.depthComplexityMap =
+      colourMap(std::vector<float>(truth->depthComplexity.begin(), truth->depthComplexity.end()), w,
+                h, std::max(1.0f, maxOf(truth->depthComplexity)), "n(p)");
+  result.depthComplexityFile = "ground_truth_depth_complexity.png";
+  truth = Error{};  // release the frame-sized buffers
+
+  std::vector<std::vector<uint32_t>> kMaps;  // per run, colour-mapped at the end (shared scale)
+  float kScale = 1.0f;
+  for (uint64_t budget : options.budgets) {
+    CompareBudget& cb = result.budgets.emplace_back();
+    cb.budgetBytes = budget;
+    cb.label = budgetLabel(budget);
+    for (const MethodDesc& method : methods) {
+      CompareRun& run = cb.runs.emplace_back();
+      run.method = method.name;
+      run.budgetBytes = budget;
+      run.budgetSlots = MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel)
+                            .fragmentSlots(budget, pixels);
+      progress("rendering " + method.name + " at " + cb.label);
+      RenderOptions ro = renderOptions;
+      ro.budgetBytes = budget;
+      auto out = render(frame, method, ro);
+      if (!out) {
+        run.error = out.error().message;
+        kMaps.emplace_back();
+        ++step;
+        continue;
+      }
+      run.stats = std::move(out->stats);
+      run.image = encodeSrgb(out->image);
+      progress("measuring " + method.name + " at " + cb.label);
+      auto errors = compareImages(gt.image, run.image);
+      if (!errors) return errors.error();
+      auto flip = computeFlip(gt.image, run.image, options.flipPixelsPerDegree);
+      if (!flip) return flip.error();
+      run.metrics.mseLinear = errors->mseLinear;
+      run.metrics.mseSrgb = errors->mseSrgb;
+      run.metrics.psnrLinear = errors->psnrLinear;
+      run.metrics.psnrSrgb = errors->psnrSrgb;
+      run.metrics.flipMean = flip->mean;
+      run.flipMap = flipErrorImage(*flip);
+      const std::string stem = fileStem(method.name) + "_" + cb.label;
+      run.imageFile = stem + ".png";
+      run.flipFile = stem + "_flip.png";
+      run.kMapFile = stem + "_kmap.png";
+      if (!out->importance.importance.empty()) {
+        run.importanceMap =
+            colourMap(out->importance.importance, w, h, maxOf(out->importance.importance), "I(p)");
+        run.importanceFile = stem + "_importance.png";
+      }
+      kScale = std::max(kScale, static_cast<float>(run.stats.kMax));
+      kMaps.push_back(std::move(out->kMap));
+      ++step;
+    }
+  }
+  result.kMapScale = kScale;
+  size_t index = 0;
+  for (CompareBudget& cb : result.budgets)
+    for (CompareRun& run : cb.runs) {
+      const std::vector<uint32_t>& k = kMaps[index++];
+      if (!run.ok()) continue;
+      run.kMap = colourMap(std::vector<float>(k.begin(), k.end()), w, h, kScale, "k(p)");
+    }
+  if (options.progress) options.progress("done", totalSteps, totalSteps);
+  return result;
+}
+
+nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersion) {
+  nlohmann::json j;
+  if (!mfrVersion.empty()) j["mfr_version"] = mfrVersion;
+  j["scene"] = r.scene;
+  j["width"] = r.width;
+  j["height"] = r.height;
+  j["compositing"] = toString(r.compositing);
+  j["capture"] = captureName(r.capture);
+  j["flip_pixels_per_degree"] = r.flipPixelsPerDegree;
+  j["budget_bytes"] =
+      r.budgets.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.budgets[0].budgetBytes);
+  nlohmann::json gt = runToJson(r.groundTruth, Compositing::KBuffer);
+  gt["depth_complexity_image"] = r.depthComplexityFile;
+  j["ground_truth"] = gt;
+  j["k_map_scale"] = r.kMapScale;
+  nlohmann::json budgets = nlohmann::json::array();
+  for (const CompareBudget& cb : r.budgets) {
+    nlohmann::json runs = nlohmann::json::array();
+    for (const CompareRun& run : cb.runs) runs.push_back(runToJson(run, r.compositing));
+    budgets.push_back(
+        {{"budget_bytes", cb.budgetBytes}, {"budget_label", cb.label}, {"methods", runs}});
+  }
+  j["methods"] = budgets.empty() ? nlohmann::json::array() : budgets[0]["methods"];
+  j["budgets"] = budgets;
+  return j;
+}
+
+std::string compareToCsv(const CompareResult& r) {
+  // pass columns: the union of the runs' pass names, in order of first appearance
+  std::vector<std::string> passes;
+  const auto addPasses = [&](const CompareRun& run) {
+    for (const PassTime& p : run.stats.passes)
+      if (std::find(passes.begin(), passes.end(), p.name) == passes.end()) passes.push_back(p.name);
+  };
+  addPasses(r.groundTruth);
+  for (const CompareBudget& cb : r.budgets)
+    for (const CompareRun& run : cb.runs) addPasses(run);
+
+  std::ostringstream csv;
+  csv << "budget_bytes,method,compositing,status,image,bytes_used,fm_slots,fragment_slots,"
+         "memory_utilisation,k_min,k_max,fragments_generated,fragments_captured,fragments_lost,"
+         "fragments_lost_percent,mse,psnr,mse_linear,psnr_linear,mse_srgb,psnr_srgb,flip_mean,"
+         "total_ms";
+  for (const std::string& p : passes) csv << ",time_" << p << "_ms";
+  csv << ",error\n";
+  const auto row = [&](const CompareRun& run, Compositing compositing) {
+    csv << (run.budgetBytes ? std::to_string(*run.budgetBytes) : std::string()) << ','
+        << csvField(run.method) << ',' << toString(compositing) << ',';
+    if (run.error) {
+      csv << "error";
+      for (size_t i = 0; i < 20 + passes.size(); ++i) csv << ',';
+      csv << csvField(*run.error) << "\n";
+      return;
+    }
+    const RenderStats& s = run.stats;
+    const CompareMetrics& m = run.metrics;
+    csv << "ok," << csvField(run.imageFile) << ',' << s.bytesUsed << ','
+        << (run.budgetBytes ? std::to_string(run.budgetSlots) : std::string()) << ','
+        << s.fragmentSlots << ',' << number(run.memoryUtilisation()) << ',' << s.kMin << ','
+        << s.kMax << ',' << s.fragmentsGenerated << ',' << s.captured << ',' << s.lost << ','
+        << number(s.lostPercent()) << ',' << number(m.mseLinear) << ',' << number(m.psnrLinear)
+        << ',' << number(m.mseLinear) << ',' << number(m.psnrLinear) << ',' << number(m.mseSrgb)
+        << ',' << number(m.psnrSrgb) << ',' << number(m.flipMean) << ','
+        << number(s.totalMs(), "%.3f");
+    for (const std::string& p : passes) {
+      csv << ',';
+      for (const PassTime& t : s.passes)
+        if (t.name == p) csv << number(t.ms, "%.3f");
+    }
+    csv << ",\n";
+  };
+  row(r.groundTruth, Compositing::KBuffer);
+  for (const CompareBudget& cb : r.budgets)
+    for (const CompareRun& run : cb.runs) row(run, r.compositing);
+  return csv.str();
+}
+
+}  // namespace mfr
