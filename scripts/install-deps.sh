@@ -16,6 +16,7 @@ packages=(
   libgtest-dev libgmock-dev
   libbenchmark-dev
   gnuplot-nox           # benchmark plots (scripts/bench.sh)
+  chromium              # the mfr compare report in headless Chromium (tests/report_chromium_test.sh)
 )
 
 missing=()

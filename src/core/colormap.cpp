@@ -84,7 +84,7 @@ std::string label(float v) {
 
 Image8 colorMapWithLegend(const std::vector<float>& values, int width, int height, float maxValue,
                           const std::string& title, Colormap map) {
-  const int scale = std::max(2, width / 384);
+  const int scale = std::max(1, width / 384);
   const int legendHeight = 40 * scale;
   Image8 img;
   img.width = width;
@@ -97,8 +97,10 @@ Image8 colorMapWithLegend(const std::vector<float>& values, int width, int heigh
   // legend: title on the left, gradient bar, labels at min / mid / max
   const glm::vec3 ink(0.1f);
   const int barY = height + 4 * scale, barH = 10 * scale;
-  const int titleW = textWidth(title, scale) + 8 * scale;
-  drawText(img, 4 * scale, barY + scale, title, scale, ink);
+  // the title goes left of the bar when there is room for both
+  const bool showTitle = textWidth(title, scale) + 8 * scale < width / 2;
+  const int titleW = showTitle ? textWidth(title, scale) + 8 * scale : 0;
+  if (showTitle) drawText(img, 4 * scale, barY + scale, title, scale, ink);
   const int barX0 = std::min(width - 1, titleW + 4 * scale);
   const int barX1 = std::max(barX0 + 1, width - 24 * scale);
   for (int x = barX0; x < barX1; ++x) {

@@ -1,0 +1,256 @@
+// mfr compare: the ground truth and several methods at several budgets, written as images,
+// results.json, results.csv and a self-contained report.html (the work is in the library:
+// mfr/compare/compare.hpp).
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <set>
+#include <sstream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "mfr/compare/compare.hpp"
+#include "mfr/core/units.hpp"
+
+namespace mfr::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CompareArgs {
+  SceneOptions scene;
+  std::string budgets;
+  std::string methods = "fkb,kplus-dynamic,vkb,vkb-fill";
+  std::string out;
+  std::string composite = "kbuffer";
+  std::string capture = "tile";
+  double pixelsPerDegree = kFlipDefaultPixelsPerDegree;
+};
+
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> items;
+  std::string item;
+  std::istringstream in(text);
+  while (std::getline(in, item, ',')) {
+    const size_t b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
+    items.push_back(b == std::string::npos ? std::string() : item.substr(b, e - b + 1));
+  }
+  return items;
+}
+
+// The command line as typed (from /proc/self/cmdline), shell-quoted where needed.
+std::string commandLine() {
+  std::ifstream f("/proc/self/cmdline", std::ios::binary);
+  std::string raw((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+  std::string line;
+  size_t start = 0;
+  while (start < raw.size()) {
+    size_t end = raw.find('\0', start);
+    if (end == std::string::npos) end = raw.size();
+    const std::string arg = raw.substr(start, end - start);
+    start = end + 1;
+    if (!line.empty()) line += ' ';
+    const bool plain = !arg.empty() && arg.find_first_not_of(
+                                           "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                           "0123456789-_./:,=+@%") == std::string::npos;
+    if (plain) {
+      line += arg;
+    } else {
+      line += '\'';
+      for (char c : arg) {
+        if (c == '\'')
+          line += "'\\''";
+        else
+          line += c;
+      }
+      line += '\'';
+    }
+  }
+  return line.empty() ? std::string("mfr compare") : line;
+}
+
+std::string utcNow() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buffer[64];
+  std::strftime(buffer, sizeof buffer, "%Y-%m-%d %H:%M:%S UTC", &tm);
+  return buffer;
+}
+
+Result<void> writeText(const fs::path& path, const std::string& text) {
+  std::ofstream f(path, std::ios::binary);
+  if (!f) return makeError(path.string() + ": cannot write");
+  f << text;
+  f.close();
+  if (!f) return makeError(path.string() + ": write failed");
+  return {};
+}
+
+std::string psnrCell(double psnr) {
+  if (!std::isfinite(psnr)) return "inf";
+  char buffer[32];
+  std::snprintf(buffer, sizeof buffer, "%.2f", psnr);
+  return buffer;
+}
+
+void printSummary(const CompareResult& r) {
+  std::fprintf(stderr, "%s %dx%d, ground truth: %llu fragments, %s, %.1f ms\n", r.scene.c_str(),
+               r.width, r.height,
+               static_cast<unsigned long long>(r.groundTruth.stats.fragmentsGenerated),
+               formatBytes(r.groundTruth.stats.bytesUsed).c_str(), r.groundTruth.stats.totalMs());
+  std::fprintf(stderr, "  %-20s %8s %11s %9s %7s %10s %9s %10s %8s %9s\n", "method", "budget",
+               "used", "k", "lost%", "mse_lin", "psnr_lin", "psnr_srgb", "flip", "ms");
+  for (const CompareBudget& cb : r.budgets)
+    for (const CompareRun& run : cb.runs) {
+      if (!run.ok()) {
+        std::fprintf(stderr, "  %-20s %8s  failed: %s\n", run.method.c_str(), cb.label.c_str(),
+                     run.error->c_str());
+        continue;
+      }
+      const RenderStats& s = run.stats;
+      char k[32];
+      std::snprintf(k, sizeof k, "%u-%u", s.kMin, s.kMax);
+      std::fprintf(stderr, "  %-20s %8s %11s %9s %7.2f %10.3e %9s %10s %8.4f %9.1f\n",
+                   run.method.c_str(), cb.label.c_str(), formatBytes(s.bytesUsed).c_str(), k,
+                   s.lostPercent(), run.metrics.mseLinear, psnrCell(run.metrics.psnrLinear).c_str(),
+                   psnrCell(run.metrics.psnrSrgb).c_str(), run.metrics.flipMean, s.totalMs());
+    }
+}
+
+int run(const CompareArgs& a, const std::string& version) {
+  if (a.scene.orbit != 0) return fail("--orbit: compare renders one view (use --camera or --view)");
+  if (a.out.empty()) return fail("--out: an output folder is required");
+  CompareOptions options;
+  options.scene = a.scene.source;
+  options.seed = a.scene.seed;
+  options.flipPixelsPerDegree = a.pixelsPerDegree;
+  if (!(a.pixelsPerDegree > 0.0 && std::isfinite(a.pixelsPerDegree)))
+    return fail("--ppd: must be a positive number");
+
+  // methods
+  for (const std::string& name : splitList(a.methods)) {
+    if (name.empty()) return fail("--methods '" + a.methods + "': empty method name in the list");
+    auto preset = methodPreset(name);
+    if (!preset) return fail("--methods: " + preset.error().message);
+    for (const std::string& seen : options.methods)
+      if (seen == name) return fail("--methods: method '" + name + "' listed twice");
+    options.methods.push_back(name);
+  }
+  if (options.methods.empty()) return fail("--methods: the method list is empty");
+  // budgets
+  for (const std::string& text : splitList(a.budgets)) {
+    if (text.empty()) return fail("--budget '" + a.budgets + "': empty budget in the list");
+    auto bytes = parseByteSize(text);
+    if (!bytes) return fail("--budget: " + bytes.error().message);
+    for (uint64_t seen : options.budgets)
+      if (seen == bytes.value()) return fail("--budget '" + text + "': listed twice");
+    options.budgets.push_back(bytes.value());
+  }
+  if (options.budgets.empty()) return fail("--budget: no budget given (e.g. --budget 20MB,40MB)");
+  auto compositing = parseCompositing(a.composite);
+  if (!compositing) return fail("--composite: " + compositing.error().message);
+  options.compositing = compositing.value();
+  if (a.capture == "parallel")
+    options.capture = CaptureMode::FragmentParallel;
+  else if (a.capture != "tile")
+    return fail("--capture '" + a.capture + "': expected tile or parallel");
+
+  // output folder: created and probed before any work
+  const fs::path dir(a.out);
+  {
+    std::error_code ec;
+    fs::create_directories(dir, ec);
+    if (ec || !fs::is_directory(dir))
+      return fail(a.out + ": cannot create the output folder" +
+                  (ec ? " (" + ec.message() + ")" : std::string(" (not a directory)")));
+    const fs::path probe = dir / ".mfr_compare_write_test";
+    if (!std::ofstream(probe)) return fail(a.out + ": output folder is not writable");
+    fs::remove(probe, ec);
+  }
+
+  Progress progress(!a.scene.quiet);
+  progress.set("loading " + a.scene.source);
+  auto prepared = prepareScene(a.scene);
+  if (!prepared) return fail(prepared.error().message);
+  options.background = prepared->scene.background;
+  RasterOptions ro;
+  ro.width = a.scene.width;
+  ro.height = a.scene.height;
+  ro.threads = a.scene.threads;
+  progress.set("setting up " + a.scene.source);
+  auto frame = RasterFrame::build(prepared->scene, prepared->cameras.front(), ro);
+  if (!frame) return fail(a.scene.source + ": " + frame.error().message);
+  options.progress = [&progress](const std::string& stage, int done, int total) {
+    progress.set(stage, done, total);
+  };
+  auto result = runComparison(frame.value(), options);
+  if (!result) return fail(a.scene.source + ": " + result.error().message);
+  const CompareResult& r = result.value();
+
+  // files
+  progress.set("writing " + a.out);
+  const auto png = [&](const std::string& file, const Image8& image) -> Result<void> {
+    if (file.empty()) return {};
+    return writePng((dir / file).string(), image);
+  };
+  std::vector<Result<void>> written;
+  written.push_back(png(r.groundTruth.imageFile, r.groundTruth.image));
+  written.push_back(png(r.depthComplexityFile, r.depthComplexityMap));
+  for (const CompareBudget& cb : r.budgets)
+    for (const CompareRun& run : cb.runs) {
+      if (!run.ok()) continue;
+      written.push_back(png(run.imageFile, run.image));
+      written.push_back(png(run.flipFile, run.flipMap));
+      written.push_back(png(run.kMapFile, run.kMap));
+      written.push_back(png(run.importanceFile, run.importanceMap));
+    }
+  std::string versionNumber = version;
+  if (versionNumber.rfind("mfr ", 0) == 0) versionNumber.erase(0, 4);
+  const nlohmann::json json = compareToJson(r, versionNumber);
+  const std::string jsonText = json.dump(2) + "\n";
+  written.push_back(writeText(dir / "results.json", jsonText));
+  written.push_back(writeText(dir / "results.csv", compareToCsv(r)));
+  ReportInfo info;
+  info.mfrVersion = version.empty() ? "mfr" : version;
+  info.commandLine = commandLine();
+  info.generated = utcNow();
+  written.push_back(writeText(dir / "report.html", compareReportHtml(r, info)));
+  for (const Result<void>& w : written)
+    if (!w) return fail(w.error().message);
+  progress.clear();
+
+  if (!a.scene.quiet) {
+    printSummary(r);
+    std::fprintf(stderr, "report: %s\n", (dir / "report.html").string().c_str());
+  }
+  if (a.scene.json) std::fputs(jsonText.c_str(), stdout);
+  return 0;
+}
+
+}  // namespace
+
+Runner addCompareCommand(CLI::App& app) {
+  auto args = std::make_shared<CompareArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "compare",
+      "Render the ground truth and several methods at several budgets; write images, metrics "
+      "(results.json, results.csv) and an HTML report");
+  args->scene.add(*cmd);
+  cmd->add_option("--budget,--budgets,-M", args->budgets,
+                  "Memory budgets, comma-separated, e.g. 20MB,40MB (MB = 2^20 bytes)")
+      ->required();
+  cmd->add_option("--methods,-m", args->methods,
+                  "Methods, comma-separated (default fkb,kplus-dynamic,vkb,vkb-fill)");
+  cmd->add_option("--out,-o", args->out, "Output folder (created if missing)")->required();
+  cmd->add_option("--composite", args->composite, "kbuffer or hybrid (the bounded methods)");
+  cmd->add_option("--capture", args->capture, "tile (default) or parallel");
+  cmd->add_option("--ppd", args->pixelsPerDegree, "FLIP pixels per degree (default 67.02)");
+  const CLI::App* root = &app;
+  return [args, root] { return run(*args, root->version()); };
+}
+
+}  // namespace mfr::cli

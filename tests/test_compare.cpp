@@ -1,0 +1,587 @@
+// mfr compare: the library comparison (runs, budgets, metrics against the ground truth, failures
+// recorded per run), its JSON / CSV / HTML, and the command line end to end (files, results.json
+// layout, metrics recomputed from the written PNGs, bad input).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "mfr/compare/compare.hpp"
+#include "mfr/metrics/flip.hpp"
+#include "mfr/metrics/image_metrics.hpp"
+#include "mfr/scene/camera.hpp"
+#include "mfr/scene/load.hpp"
+#include "mfr/scene/scene.hpp"
+
+namespace mfr {
+namespace {
+
+namespace fs = std::filesystem;
+
+// 200 strands at 96x96: ~32k fragments, depth complexity ~25; the exact A-buffer needs ~320 KiB,
+// so it fails at 200 KiB and fits at 400 KiB.
+const char* kScene = "procedural:hairball?strands=200";
+constexpr int kSize = 96;
+constexpr uint64_t kSmall = 200u << 10, kLarge = 400u << 10;
+const std::vector<std::string> kMethods = {"fkb", "kplus-dynamic", "vkb", "vkb-fill", "abuffer"};
+
+// ---- library -------------------------------------------------------------------------------
+
+RasterFrame makeFrame() {
+  auto scene = loadScene(kScene);
+  EXPECT_TRUE(scene.ok());
+  RasterOptions ro;
+  ro.width = ro.height = kSize;
+  ro.threads = 2;
+  const Camera camera =
+      scene->defaultCamera ? *scene->defaultCamera : frameBounds(sceneBounds(scene.value()));
+  auto frame = RasterFrame::build(scene.value(), camera, ro);
+  EXPECT_TRUE(frame.ok());
+  return std::move(frame.value());
+}
+
+CompareOptions defaultOptions() {
+  CompareOptions o;
+  o.methods = kMethods;
+  o.budgets = {kSmall, kLarge};
+  o.scene = kScene;
+  return o;
+}
+
+class CompareLibrary : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    frame_ = new RasterFrame(makeFrame());
+    int calls = 0, lastDone = -1, lastTotal = -1;
+    CompareOptions o = defaultOptions();
+    o.progress = [&](const std::string&, int done, int total) {
+      ++calls;
+      lastDone = done;
+      lastTotal = total;
+    };
+    auto r = runComparison(*frame_, o);
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    result_ = new CompareResult(std::move(r.value()));
+    EXPECT_GT(calls, 10);
+    EXPECT_EQ(lastDone, lastTotal);
+    EXPECT_EQ(lastTotal, 1 + static_cast<int>(kMethods.size()) * 2);
+  }
+  static void TearDownTestSuite() {
+    delete result_;
+    delete frame_;
+    result_ = nullptr;
+    frame_ = nullptr;
+  }
+  static const CompareRun& run(size_t budget, const std::string& method) {
+    for (const CompareRun& r : result_->budgets.at(budget).runs)
+      if (r.method == method) return r;
+    throw std::runtime_error("no run " + method);
+  }
+  static RasterFrame* frame_;
+  static CompareResult* result_;
+};
+RasterFrame* CompareLibrary::frame_ = nullptr;
+CompareResult* CompareLibrary::result_ = nullptr;
+
+TEST_F(CompareLibrary, EveryMethodAtEveryBudgetInOrder) {
+  const CompareResult& r = *result_;
+  EXPECT_EQ(r.width, kSize);
+  EXPECT_EQ(r.height, kSize);
+  EXPECT_EQ(r.scene, kScene);
+  ASSERT_EQ(r.budgets.size(), 2u);
+  EXPECT_EQ(r.budgets[0].budgetBytes, kSmall);
+  EXPECT_EQ(r.budgets[0].label, "200KB");
+  EXPECT_EQ(r.budgets[1].budgetBytes, kLarge);
+  for (const CompareBudget& cb : r.budgets) {
+    ASSERT_EQ(cb.runs.size(), kMethods.size());
+    for (size_t i = 0; i < kMethods.size(); ++i) {
+      EXPECT_EQ(cb.runs[i].method, kMethods[i]);
+      EXPECT_EQ(cb.runs[i].budgetBytes, cb.budgetBytes);
+    }
+  }
+}
+
+TEST_F(CompareLibrary, GroundTruthIsTheExactAbuffer) {
+  const CompareRun& gt = result_->groundTruth;
+  ASSERT_TRUE(gt.ok());
+  EXPECT_EQ(gt.method, "abuffer");
+  EXPECT_FALSE(gt.budgetBytes);
+  EXPECT_GT(gt.stats.fragmentsGenerated, 10000u);
+  EXPECT_EQ(gt.stats.lost, 0u);
+  EXPECT_EQ(gt.stats.captured, gt.stats.fragmentsGenerated);
+  EXPECT_EQ(gt.image.width, kSize);
+  EXPECT_EQ(result_->depthComplexityMap.width, kSize);
+  EXPECT_GT(result_->depthComplexityMap.height, kSize);  // legend strip below
+  EXPECT_EQ(gt.metrics.mseLinear, 0.0);
+  EXPECT_TRUE(std::isinf(gt.metrics.psnrLinear));
+}
+
+TEST_F(CompareLibrary, BudgetsAreRespectedAndFragmentsAddUp) {
+  for (const CompareBudget& cb : result_->budgets)
+    for (const CompareRun& run : cb.runs) {
+      if (!run.ok()) continue;
+      SCOPED_TRACE(run.method + " at " + cb.label);
+      EXPECT_LE(run.stats.bytesUsed, cb.budgetBytes);
+      EXPECT_EQ(run.stats.captured + run.stats.lost, run.stats.fragmentsGenerated);
+      EXPECT_EQ(run.stats.fragmentsGenerated, result_->groundTruth.stats.fragmentsGenerated);
+      EXPECT_LE(run.stats.captured, run.budgetSlots);
+      EXPECT_GT(run.budgetSlots, 0u);
+      EXPECT_LE(run.budgetSlots * 8, cb.budgetBytes);
+      EXPECT_LE(run.memoryUtilisation(), 1.0);
+      EXPECT_GT(run.memoryUtilisation(), 0.0);
+      EXPECT_LE(run.stats.kMin, run.stats.kMax);
+      EXPECT_EQ(run.image.width, kSize);
+      EXPECT_EQ(run.flipMap.width, kSize);
+      EXPECT_EQ(run.flipMap.height, kSize);
+      EXPECT_EQ(run.kMap.width, kSize);
+      EXPECT_FALSE(run.stats.passes.empty());
+      // importance maps for the variable k-buffer only
+      const bool importance = run.method == "vkb" || run.method == "vkb-fill";
+      EXPECT_EQ(!run.importanceFile.empty(), importance);
+      EXPECT_EQ(!run.importanceMap.rgba.empty(), importance);
+    }
+  // more memory, fewer losses
+  for (const char* m : {"fkb", "kplus-dynamic", "vkb-fill"})
+    EXPECT_LE(run(1, m).stats.lost, run(0, m).stats.lost) << m;
+}
+
+TEST_F(CompareLibrary, FailingMethodIsRecordedAndTheRunContinues) {
+  const CompareRun& small = run(0, "abuffer");
+  ASSERT_FALSE(small.ok());
+  EXPECT_NE(small.error->find("abuffer"), std::string::npos) << *small.error;
+  EXPECT_TRUE(small.imageFile.empty());
+  // the other methods at that budget, and the abuffer at the larger one, ran
+  EXPECT_TRUE(run(0, "fkb").ok());
+  EXPECT_TRUE(run(0, "vkb-fill").ok());
+  const CompareRun& large = run(1, "abuffer");
+  ASSERT_TRUE(large.ok()) << *large.error;
+  EXPECT_EQ(large.metrics.mseLinear, 0.0);  // the abuffer against itself
+  EXPECT_EQ(large.metrics.mseSrgb, 0.0);
+  EXPECT_EQ(large.metrics.flipMean, 0.0);
+  EXPECT_TRUE(std::isinf(large.metrics.psnrSrgb));
+  EXPECT_EQ(large.stats.lost, 0u);
+}
+
+TEST_F(CompareLibrary, MetricsMatchTheMetricsApiOnTheImages) {
+  for (const CompareBudget& cb : result_->budgets)
+    for (const CompareRun& run : cb.runs) {
+      if (!run.ok()) continue;
+      SCOPED_TRACE(run.method + " at " + cb.label);
+      auto e = compareImages(result_->groundTruth.image, run.image);
+      ASSERT_TRUE(e.ok());
+      EXPECT_DOUBLE_EQ(run.metrics.mseLinear, e->mseLinear);
+      EXPECT_DOUBLE_EQ(run.metrics.mseSrgb, e->mseSrgb);
+      auto flip = computeFlip(result_->groundTruth.image, run.image);
+      ASSERT_TRUE(flip.ok());
+      EXPECT_DOUBLE_EQ(run.metrics.flipMean, flip->mean);
+      if (run.stats.lost == 0) {  // every fragment captured: the exact image
+        EXPECT_EQ(run.metrics.mseLinear, 0.0);
+        EXPECT_EQ(run.metrics.flipMean, 0.0);
+      } else {
+        EXPECT_GT(run.metrics.mseLinear, 0.0);
+        EXPECT_GT(run.metrics.flipMean, 0.0);
+        EXPECT_NEAR(run.metrics.psnrLinear, 10.0 * std::log10(1.0 / run.metrics.mseLinear), 1e-9);
+      }
+    }
+}
+
+TEST_F(CompareLibrary, KMapsShareOneScale) {
+  uint32_t kMax = 1;
+  for (const CompareBudget& cb : result_->budgets)
+    for (const CompareRun& run : cb.runs)
+      if (run.ok()) kMax = std::max(kMax, run.stats.kMax);
+  EXPECT_EQ(result_->kMapScale, static_cast<float>(kMax));
+}
+
+TEST_F(CompareLibrary, JsonHasTheDocumentedLayout) {
+  const nlohmann::json j = compareToJson(*result_, "0.1.0");
+  EXPECT_EQ(j["mfr_version"], "0.1.0");
+  EXPECT_EQ(j["scene"], kScene);
+  EXPECT_EQ(j["width"], kSize);
+  EXPECT_EQ(j["height"], kSize);
+  EXPECT_EQ(j["budget_bytes"], kSmall);
+  EXPECT_EQ(j["compositing"], "kbuffer");
+  EXPECT_EQ(j["ground_truth"]["image"], "ground_truth.png");
+  EXPECT_EQ(j["ground_truth"]["depth_complexity_image"], "ground_truth_depth_complexity.png");
+  EXPECT_EQ(j["ground_truth"]["mse"], 0.0);
+  EXPECT_TRUE(j["ground_truth"]["psnr"].is_null());
+  EXPECT_TRUE(j["ground_truth"]["fm_slots"].is_null());
+  ASSERT_EQ(j["budgets"].size(), 2u);
+  EXPECT_EQ(j["methods"], j["budgets"][0]["methods"]);
+  EXPECT_EQ(j["budgets"][1]["budget_bytes"], kLarge);
+  EXPECT_EQ(j["budgets"][1]["budget_label"], "400KB");
+  const nlohmann::json& fkb = j["budgets"][1]["methods"][0];
+  EXPECT_EQ(fkb["name"], "fkb");
+  EXPECT_EQ(fkb["image"], "fkb_400KB.png");
+  EXPECT_EQ(fkb["flip_image"], "fkb_400KB_flip.png");
+  EXPECT_EQ(fkb["k_map_image"], "fkb_400KB_kmap.png");
+  EXPECT_FALSE(fkb.contains("importance_image"));
+  EXPECT_EQ(j["budgets"][1]["methods"][2]["importance_image"], "vkb_400KB_importance.png");
+  EXPECT_EQ(fkb["mse"], fkb["mse_linear"]);
+  EXPECT_EQ(fkb["psnr"], fkb["psnr_linear"]);
+  EXPECT_TRUE(fkb["time_ms"].is_object());
+  EXPECT_TRUE(fkb["time_ms"].contains("capture"));
+  EXPECT_TRUE(fkb["total_ms"].is_number());
+  const nlohmann::json& failed = j["budgets"][0]["methods"][4];
+  EXPECT_EQ(failed["name"], "abuffer");
+  EXPECT_TRUE(failed["error"].is_string());
+  EXPECT_FALSE(failed.contains("mse"));
+  EXPECT_FALSE(failed.contains("image"));
+}
+
+TEST_F(CompareLibrary, CsvHasOneRowPerRunAndTheGroundTruthFirst) {
+  const std::string csv = compareToCsv(*result_);
+  std::istringstream in(csv);
+  std::string header, line;
+  std::getline(in, header);
+  const size_t columns = static_cast<size_t>(std::count(header.begin(), header.end(), ',')) + 1;
+  EXPECT_NE(header.find("mse_linear"), std::string::npos);
+  EXPECT_NE(header.find("psnr_srgb"), std::string::npos);
+  EXPECT_NE(header.find("time_capture_ms"), std::string::npos);
+  std::vector<std::string> rows;
+  while (std::getline(in, line)) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 1 + kMethods.size() * 2);
+  EXPECT_EQ(rows[0].rfind(",abuffer,kbuffer,ok,ground_truth.png,", 0), 0u) << rows[0];
+  for (const std::string& row : rows) {
+    // no field of these rows is quoted except an error message; count the columns outside quotes
+    size_t commas = 0;
+    bool quoted = false;
+    for (char c : row) {
+      if (c == '"') quoted = !quoted;
+      if (c == ',' && !quoted) ++commas;
+    }
+    EXPECT_EQ(commas + 1, columns) << row;
+  }
+  EXPECT_NE(rows[5].find(",abuffer,kbuffer,error,"), std::string::npos) << rows[5];
+}
+
+TEST_F(CompareLibrary, HtmlReportIsSelfContainedAndShowsEverything) {
+  ReportInfo info;
+  info.mfrVersion = "mfr 0.1.0";
+  info.commandLine = "mfr compare '<scene>' & more";
+  const std::string html = compareReportHtml(*result_, info);
+  EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
+  EXPECT_NE(html.find("</html>"), std::string::npos);
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  // no external resource: the only URL is the SVG namespace
+  std::string stripped = html;
+  for (size_t p; (p = stripped.find("http://www.w3.org/2000/svg")) != std::string::npos;)
+    stripped.erase(p, 26);
+  EXPECT_EQ(stripped.find("http:"), std::string::npos);
+  EXPECT_EQ(stripped.find("https:"), std::string::npos);
+  EXPECT_EQ(stripped.find("url("), std::string::npos);
+  EXPECT_NE(html.find("mfr compare &#39;&lt;scene&gt;&#39; &amp; more"), std::string::npos);
+  EXPECT_NE(html.find("mfr 0.1.0"), std::string::npos);
+  EXPECT_NE(html.find("<table class=\"results\">"), std::string::npos);
+  // every written image is shown
+  std::set<std::string> files = {"ground_truth.png", "ground_truth_depth_complexity.png"};
+  for (const CompareBudget& cb : result_->budgets)
+    for (const CompareRun& run : cb.runs)
+      for (const std::string* f :
+           {&run.imageFile, &run.flipFile, &run.kMapFile, &run.importanceFile})
+        if (!f->empty()) files.insert(*f);
+  for (const std::string& f : files)
+    EXPECT_NE(html.find("<img src=\"" + f + "\""), std::string::npos) << f;
+  // several budgets: the two error-vs-budget plots, with axes, a legend entry per method
+  size_t svgs = 0;
+  for (size_t p = html.find("<svg"); p != std::string::npos; p = html.find("<svg", p + 1)) ++svgs;
+  EXPECT_GE(svgs, 2u);
+  EXPECT_NE(html.find("Mean FLIP vs budget"), std::string::npos);
+  EXPECT_NE(html.find("MSE (linear) vs budget"), std::string::npos);
+  EXPECT_NE(html.find("memory budget M"), std::string::npos);
+  // the failure is on the page
+  EXPECT_NE(html.find("abuffer needs"), std::string::npos);
+}
+
+TEST(CompareOptionsCheck, BadOptionsAreErrorsNamingTheInput) {
+  static const RasterFrame frame = makeFrame();
+  const auto error = [&](CompareOptions o) {
+    auto r = runComparison(frame, o);
+    return r.ok() ? std::string() : r.error().message;
+  };
+  CompareOptions o = defaultOptions();
+  o.methods.clear();
+  EXPECT_NE(error(o).find("empty"), std::string::npos);
+  o = defaultOptions();
+  o.methods = {"fkb", "kbuffer9"};
+  EXPECT_NE(error(o).find("kbuffer9"), std::string::npos);
+  o.methods = {"fkb", "fkb"};
+  EXPECT_NE(error(o).find("twice"), std::string::npos);
+  o = defaultOptions();
+  o.budgets.clear();
+  EXPECT_NE(error(o).find("budget"), std::string::npos);
+  o.budgets = {kSmall, kSmall};
+  EXPECT_NE(error(o).find("200KB"), std::string::npos);
+}
+
+TEST(CompareOptionsCheck, SingleBudgetHasNoPlotsAndHybridIsRecorded) {
+  static const RasterFrame frame = makeFrame();
+  CompareOptions o;
+  o.methods = {"kplus-sb"};
+  o.budgets = {1u << 20};
+  o.compositing = Compositing::Hybrid;
+  o.scene = kScene;
+  auto r = runComparison(frame, o);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  ASSERT_TRUE(r->budgets[0].runs[0].ok()) << *r->budgets[0].runs[0].error;
+  EXPECT_EQ(r->budgets[0].label, "1MB");
+  // the hybrid tail is charged: 20 B per pixel
+  EXPECT_EQ(r->budgets[0].runs[0].stats.bytesByCategory.count("tail"), 1u);
+  const nlohmann::json j = compareToJson(r.value());
+  EXPECT_EQ(j["compositing"], "hybrid");
+  EXPECT_EQ(j["methods"][0]["compositing"], "hybrid");
+  EXPECT_EQ(j["ground_truth"]["compositing"], "kbuffer");
+  const std::string html = compareReportHtml(r.value(), {});
+  EXPECT_EQ(html.find("<svg"), std::string::npos);
+}
+
+TEST(CompareBudgetLabel, WholeUnitsOrBytes) {
+  EXPECT_EQ(budgetLabel(20u << 20), "20MB");
+  EXPECT_EQ(budgetLabel(400u << 10), "400KB");
+  EXPECT_EQ(budgetLabel(1536u << 20), "1536MB");
+  EXPECT_EQ(budgetLabel(1000), "1000B");
+}
+
+// ---- command line ----------------------------------------------------------------------------
+
+struct CompareCliRun {
+  int exitCode = -1;
+  bool signaled = false;
+  std::string err;
+  std::string out;
+};
+
+fs::path tempDir() {
+  static const fs::path dir = [] {
+    fs::path d = fs::temp_directory_path() / ("mfr_compare_test_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+  }();
+  return dir;
+}
+
+// removes the temporary folder after the last test of the process
+class TempDirCleanup : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(tempDir(), ec);
+  }
+};
+[[maybe_unused]] ::testing::Environment* const kCleanup =
+    ::testing::AddGlobalTestEnvironment(new TempDirCleanup);
+
+CompareCliRun runCli(const std::string& args) {
+  const fs::path err = tempDir() / "stderr.txt", out = tempDir() / "stdout.txt";
+  const std::string cmd = std::string(MFR_CLI_PATH) + " " + args + " >" + out.string() + " 2>" +
+                          err.string() + " </dev/null";
+  const int status = std::system(cmd.c_str());
+  CompareCliRun r;
+  r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) >= 128);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream e(err), o(out);
+  std::stringstream es, os;
+  es << e.rdbuf();
+  os << o.rdbuf();
+  r.err = es.str();
+  r.out = os.str();
+  return r;
+}
+
+std::string sceneArgs() {
+  std::string s = "'";
+  s += kScene;
+  s += "' --width ";
+  s += std::to_string(kSize);
+  s += " --height ";
+  s += std::to_string(kSize);
+  s += " --threads 2";
+  return s;
+}
+
+class CompareCli : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new fs::path(tempDir() / "out dir");  // a space in the path on purpose
+    fs::remove_all(*dir_);
+    run_ =
+        new CompareCliRun(runCli("compare " + sceneArgs() +
+                                 " --budget 200KB,400KB --methods fkb,kplus-dynamic,vkb,vkb-fill,"
+                                 "abuffer --json --out '" +
+                                 dir_->string() + "'"));
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete run_;
+    delete dir_;
+  }
+  static nlohmann::json results() {
+    return nlohmann::json::parse(std::ifstream(*dir_ / "results.json"));
+  }
+  static fs::path* dir_;
+  static CompareCliRun* run_;
+};
+fs::path* CompareCli::dir_ = nullptr;
+CompareCliRun* CompareCli::run_ = nullptr;
+
+TEST_F(CompareCli, WritesEveryFile) {
+  ASSERT_EQ(run_->exitCode, 0) << run_->err;
+  for (const char* f : {"results.json", "results.csv", "report.html", "ground_truth.png",
+                        "ground_truth_depth_complexity.png", "fkb_200KB.png", "fkb_200KB_flip.png",
+                        "fkb_200KB_kmap.png", "vkb_400KB_importance.png",
+                        "vkb-fill_200KB_importance.png", "abuffer_400KB.png"})
+    EXPECT_TRUE(fs::exists(*dir_ / f)) << f;
+  EXPECT_FALSE(fs::exists(*dir_ / "abuffer_200KB.png"));  // failed at 200 KiB
+  // every file the JSON names exists
+  const nlohmann::json j = results();
+  std::vector<nlohmann::json> runs = {j["ground_truth"]};
+  for (const auto& b : j["budgets"])
+    for (const auto& m : b["methods"]) runs.push_back(m);
+  for (const auto& m : runs)
+    for (const char* key :
+         {"image", "flip_image", "k_map_image", "importance_image", "depth_complexity_image"})
+      if (m.contains(key)) {
+        EXPECT_TRUE(fs::exists(*dir_ / m[key].get<std::string>())) << m[key];
+      }
+}
+
+TEST_F(CompareCli, ResultsJsonHasTheDocumentedKeysAndStdoutIsTheSame) {
+  ASSERT_EQ(run_->exitCode, 0) << run_->err;
+  const nlohmann::json j = results();
+  EXPECT_EQ(nlohmann::json::parse(run_->out), j);  // --json
+  for (const char* key : {"scene", "width", "height", "budget_bytes", "ground_truth", "methods",
+                          "budgets", "mfr_version"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["scene"], kScene);
+  EXPECT_EQ(j["budget_bytes"], kSmall);
+  EXPECT_EQ(j["ground_truth"]["name"], "abuffer");
+  EXPECT_GT(j["ground_truth"]["fragments_captured"].get<uint64_t>(), 0u);
+  EXPECT_EQ(j["ground_truth"]["fragments_lost"], 0);
+  ASSERT_EQ(j["methods"].size(), 5u);
+  ASSERT_EQ(j["budgets"].size(), 2u);
+  for (const auto& b : j["budgets"]) {
+    const uint64_t budget = b["budget_bytes"].get<uint64_t>();
+    for (const auto& m : b["methods"]) {
+      SCOPED_TRACE(m["name"].get<std::string>() + " at " + std::to_string(budget));
+      EXPECT_EQ(m["budget_bytes"], budget);
+      if (m.contains("error")) {
+        EXPECT_FALSE(m.contains("mse"));
+        continue;
+      }
+      for (const char* key : {"name",
+                              "image",
+                              "bytes_used",
+                              "fm_slots",
+                              "fragment_slots",
+                              "memory_utilisation",
+                              "fragments_generated",
+                              "fragments_captured",
+                              "fragments_lost",
+                              "fragments_lost_percent",
+                              "k_min",
+                              "k_max",
+                              "mse",
+                              "psnr",
+                              "mse_linear",
+                              "psnr_linear",
+                              "mse_srgb",
+                              "psnr_srgb",
+                              "flip_mean",
+                              "time_ms",
+                              "total_ms"})
+        EXPECT_TRUE(m.contains(key)) << key;
+      EXPECT_LE(m["bytes_used"].get<uint64_t>(), budget);
+      EXPECT_EQ(m["fragments_captured"].get<uint64_t>() + m["fragments_lost"].get<uint64_t>(),
+                m["fragments_generated"].get<uint64_t>());
+      EXPECT_EQ(m["mse"], m["mse_linear"]);
+    }
+  }
+  // the failure is recorded, and the abuffer against itself has no error
+  EXPECT_EQ(j["methods"][4]["name"], "abuffer");
+  EXPECT_NE(j["methods"][4]["error"].get<std::string>().find("abuffer"), std::string::npos);
+  EXPECT_EQ(j["budgets"][1]["methods"][4]["mse"], 0.0);
+  EXPECT_TRUE(j["budgets"][1]["methods"][4]["psnr"].is_null());
+}
+
+TEST_F(CompareCli, MetricsMatchTheWrittenPngs) {
+  ASSERT_EQ(run_->exitCode, 0) << run_->err;
+  const nlohmann::json j = results();
+  auto truth = readPng((*dir_ / j["ground_truth"]["image"].get<std::string>()).string());
+  ASSERT_TRUE(truth.ok());
+  int checked = 0;
+  for (const auto& b : j["budgets"])
+    for (const auto& m : b["methods"]) {
+      if (m.contains("error")) continue;
+      auto image = readPng((*dir_ / m["image"].get<std::string>()).string());
+      ASSERT_TRUE(image.ok());
+      auto stats = compareImages(*truth, *image);
+      ASSERT_TRUE(stats.ok());
+      EXPECT_NEAR(m["mse_linear"].get<double>(), stats->mseLinear, 1e-12);
+      EXPECT_NEAR(m["mse_srgb"].get<double>(), stats->mseSrgb, 1e-12);
+      if (stats->mseLinear > 0.0) {
+        EXPECT_NEAR(m["psnr_srgb"].get<double>(), stats->psnrSrgb, 1e-9);
+      }
+      auto flip = computeFlip(*truth, *image);
+      ASSERT_TRUE(flip.ok());
+      EXPECT_NEAR(m["flip_mean"].get<double>(), flip->mean, 1e-12);
+      ++checked;
+    }
+  EXPECT_EQ(checked, 9);
+}
+
+TEST_F(CompareCli, SummaryAndReportPathOnStderrAndACsvRowPerRun) {
+  ASSERT_EQ(run_->exitCode, 0) << run_->err;
+  EXPECT_NE(run_->err.find("report.html"), std::string::npos) << run_->err;
+  EXPECT_NE(run_->err.find("kplus-dynamic"), std::string::npos) << run_->err;
+  std::ifstream csv(*dir_ / "results.csv");
+  size_t lines = 0;
+  for (std::string line; std::getline(csv, line);) ++lines;
+  EXPECT_EQ(lines, 1u + 1u + 10u);
+  std::ifstream html(*dir_ / "report.html");
+  std::stringstream s;
+  s << html.rdbuf();
+  EXPECT_NE(s.str().find("--budget 200KB,400KB"), std::string::npos);  // the command line
+}
+
+// one line on stderr naming `needle`, exit code 1, nothing written
+void expectCleanFailure(const std::string& args, const std::string& needle) {
+  const fs::path out = tempDir() / "never";
+  fs::remove_all(out);
+  const bool outGiven = args.find("--out") != std::string::npos;
+  const CompareCliRun r = runCli("compare " + args + (outGiven ? "" : " --out " + out.string()));
+  EXPECT_FALSE(r.signaled) << args;
+  EXPECT_EQ(r.exitCode, 1) << args << "\n" << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+  EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\n" << r.err;
+  EXPECT_EQ(r.err.rfind("mfr: error: ", 0), 0u) << r.err;
+  EXPECT_FALSE(fs::exists(out / "results.json")) << args;
+}
+
+TEST(CompareCliErrors, BadInputIsOneLineNamingIt) {
+  const std::string scene = sceneArgs() + " -q";
+  expectCleanFailure(scene + " --budget 200KB --methods fkb,kbuffer9", "kbuffer9");
+  expectCleanFailure(scene + " --budget 200KB,12XB", "12XB");
+  expectCleanFailure(scene + " --budget 200KB,,400KB", "--budget");
+  expectCleanFailure(scene + " --budget 200KB --methods ''", "--methods");
+  expectCleanFailure(scene + " --budget 200KB --methods ,", "--methods");
+  expectCleanFailure(scene + " --budget 200KB --methods fkb,fkb", "fkb");
+  expectCleanFailure(scene + " --budget 200KB --composite blend", "blend");
+  expectCleanFailure("procedural:teapot -q --budget 200KB", "teapot");
+  // an output folder that cannot be created: a path below a regular file
+  const fs::path file = tempDir() / "a_file";
+  std::ofstream(file) << "x";
+  const std::string dir = (file / "sub").string();
+  expectCleanFailure(scene + " --budget 200KB --out " + dir, dir);
+}
+
+}  // namespace
+}  // namespace mfr
