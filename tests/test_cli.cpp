@@ -1,7 +1,6 @@
 // The command line end to end: bad input is one line on stderr naming the input and a non-zero
 // exit (never a crash); good input writes the promised files with the promised keys.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -10,42 +9,20 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_runner.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int exitCode = -1;
-  bool signaled = false;
-  std::string err;
-  std::string out;
-};
+using mfr::test::CliRun;
 
 fs::path tempDir() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("mfr_cli_test_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = mfr::test::processTempDir("mfr_cli_test");
   return dir;
 }
 
-CliRun runCli(const std::string& args) {
-  const fs::path err = tempDir() / "stderr.txt", out = tempDir() / "stdout.txt";
-  const std::string cmd = std::string(MFR_CLI_PATH) + " " + args + " >" + out.string() + " 2>" +
-                          err.string() + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  CliRun r;
-  r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) >= 128);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(err), o(out);
-  std::stringstream es, os;
-  es << e.rdbuf();
-  os << o.rdbuf();
-  r.err = es.str();
-  r.out = os.str();
-  return r;
-}
+CliRun runCli(const std::string& args) { return mfr::test::runCli(args, tempDir()); }
 
 std::string write(const std::string& name, const std::string& content) {
   const fs::path p = tempDir() / name;

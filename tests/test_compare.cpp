@@ -2,7 +2,6 @@
 // recorded per run), its JSON / CSV / HTML, and the command line end to end (files, results.json
 // layout, metrics recomputed from the written PNGs, bad input).
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -21,6 +20,7 @@
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/load.hpp"
 #include "mfr/scene/scene.hpp"
+#include "cli_runner.hpp"
 
 namespace mfr {
 namespace {
@@ -353,19 +353,10 @@ TEST(CompareBudgetLabel, WholeUnitsOrBytes) {
 
 // ---- command line ----------------------------------------------------------------------------
 
-struct CompareCliRun {
-  int exitCode = -1;
-  bool signaled = false;
-  std::string err;
-  std::string out;
-};
+using CompareCliRun = mfr::test::CliRun;
 
 fs::path tempDir() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("mfr_compare_test_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = mfr::test::processTempDir("mfr_compare_test");
   return dir;
 }
 
@@ -380,22 +371,7 @@ class TempDirCleanup : public ::testing::Environment {
 [[maybe_unused]] ::testing::Environment* const kCleanup =
     ::testing::AddGlobalTestEnvironment(new TempDirCleanup);
 
-CompareCliRun runCli(const std::string& args) {
-  const fs::path err = tempDir() / "stderr.txt", out = tempDir() / "stdout.txt";
-  const std::string cmd = std::string(MFR_CLI_PATH) + " " + args + " >" + out.string() + " 2>" +
-                          err.string() + " </dev/null";
-  const int status = std::system(cmd.c_str());
-  CompareCliRun r;
-  r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) >= 128);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(err), o(out);
-  std::stringstream es, os;
-  es << e.rdbuf();
-  os << o.rdbuf();
-  r.err = es.str();
-  r.out = os.str();
-  return r;
-}
+CompareCliRun runCli(const std::string& args) { return mfr::test::runCli(args, tempDir()); }
 
 std::string sceneArgs() {
   std::string s = "'";

@@ -4,7 +4,6 @@
 // matrices derived from the sRGB primaries), and (c) pinned values. The CLI's error cases run the
 // real binary.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <tbb/task_arena.h>
 
 #include <algorithm>
@@ -24,6 +23,7 @@
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
 #include "mfr/metrics/magma.hpp"
+#include "cli_runner.hpp"
 
 namespace {
 
@@ -576,41 +576,17 @@ TEST(Flip, Percentiles) {
 
 namespace fs = std::filesystem;
 
-struct MetricsCliRun {
-  int exitCode = -1;
-  bool signaled = false;
-  std::string err;
-  std::string out;
-};
+using MetricsCliRun = mfr::test::CliRun;
 
 fs::path metricsTempDir() {
-  static const fs::path dir = [] {
-    fs::path d = fs::temp_directory_path() / ("mfr_metrics_test_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = mfr::test::processTempDir("mfr_metrics_test");
   return dir;
 }
 
 MetricsCliRun runMetricsCli(const std::string& args) {
-  const fs::path err = metricsTempDir() / "stderr.txt", out = metricsTempDir() / "stdout.txt";
-  std::string cmd = MFR_CLI_PATH;
-  cmd += " metrics ";
-  cmd += args;
-  cmd += " >" + out.string();
-  cmd += " 2>" + err.string();
-  cmd += " </dev/null";
-  const int status = std::system(cmd.c_str());
-  MetricsCliRun r;
-  r.signaled = WIFSIGNALED(status) || (WIFEXITED(status) && WEXITSTATUS(status) >= 128);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream e(err), o(out);
-  std::stringstream es, os;
-  es << e.rdbuf();
-  os << o.rdbuf();
-  r.err = es.str();
-  r.out = os.str();
-  return r;
+  std::string command = "metrics ";
+  command += args;
+  return mfr::test::runCli(command, metricsTempDir());
 }
 
 std::string writeImage(const std::string& name, const Image8& image) {
