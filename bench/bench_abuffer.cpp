@@ -14,8 +14,11 @@
 // The A-buffer is the papers' unbounded ground truth (the k+-buffer paper's Figure 9 compares
 // A-buffer alternatives); this is the raw rasterizer + store speed every other bench builds on.
 // CSV: abuffer.csv.
+#include <cstdint>
+#include <cstdio>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench_common.hpp"
@@ -32,14 +35,13 @@ constexpr double kGoalMFragPerS = 100.0;  // layers, rasterize + capture, 1024x1
 }  // namespace
 
 int main(int argc, char** argv) {
-  Args args;
-  if (!parseArgs(argc, argv, kProgram, args)) return 2;
-  auto csv = openCsv(kProgram, args,
-          "scene,source,width,height,threads,reps,triangles,fragments,covered_pixels,max_depth,"
-          "setup_ms,count_ms,alloc_ms,capture_ms,resolve_ms,total_ms,rc_ms,rc_mfrag_s,"
-          "rc_ns_frag,count_mfrag_s,count_ns_frag,capture_mfrag_s,capture_ns_frag,"
-          "resolve_mfrag_s,resolve_ns_frag,total_mfrag_s,goal_mfrag_s");
-  if (!csv) return 1;
+  const Args args = parseArgs(argc, argv, kProgram);
+  Csv csv =
+      openCsv(kProgram, args,
+              "scene,source,width,height,threads,reps,triangles,fragments,covered_pixels,max_depth,"
+              "setup_ms,count_ms,alloc_ms,capture_ms,resolve_ms,total_ms,rc_ms,rc_mfrag_s,"
+              "rc_ns_frag,count_mfrag_s,count_ns_frag,capture_mfrag_s,capture_ns_frag,"
+              "resolve_mfrag_s,resolve_ns_frag,total_mfrag_s,goal_mfrag_s");
 
   std::printf("bench_abuffer: A-buffer rasterize + capture throughput, %s\n",
               runDescription(args, resolveThreads(args.threads)).c_str());
@@ -77,7 +79,7 @@ int main(int argc, char** argv) {
     runInterleaved(cases, args.reps);
     const Case& m = cases[0];
     if (m.error) {
-      std::fprintf(stderr, "bench_abuffer: %s: %s\n", sc.label.c_str(), m.error->c_str());
+      printError(kProgram, sc.label + ": " + *m.error);
       failed = true;
       continue;
     }
@@ -121,7 +123,7 @@ int main(int argc, char** argv) {
                   kGoalMFragPerS, rc, rc >= kGoalMFragPerS ? "MET" : "NOT MET", where.c_str());
     }
 
-    csv->row({sc.label,
+    csv.row({sc.label,
              sc.source,
              std::to_string(args.size),
              std::to_string(args.size),
@@ -149,6 +151,6 @@ int main(int argc, char** argv) {
              fixed(mfragPerS(frags, m.totalMs()), 2),
              sc.label == "layers" ? fixed(kGoalMFragPerS, 0) : ""});
   }
-  std::printf("\nwrote %s\n", csv->path().c_str());
+  std::printf("\nwrote %s\n", csv.path().c_str());
   return failed ? 1 : 0;
 }

@@ -10,7 +10,10 @@
 // re-check only fires when another thread got there first), and whether the fragment-parallel
 // image equals the tile-owned one (it should: both keep the k nearest fragments of every pixel).
 // CSV: capture_modes.csv (one row per scene and method, both modes side by side).
+#include <cstdint>
+#include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench_common.hpp"
@@ -27,14 +30,13 @@ constexpr uint32_t kK = 8;
 }  // namespace
 
 int main(int argc, char** argv) {
-  Args args;
-  if (!parseArgs(argc, argv, kProgram, args)) return 2;
-  auto csv = openCsv(kProgram, args,
-          "scene,method,k,width,height,threads,reps,fragments,tile_capture_ms,tile_mfrag_s,"
-          "parallel_capture_ms,parallel_mfrag_s,tile_speedup,tile_culled_kplus,"
-          "parallel_culled_kplus,tile_in_store,parallel_in_store,tile_captured,"
-          "parallel_captured,image_max_diff");
-  if (!csv) return 1;
+  const Args args = parseArgs(argc, argv, kProgram);
+  Csv csv =
+      openCsv(kProgram, args,
+              "scene,method,k,width,height,threads,reps,fragments,tile_capture_ms,tile_mfrag_s,"
+              "parallel_capture_ms,parallel_mfrag_s,tile_speedup,tile_culled_kplus,"
+              "parallel_culled_kplus,tile_in_store,parallel_in_store,tile_captured,"
+              "parallel_captured,image_max_diff");
   std::printf("bench_capture_modes: tile-owned vs fragment-parallel capture, k = %u, %s\n", kK,
               runDescription(args, resolveThreads(args.threads)).c_str());
 
@@ -105,7 +107,7 @@ int main(int argc, char** argv) {
       const RenderStats& t = results[0]->stats;
       const RenderStats& p = results[1]->stats;
       const double tileMs = results[0]->pass("capture"), parMs = results[1]->pass("capture");
-      csv->row({sc.label,
+      csv.row({sc.label,
                name,
                std::to_string(kK),
                num(frame->width()),
@@ -130,6 +132,6 @@ int main(int argc, char** argv) {
   std::printf("\n");
   table.print();
   std::printf("\nM frag/s = fragments generated / capture-pass time\nwrote %s\n",
-              csv->path().c_str());
+              csv.path().c_str());
   return failed ? 1 : 0;
 }

@@ -78,9 +78,10 @@ inline bool parseInt(const char* text, int lo, int hi, int& value) {
   return true;
 }
 
-// The common options; --help prints the usage and exits. A program with options of its own takes
-// them out of argv first.
-inline bool parseArgs(int argc, char** argv, const Program& program, Args& a) {
+// The common options. --help prints the usage and exits (0); a bad command line is reported and
+// exits (2). A program with options of its own takes them out of argv first.
+inline Args parseArgs(int argc, char** argv, const Program& program) {
+  Args a;
   bool sizeSet = false, repsSet = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
@@ -97,12 +98,12 @@ inline bool parseArgs(int argc, char** argv, const Program& program, Args& a) {
       a.out = value;
       ++i;
     } else if (arg == "--size") {
-      if (!intOption(16, kMaxImageSize, a.size)) return false;
+      if (!intOption(16, kMaxImageSize, a.size)) std::exit(2);
       sizeSet = true;
     } else if (arg == "--threads") {
-      if (!intOption(0, 1024, a.threads)) return false;
+      if (!intOption(0, 1024, a.threads)) std::exit(2);
     } else if (arg == "--reps") {
-      if (!intOption(1, 1000, a.reps)) return false;
+      if (!intOption(1, 1000, a.reps)) std::exit(2);
       repsSet = true;
     } else if (arg == "--quick") {
       a.quick = true;
@@ -112,12 +113,12 @@ inline bool parseArgs(int argc, char** argv, const Program& program, Args& a) {
     } else {
       std::fprintf(stderr, "%s: unknown or incomplete option '%s'\n", argv[0], arg.c_str());
       usage(argv[0], program);
-      return false;
+      std::exit(2);
     }
   }
   if (a.quick && !sizeSet) a.size = 256;
   if (a.quick && !repsSet) a.reps = 1;
-  return true;
+  return a;
 }
 
 // "WxH, T thread(s) (C cores), median of R run(s)": the set-up line every program opens with.
@@ -206,16 +207,15 @@ class Csv {
   std::ofstream file_;
 };
 
-// Creates the --out directory and starts the program's CSV file there with its header line;
-// nothing (after saying so) when the file cannot be written.
-inline std::optional<Csv> openCsv(const Program& program, const Args& args,
-                                  const std::string& header) {
+// Creates the --out directory and starts the program's CSV file there with its header line (the
+// column names, comma-separated). A file that cannot be written is reported and exits (1).
+inline Csv openCsv(const Program& program, const Args& args, const std::string& header) {
   std::error_code ec;
   std::filesystem::create_directories(args.out, ec);
-  std::optional<Csv> csv(std::in_place, std::filesystem::path(args.out) / program.csv, header);
-  if (!csv->ok()) {
-    printError(program, "cannot write " + csv->path().string());
-    return std::nullopt;
+  Csv csv(std::filesystem::path(args.out) / program.csv, header);
+  if (!csv.ok()) {
+    printError(program, "cannot write " + csv.path().string());
+    std::exit(1);
   }
   return csv;
 }

@@ -11,6 +11,8 @@
 // an integer: the layers scene depends only on n = r*k (the split into k and r is the paper's
 // notation), so those points use the n = 128 scene layers?k=1&r=128 to keep n exact.
 // CSV: k_sweep.csv.
+#include <cstdint>
+#include <cstdio>
 #include <optional>
 #include <string>
 #include <utility>
@@ -43,14 +45,13 @@ std::string layersSpec(int k) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  Args args;
-  if (!parseArgs(argc, argv, kProgram, args)) return 2;
-  auto csv = openCsv(kProgram, args,
-          "k,n,scene,width,height,threads,reps,fragments,covered_pixels,culled_kplus,captured,"
-          "array_alloc_ms,array_capture_ms,array_resolve_ms,array_total_ms,heap_alloc_ms,"
-          "heap_capture_ms,heap_resolve_ms,heap_total_ms,heap_speedup_capture,"
-          "heap_speedup_total,winner_capture,winner_total");
-  if (!csv) return 1;
+  const Args args = parseArgs(argc, argv, kProgram);
+  Csv csv =
+      openCsv(kProgram, args,
+              "k,n,scene,width,height,threads,reps,fragments,covered_pixels,culled_kplus,captured,"
+              "array_alloc_ms,array_capture_ms,array_resolve_ms,array_total_ms,heap_alloc_ms,"
+              "heap_capture_ms,heap_resolve_ms,heap_total_ms,heap_speedup_capture,"
+              "heap_speedup_total,winner_capture,winner_total");
   const std::vector<int> ks =
       args.quick ? std::vector<int>{4, 16, 64} : std::vector<int>{4, 8, 12, 16, 24, 32, 48, 64};
   std::printf(
@@ -109,7 +110,7 @@ int main(int argc, char** argv) {
                fixed(arr.pass("resolve"), 1), fixed(heap.pass("resolve"), 1),
                fixed(arr.totalMs(), 1), fixed(heap.totalMs(), 1), fixed(speedTotal, 2) + "x",
                winCapture, winTotal});
-    csv->row({std::to_string(k),
+    csv.row({std::to_string(k),
              fixed(n, 2),
              spec,
              num(frame->width()),
@@ -142,6 +143,6 @@ int main(int argc, char** argv) {
     std::printf("\nheap faster in total from k = %d on (paper: above about k = 16)\n", *from);
   else
     std::printf("\nheap not faster in total at the largest k (paper: above about k = 16)\n");
-  std::printf("heap speed-up = array total / heap total\nwrote %s\n", csv->path().c_str());
+  std::printf("heap speed-up = array total / heap total\nwrote %s\n", csv.path().c_str());
   return failed ? 1 : 0;
 }

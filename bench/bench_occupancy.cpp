@@ -11,7 +11,10 @@
 // runs); and the speed-up over the baseline in total time and in capture-pass time. Occupancy
 // culling is conservative (Lemma 2.1), so each variant must capture what the baseline captures and
 // produce the same image: the "same" column checks it. CSV: occupancy.csv.
+#include <cstdint>
+#include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench_common.hpp"
@@ -30,14 +33,13 @@ constexpr const char* kScene = "procedural:hairball";
 }  // namespace
 
 int main(int argc, char** argv) {
-  Args args;
-  if (!parseArgs(argc, argv, kProgram, args)) return 2;
-  auto csv = openCsv(kProgram, args,
-          "d,buckets,width,height,threads,reps,fragments,culled_occupancy,culled_kplus,"
-          "rejected_in_store,inserted,evicted,captured,occupancy_pct,kplus_pct,in_store_pct,"
-          "rejected_pct,bytes_used,occupancy_passes_ms,capture_ms,resolve_ms,total_ms,"
-          "speedup_capture,speedup_total,image_max_diff");
-  if (!csv) return 1;
+  const Args args = parseArgs(argc, argv, kProgram);
+  Csv csv =
+      openCsv(kProgram, args,
+              "d,buckets,width,height,threads,reps,fragments,culled_occupancy,culled_kplus,"
+              "rejected_in_store,inserted,evicted,captured,occupancy_pct,kplus_pct,in_store_pct,"
+              "rejected_pct,bytes_used,occupancy_passes_ms,capture_ms,resolve_ms,total_ms,"
+              "speedup_capture,speedup_total,image_max_diff");
   const std::vector<int> ds =
       args.quick ? std::vector<int>{1, 4, 64} : std::vector<int>{1, 2, 4, 8, 16, 32, 64};
 
@@ -96,11 +98,11 @@ int main(int argc, char** argv) {
     table.add({label, d == 0 ? "-" : std::to_string(32 * d),
                fixed(percent(s.culledOccupancy, gen), 2) + "%",
                fixed(percent(s.culledKPlus, gen), 2) + "%",
-               fixed(percent(s.rejectedInStore, gen), 2) + "%", num(s.captured),
-               mib(s.bytesUsed), fixed(m.occupancyMs(), 1),
-               fixed(m.pass("capture"), 1), fixed(m.totalMs(), 1), fixed(speedCapture, 2) + "x",
-               fixed(speedTotal, 2) + "x", same ? "yes" : "NO (max diff " + fixed(diff, 4) + ")"});
-    csv->row({std::to_string(d),
+               fixed(percent(s.rejectedInStore, gen), 2) + "%", num(s.captured), mib(s.bytesUsed),
+               fixed(m.occupancyMs(), 1), fixed(m.pass("capture"), 1), fixed(m.totalMs(), 1),
+               fixed(speedCapture, 2) + "x", fixed(speedTotal, 2) + "x",
+               same ? "yes" : "NO (max diff " + fixed(diff, 4) + ")"});
+    csv.row({std::to_string(d),
              std::to_string(32 * d),
              num(frame->width()),
              num(frame->height()),
@@ -131,6 +133,6 @@ int main(int argc, char** argv) {
       "\n%llu fragments generated per run; speed-up = baseline time / time (baseline: "
       "d = off)\n",
       static_cast<unsigned long long>(base.stats.fragmentsGenerated));
-  std::printf("wrote %s\n", csv->path().c_str());
+  std::printf("wrote %s\n", csv.path().c_str());
   return failed ? 1 : 0;
 }

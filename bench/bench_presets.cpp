@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench_common.hpp"
@@ -33,7 +34,8 @@ constexpr Program kProgram{
     .csv = "presets.csv",
     .options = " [--budget M]",
     .optionsHelp =
-        "  --budget M    memory budget, e.g. 20MB (default 20 MiB at 1024x1024, scaled with the pixel\n"
+        "  --budget M    memory budget, e.g. 20MB (default 20 MiB at 1024x1024, "
+        "scaled with the pixel\n"
         "                count at other sizes so the bytes per pixel stay the same)\n"};
 
 constexpr uint64_t kBudgetAt1024 = 20ull << 20;  // M = 20 MiB at 1024x1024
@@ -81,22 +83,20 @@ double otherMs(const Case& m, std::string& names) {
 int main(int argc, char** argv) {
   std::optional<uint64_t> budgetOption;
   if (!takeBudget(argc, argv, budgetOption)) return 2;
-  Args args;
-  if (!parseArgs(argc, argv, kProgram, args)) return 2;
+  const Args args = parseArgs(argc, argv, kProgram);
   const double pixelScale = static_cast<double>(args.size) * args.size / (1024.0 * 1024.0);
   const uint64_t budget =
       budgetOption.value_or(static_cast<uint64_t>(static_cast<double>(kBudgetAt1024) * pixelScale));
 
-  auto csv = openCsv(kProgram, args,
-          "scene,scene_index,method,method_index,width,height,budget_bytes,max_depth,status,"
-          "k_min,k_max,global_k,bytes_used,fragments,captured,lost,loss_pct,total_ms,count_ms,"
-          "alloc_ms,occupancy_ms,capture_ms,resolve_ms,other_ms,other_passes,error");
-  if (!csv) return 1;
-  std::printf(
-      "bench_presets: every preset under M = %s (%llu bytes)%s, %s\n",
-      formatBytes(budget).c_str(), static_cast<unsigned long long>(budget),
-      budgetOption ? "" : (args.size == 1024 ? "" : " (20 MiB scaled to the pixel count)"),
-      runDescription(args, resolveThreads(args.threads)).c_str());
+  Csv csv =
+      openCsv(kProgram, args,
+              "scene,scene_index,method,method_index,width,height,budget_bytes,max_depth,status,"
+              "k_min,k_max,global_k,bytes_used,fragments,captured,lost,loss_pct,total_ms,count_ms,"
+              "alloc_ms,occupancy_ms,capture_ms,resolve_ms,other_ms,other_passes,error");
+  std::printf("bench_presets: every preset under M = %s (%llu bytes)%s, %s\n",
+              formatBytes(budget).c_str(), static_cast<unsigned long long>(budget),
+              budgetOption ? "" : (args.size == 1024 ? "" : " (20 MiB scaled to the pixel count)"),
+              runDescription(args, resolveThreads(args.threads)).c_str());
 
   // every preset, then the +occupancy variant of each one that has it (the bounded ones)
   std::vector<std::string> presets = presetNames();
@@ -189,7 +189,7 @@ int main(int argc, char** argv) {
             {name, "-", "-", "-", "-", "-", "-", "-", "-", "-", "-", "-", "error: " + message});
         row.insert(row.end(), {"error", "", "", "", "", "", "", "", "", "", "", "", "", "", "", "",
                                "", message});
-        csv->row(row);
+        csv.row(row);
         continue;
       }
       const RenderStats& s = m.stats;
@@ -223,6 +223,6 @@ int main(int argc, char** argv) {
       "\nk: slots per covered pixel (min-max); MiB: bytes used (abuffer: what it needs, no budget);"
       "\nloss: %% of generated fragments not captured; pass times in ms (alloc = allocate + clear,"
       "\noccupancy = depth range + fill + count passes)\nwrote %s\n",
-      csv->path().c_str());
+      csv.path().c_str());
   return failed ? 1 : 0;
 }
