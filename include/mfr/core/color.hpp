@@ -62,10 +62,30 @@ inline uint8_t unorm8(float v) {
 /// Packs linear RGB + alpha into the fragment colour word: R in bits 0-7, G 8-15, B 16-23 (sRGB
 /// codes), A 24-31 (linear), i.e. the byte order of GL's packUnorm4x8 / RGBA8 in memory.
 inline uint32_t packFragmentColor(const ColorTables& t, const glm::vec3& linearRgb, float alpha) {
+#if defined(__SSE2__)
+  // the clamps, scales and conversions of all four channels at once (maxps maps NaN to 0)
+  const __m128 v = _mm_setr_ps(linearRgb.r, linearRgb.g, linearRgb.b, alpha);
+  const __m128 c = _mm_min_ps(_mm_max_ps(v, _mm_setzero_ps()), _mm_set1_ps(1.0f));
+  const __m128i index = _mm_cvttps_epi32(
+      _mm_add_ps(_mm_mul_ps(c, _mm_setr_ps(4095.0f, 4095.0f, 4095.0f, 255.0f)), _mm_set1_ps(0.5f)));
+  alignas(16) int32_t i[4];
+  alignas(16) float clamped[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(i), index);
+  _mm_store_ps(clamped, c);
+  uint32_t word = static_cast<uint32_t>(i[3]) << 24;
+  for (int ch = 0; ch < 3; ++ch) {
+    int32_t code = t.coarseSrgb8[i[ch]];
+    code += clamped[ch] >= t.lowerBound[code + 1];
+    code -= clamped[ch] < t.lowerBound[code];
+    word |= static_cast<uint32_t>(code) << (8 * ch);
+  }
+  return word;
+#else
   return static_cast<uint32_t>(encodeSrgb8(t, linearRgb.r)) |
          (static_cast<uint32_t>(encodeSrgb8(t, linearRgb.g)) << 8) |
          (static_cast<uint32_t>(encodeSrgb8(t, linearRgb.b)) << 16) |
          (static_cast<uint32_t>(unorm8(alpha)) << 24);
+#endif
 }
 inline uint32_t packFragmentColor(const glm::vec3& linearRgb, float alpha) {
   return packFragmentColor(ColorTables::get(), linearRgb, alpha);

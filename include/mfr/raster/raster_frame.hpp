@@ -30,7 +30,7 @@ inline constexpr float kAmbient = 0.2f;
 struct RasterOptions {
   int width = 512;
   int height = 512;
-  int tileSize = 32;  // pixels per tile side
+  int tileSize = 16;  // pixels per tile side
   int threads = 0;    // 0 = all cores
 };
 
