@@ -114,7 +114,10 @@ TEST(VariableKBuffer, SumOfKNeverExceedsTheSlotsTheBudgetBuys) {
         uint64_t demand = 0;
         for (uint32_t n : out.depthComplexity) demand += n;
         EXPECT_EQ(sumK, std::min(slots, demand)) << budget;
-        for (size_t p = 0; p < out.kMap.size(); ++p) EXPECT_LE(out.kMap[p], out.depthComplexity[p]);
+        for (size_t p = 0; p < out.kMap.size(); ++p) {
+          EXPECT_LE(out.kMap[p], out.depthComplexity[p]);
+          if (out.depthComplexity[p] > 0) EXPECT_GE(out.kMap[p], 1u) << "every covered pixel keeps one";
+        }
       }
     }
 }

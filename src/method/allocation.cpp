@@ -6,8 +6,9 @@
 //   dynamic k     the largest global k whose exact memory fits M, read off the depth-complexity
 //                 histogram (dynamic k-buffer, [VPF15] as summarised by the variable k-buffer paper);
 //   importance    k(p) = floor(P(p) F(M)), P(p) = I(p) / sum I (variable k-buffer, Eqs. 1-2); the
-//                 fill variant caps k(p) at n(p) and hands freed and remainder slots to the pixels
-//                 with the largest unmet importance;
+//                 fill variant gives every covered pixel one slot, the rest by importance capped
+//                 at n(p), and hands freed and remainder slots to the pixels with the largest unmet
+//                 importance;
 //   unbounded     k(p) = n(p) (A-buffer / S-buffer).
 // Offsets are an exclusive prefix sum of k(p) in tile-major order (the S-buffer's clustering of
 // pixels by tiles, for locality).
@@ -184,12 +185,21 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
       double total = 0.0;
       for (float i : importance) total += i;
       std::vector<uint64_t> k(pixels, 0);
-      if (total > 0.0)
-        for (size_t p = 0; p < pixels; ++p)
-          k[p] = static_cast<uint64_t>(std::floor(importance[p] / total *
-                                                  static_cast<double>(slotsInBudget)));
-      if (method.fillUnusedSlots) {
-        for (size_t p = 0; p < pixels; ++p) k[p] = std::min<uint64_t>(k[p], n[p]);
+      if (!method.fillUnusedSlots) {  // the paper's rule, Eq. 1
+        if (total > 0.0)
+          for (size_t p = 0; p < pixels; ++p)
+            k[p] = static_cast<uint64_t>(std::floor(importance[p] / total *
+                                                    static_cast<double>(slotsInBudget)));
+      } else {
+        // fill: one slot for every covered pixel first (like DHOIT's allocation), the rest by
+        // importance, capped at n(p), then the freed and remainder slots to the unmet pixels
+        const double share = static_cast<double>(slotsInBudget - covered);
+        for (size_t p = 0; p < pixels; ++p) {
+          if (n[p] == 0) continue;
+          const uint64_t byImportance =
+              total > 0.0 ? static_cast<uint64_t>(std::floor(importance[p] / total * share)) : 0;
+          k[p] = 1 + std::min<uint64_t>(n[p] - 1, byImportance);
+        }
         fillByImportance(n, importance, slotsInBudget, k);
       }
       a.reservedK.resize(pixels);

@@ -51,8 +51,9 @@ struct MethodDesc {
   Compositing compositing = Compositing::KBuffer;
   std::optional<uint32_t> k;  // explicit k (otherwise derived from the budget)
   ImportanceParams importance;  // Importance allocation only
-  /// Importance allocation: cap k(p) at n(p) and hand the freed and the floor() remainder slots to
-  /// the pixels with the largest unmet importance (vkb-fill), instead of the paper's exact rule.
+  /// Importance allocation: one slot for every covered pixel, the rest by importance capped at
+  /// n(p), and the freed and floor() remainder slots to the pixels with the largest unmet
+  /// importance (vkb-fill), instead of the paper's exact rule.
   bool fillUnusedSlots = false;
 };
 
