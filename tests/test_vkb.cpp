@@ -116,7 +116,9 @@ TEST(VariableKBuffer, SumOfKNeverExceedsTheSlotsTheBudgetBuys) {
         EXPECT_EQ(sumK, std::min(slots, demand)) << budget;
         for (size_t p = 0; p < out.kMap.size(); ++p) {
           EXPECT_LE(out.kMap[p], out.depthComplexity[p]);
-          if (out.depthComplexity[p] > 0) EXPECT_GE(out.kMap[p], 1u) << "every covered pixel keeps one";
+          if (out.depthComplexity[p] > 0) {
+            EXPECT_GE(out.kMap[p], 1u) << "every covered pixel keeps one";
+          }
         }
       }
     }
