@@ -12,8 +12,8 @@
 namespace mfr {
 namespace {
 
-RenderOutput renderWith(const Scene& scene, const Camera& camera, int size, const std::string& preset,
-                        RenderOptions options = {}, int threads = 2) {
+RenderOutput renderWith(const Scene& scene, const Camera& camera, int size,
+                        const std::string& preset, RenderOptions options = {}, int threads = 2) {
   RasterOptions ro;
   ro.width = size;
   ro.height = size;
@@ -26,7 +26,9 @@ RenderOutput renderWith(const Scene& scene, const Camera& camera, int size, cons
 }
 
 // Independent reference: sRGB by its formula (not the lookup tables), compositing in double.
-double srgbDecode(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
+double srgbDecode(double c) {
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
 double srgbEncode(double l) {
   l = std::clamp(l, 0.0, 1.0);
   return l <= 0.0031308 ? l * 12.92 : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
@@ -63,10 +65,9 @@ TEST(ABuffer, CompositesLikeAnIndependentFrontToBackReference) {
       for (int i : {2, 0, 1}) {  // near to far
         const glm::dvec4 c(layers[i].color);
         // the fragment colour travels as sRGB8 + alpha8
-        const glm::dvec3 shaded(
-            srgbDecode(std::round(srgbEncode(c.r * light) * 255.0) / 255.0),
-            srgbDecode(std::round(srgbEncode(c.g * light) * 255.0) / 255.0),
-            srgbDecode(std::round(srgbEncode(c.b * light) * 255.0) / 255.0));
+        const glm::dvec3 shaded(srgbDecode(std::round(srgbEncode(c.r * light) * 255.0) / 255.0),
+                                srgbDecode(std::round(srgbEncode(c.g * light) * 255.0) / 255.0),
+                                srgbDecode(std::round(srgbEncode(c.b * light) * 255.0) / 255.0));
         const double a = std::round(c.a * 255.0) / 255.0;
         color += T * a * shaded;
         T *= 1.0 - a;
@@ -88,7 +89,8 @@ TEST(ABuffer, EqualDepthsGiveTheSameImageInAnySubmissionOrder) {
   ab.insert(ab.end(), b.begin(), b.end());
   ba.insert(ba.end(), a.begin(), a.end());
   const RenderOutput first = renderWith(test::makeScene(ab), test::screenCamera(), size, "abuffer");
-  const RenderOutput second = renderWith(test::makeScene(ba), test::screenCamera(), size, "abuffer");
+  const RenderOutput second =
+      renderWith(test::makeScene(ba), test::screenCamera(), size, "abuffer");
   EXPECT_EQ(encodeSrgb(first.image).rgba, encodeSrgb(second.image).rgba);
 }
 

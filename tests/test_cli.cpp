@@ -22,7 +22,9 @@ fs::path tempDir() {
   return dir;
 }
 
-CliRun runCli(const std::string& args) { return mfr::test::runCli(args, tempDir()); }
+CliRun runCli(const std::string& args) {
+  return mfr::test::runCli(args, tempDir());
+}
 
 std::string write(const std::string& name, const std::string& content) {
   const fs::path p = tempDir() / name;
@@ -47,7 +49,8 @@ TEST(Cli, MissingFileIsAnErrorNamingIt) {
 }
 
 TEST(Cli, MalformedGltfIsAnErrorNamingIt) {
-  const std::string path = write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [");
+  const std::string path =
+      write("broken.gltf", "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [");
   expectCleanFailure("render " + path + " -q", path);
 }
 
@@ -57,7 +60,8 @@ TEST(Cli, MalformedObjIsAnErrorNamingIt) {
 }
 
 TEST(Cli, MalformedPlyIsAnErrorNamingIt) {
-  const std::string path = write("broken.ply", "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n");
+  const std::string path =
+      write("broken.ply", "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n");
   expectCleanFailure("render " + path + " -q", path);
 }
 
@@ -85,8 +89,8 @@ TEST(Cli, ZeroNegativeAndAbsurdSizesAreErrors) {
 
 TEST(Cli, BadBudgetsAreErrors) {
   expectCleanFailure("render procedural:spheres --method fkb --budget 12XB -q", "12XB");
-  expectCleanFailure("render procedural:spheres --method fkb --budget 1KB --width 64 --height 64 -q",
-                     "1024 B");
+  expectCleanFailure(
+      "render procedural:spheres --method fkb --budget 1KB --width 64 --height 64 -q", "1024 B");
   expectCleanFailure("render procedural:spheres --method kplus-heap -q", "budget");
 }
 
@@ -98,12 +102,14 @@ TEST(Cli, UnknownMethodAndNonFiniteCameraAreErrors) {
 TEST(Cli, RenderWritesImageMapsAndStatsWithTheDocumentedKeys) {
   const fs::path dir = tempDir() / "render";
   fs::create_directories(dir);
-  const CliRun r = runCli("render procedural:spheres --width 96 --height 80 --method kplus-sb --budget 400KB "
-                       "--composite hybrid -q -o " + (dir / "img.png").string() + " --k-map " +
-                       (dir / "k.png").string() + " --depth-complexity " + (dir / "n.png").string() +
-                       " --stats-json " + (dir / "stats.json").string());
+  const CliRun r = runCli(
+      "render procedural:spheres --width 96 --height 80 --method kplus-sb --budget 400KB "
+      "--composite hybrid -q -o " +
+      (dir / "img.png").string() + " --k-map " + (dir / "k.png").string() + " --depth-complexity " +
+      (dir / "n.png").string() + " --stats-json " + (dir / "stats.json").string());
   ASSERT_EQ(r.exitCode, 0) << r.err;
-  for (const char* f : {"img.png", "k.png", "n.png", "stats.json"}) EXPECT_TRUE(fs::exists(dir / f)) << f;
+  for (const char* f : {"img.png", "k.png", "n.png", "stats.json"})
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
   const nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "stats.json"));
   for (const char* key : {"method", "budget_bytes", "bytes_used", "fragments_generated",
                           "fragments_captured", "fragments_lost", "k_min", "k_max", "time_ms"})
@@ -132,9 +138,10 @@ TEST(Cli, OrbitWritesOneImagePerView) {
   const fs::path dir = tempDir() / "orbit";
   fs::create_directories(dir);
   const CliRun r = runCli("render procedural:bottles --width 32 --height 32 --orbit 3 -q -o " +
-                       (dir / "o.png").string());
+                          (dir / "o.png").string());
   ASSERT_EQ(r.exitCode, 0) << r.err;
-  for (const char* f : {"o_v000.png", "o_v001.png", "o_v002.png"}) EXPECT_TRUE(fs::exists(dir / f)) << f;
+  for (const char* f : {"o_v000.png", "o_v001.png", "o_v002.png"})
+    EXPECT_TRUE(fs::exists(dir / f)) << f;
 }
 
 }  // namespace

@@ -12,7 +12,8 @@ namespace {
 
 int referenceEncode(double linear) {
   linear = std::clamp(linear, 0.0, 1.0);
-  const double e = linear <= 0.0031308 ? linear * 12.92 : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+  const double e =
+      linear <= 0.0031308 ? linear * 12.92 : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
   return static_cast<int>(std::lround(e * 255.0));
 }
 

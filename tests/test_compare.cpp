@@ -14,13 +14,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_runner.hpp"
 #include "mfr/compare/compare.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/load.hpp"
 #include "mfr/scene/scene.hpp"
-#include "cli_runner.hpp"
 
 namespace mfr {
 namespace {
@@ -371,7 +371,9 @@ class TempDirCleanup : public ::testing::Environment {
 [[maybe_unused]] ::testing::Environment* const kCleanup =
     ::testing::AddGlobalTestEnvironment(new TempDirCleanup);
 
-CompareCliRun runCli(const std::string& args) { return mfr::test::runCli(args, tempDir()); }
+CompareCliRun runCli(const std::string& args) {
+  return mfr::test::runCli(args, tempDir());
+}
 
 std::string sceneArgs() {
   std::string s = "'";

@@ -19,11 +19,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "cli_runner.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
 #include "mfr/metrics/magma.hpp"
-#include "cli_runner.hpp"
 
 namespace {
 

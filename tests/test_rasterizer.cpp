@@ -31,9 +31,8 @@ RasterFrame buildFrame(const Scene& scene, int size, const Camera& camera = scre
 std::vector<Fragment> allFragments(const RasterFrame& frame) {
   std::vector<std::vector<Fragment>> perTile(frame.tileCount());
   frame.forEachTile([&](int tile) {
-    frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
-                                           perTile[tile].push_back(f);
-                                         }});
+    frame.rasterizeTile<ShadeMode::Full>(
+        tile, EmitAll{[&](const Fragment& f) { perTile[tile].push_back(f); }});
   });
   std::vector<Fragment> all;
   for (const auto& t : perTile) all.insert(all.end(), t.begin(), t.end());
@@ -67,7 +66,8 @@ TEST(Rasterizer, JitteredMeshCoversEveryPixelExactlyOnce) {
       tris.push_back({grid[j][i], grid[j + 1][i + 1], grid[j + 1][i]});
     }
   const std::vector<int> c = coverage(buildFrame(makeScene(tris), size));
-  for (int p = 0; p < size * size; ++p) ASSERT_EQ(c[p], 1) << "pixel " << p % size << "," << p / size;
+  for (int p = 0; p < size * size; ++p)
+    ASSERT_EQ(c[p], 1) << "pixel " << p % size << "," << p / size;
 }
 
 TEST(Rasterizer, FanAroundAPixelCentreCoversItOnce) {
@@ -81,7 +81,8 @@ TEST(Rasterizer, FanAroundAPixelCentreCoversItOnce) {
                     screenPoint(8.5 + 20 * std::cos(a1), 8.5 + 20 * std::sin(a1), size)});
   }
   const std::vector<int> c = coverage(buildFrame(makeScene(tris), size));
-  for (int p = 0; p < size * size; ++p) ASSERT_EQ(c[p], 1) << "pixel " << p % size << "," << p / size;
+  for (int p = 0; p < size * size; ++p)
+    ASSERT_EQ(c[p], 1) << "pixel " << p % size << "," << p / size;
 }
 
 TEST(Rasterizer, TopLeftRuleOnEdgesThroughPixelCentres) {
@@ -184,9 +185,10 @@ TEST(Rasterizer, DepthAndTextureCoordinatesArePerspectiveCorrect) {
   const int size = 64;
   Scene scene;
   scene.name = "tilted";
-  scene.positions = {{-1.0f, -0.8f, 0.5f}, {1.0f, -0.8f, 0.5f}, {1.0f, 0.8f, -6.0f}, {-1.0f, 0.8f, -6.0f}};
-  const glm::vec3 n = glm::normalize(glm::cross(scene.positions[1] - scene.positions[0],
-                                                scene.positions[3] - scene.positions[0]));
+  scene.positions = {
+      {-1.0f, -0.8f, 0.5f}, {1.0f, -0.8f, 0.5f}, {1.0f, 0.8f, -6.0f}, {-1.0f, 0.8f, -6.0f}};
+  const glm::vec3 n = glm::normalize(
+      glm::cross(scene.positions[1] - scene.positions[0], scene.positions[3] - scene.positions[0]));
   scene.normals.assign(4, n);
   scene.uvs = {{0.0f, 1.0f}, {1.0f, 1.0f}, {1.0f, 0.0f}, {0.0f, 0.0f}};
   scene.indices = {0, 1, 2, 0, 2, 3};
@@ -206,7 +208,8 @@ TEST(Rasterizer, DepthAndTextureCoordinatesArePerspectiveCorrect) {
   cam.zNear = 0.5f;
   cam.zFar = 20.0f;
   const RasterFrame frame = buildFrame(scene, size, cam);
-  const glm::mat4 viewProj = projectionMatrix(frame.camera(), size, size) * viewMatrix(frame.camera());
+  const glm::mat4 viewProj =
+      projectionMatrix(frame.camera(), size, size) * viewMatrix(frame.camera());
   int checked = 0;
   for (const Fragment& f : allFragments(frame)) {
     const int x = static_cast<int>(f.pixel % size), y = static_cast<int>(f.pixel / size);
@@ -238,7 +241,9 @@ TEST(Rasterizer, SameFragmentsForAnyThreadCount) {
   std::uniform_real_distribution<float> u(-1.2f, 1.2f), z(-3.0f, 0.5f);
   std::vector<TestTriangle> tris;
   for (int i = 0; i < 300; ++i)
-    tris.push_back({{u(rng), u(rng), z(rng)}, {u(rng), u(rng), z(rng)}, {u(rng), u(rng), z(rng)},
+    tris.push_back({{u(rng), u(rng), z(rng)},
+                    {u(rng), u(rng), z(rng)},
+                    {u(rng), u(rng), z(rng)},
                     {0.3f, 0.6f, 0.9f, 0.4f}});
   const Scene scene = makeScene(tris);
   auto collect = [&](int threads) {
@@ -272,7 +277,8 @@ TEST(Rasterizer, RejectsAbsurdSizes) {
     o.height = h;
     auto frame = RasterFrame::build(scene, screenCamera(), o);
     ASSERT_FALSE(frame.ok());
-    EXPECT_NE(frame.error().message.find(std::to_string(w) + "x" + std::to_string(h)), std::string::npos);
+    EXPECT_NE(frame.error().message.find(std::to_string(w) + "x" + std::to_string(h)),
+              std::string::npos);
   }
 }
 

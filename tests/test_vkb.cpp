@@ -51,7 +51,8 @@ TEST(Importance, PeripheryTermFollowsEquation4) {
 TEST(Importance, FresnelTermFollowsEquation5) {
   const std::vector<uint32_t> n = {1, 1, 1};
   const std::vector<float> cosine = {1.0f, 0.5f, 0.0f};
-  const ImportanceMaps m = computeImportance(3, 1, n, cosine, onlyFactor(false, false, true, false));
+  const ImportanceMaps m =
+      computeImportance(3, 1, n, cosine, onlyFactor(false, false, true, false));
   EXPECT_NEAR(m.importance[0], 1.0, 1e-6);
   EXPECT_NEAR(m.importance[1], 1.0 - std::pow(0.5, 5) / 2.0, 1e-6);
   EXPECT_NEAR(m.importance[2], 0.5, 1e-6);

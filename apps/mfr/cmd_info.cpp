@@ -25,7 +25,8 @@ int run(const SceneOptions& o) {
   nlohmann::json views = nlohmann::json::array();
   const MemoryModel abuffer = MemoryModel::of(methodPreset("abuffer").value());
   for (size_t v = 0; v < prepared->cameras.size(); ++v) {
-    progress.set("counting fragments", static_cast<int>(v), static_cast<int>(prepared->cameras.size()));
+    progress.set("counting fragments", static_cast<int>(v),
+                 static_cast<int>(prepared->cameras.size()));
     RasterOptions ro{o.width, o.height, 32, o.threads};
     auto frame = RasterFrame::build(scene, prepared->cameras[v], ro);
     if (!frame) return fail(o.source + ": " + frame.error().message);
@@ -38,16 +39,18 @@ int run(const SceneOptions& o) {
       maxN = std::max(maxN, c);
     }
     const Camera& c = frame->camera();
-    views.push_back({{"view", v},
-                     {"camera", {{"eye", {c.eye.x, c.eye.y, c.eye.z}},
-                                 {"target", {c.target.x, c.target.y, c.target.z}},
-                                 {"up", {c.up.x, c.up.y, c.up.z}},
-                                 {"fov", c.fovYDegrees}}},
-                     {"fragments", total},
-                     {"covered_pixels", covered},
-                     {"max_depth_complexity", maxN},
-                     {"mean_depth_complexity", covered ? double(total) / covered : 0.0},
-                     {"abuffer_bytes", abuffer.overhead(frame->pixelCount()) + total * kNodeBytes}});
+    views.push_back(
+        {{"view", v},
+         {"camera",
+          {{"eye", {c.eye.x, c.eye.y, c.eye.z}},
+           {"target", {c.target.x, c.target.y, c.target.z}},
+           {"up", {c.up.x, c.up.y, c.up.z}},
+           {"fov", c.fovYDegrees}}},
+         {"fragments", total},
+         {"covered_pixels", covered},
+         {"max_depth_complexity", maxN},
+         {"mean_depth_complexity", covered ? double(total) / covered : 0.0},
+         {"abuffer_bytes", abuffer.overhead(frame->pixelCount()) + total * kNodeBytes}});
   }
   nlohmann::json j = {{"scene", o.source},
                       {"triangles", scene.triangleCount()},
@@ -72,13 +75,14 @@ int run(const SceneOptions& o) {
   std::printf("materials   %zu (%zu blend, %zu mask, %zu opaque), %zu textures\n",
               scene.materials.size(), blend, mask, opaque, scene.textures.size());
   for (const auto& v : views)
-    std::printf("view %-3d    %dx%d: %llu fragments on %llu pixels, depth complexity max %u mean "
-                "%.2f, A-buffer %s\n",
-                v["view"].get<int>(), o.width, o.height,
-                static_cast<unsigned long long>(v["fragments"].get<uint64_t>()),
-                static_cast<unsigned long long>(v["covered_pixels"].get<uint64_t>()),
-                v["max_depth_complexity"].get<uint32_t>(), v["mean_depth_complexity"].get<double>(),
-                formatBytes(v["abuffer_bytes"].get<uint64_t>()).c_str());
+    std::printf(
+        "view %-3d    %dx%d: %llu fragments on %llu pixels, depth complexity max %u mean "
+        "%.2f, A-buffer %s\n",
+        v["view"].get<int>(), o.width, o.height,
+        static_cast<unsigned long long>(v["fragments"].get<uint64_t>()),
+        static_cast<unsigned long long>(v["covered_pixels"].get<uint64_t>()),
+        v["max_depth_complexity"].get<uint32_t>(), v["mean_depth_complexity"].get<double>(),
+        formatBytes(v["abuffer_bytes"].get<uint64_t>()).c_str());
   return 0;
 }
 

@@ -45,8 +45,7 @@ Result<MethodDesc> buildMethod(const RenderArgs& a) {
     if (*a.k < 1 || *a.k > (1u << 20)) return makeError("--k: must be in [1, 1048576]");
     if (m.allocation == AllocationPolicy::Unbounded)
       return makeError("--k: the abuffer keeps every fragment; pick a bounded method");
-    if (m.name.rfind("zbuffer", 0) == 0 && *a.k != 1)
-      return makeError("--k: zbuffer has k = 1");
+    if (m.name.rfind("zbuffer", 0) == 0 && *a.k != 1) return makeError("--k: zbuffer has k = 1");
     m.k = *a.k;
   }
   auto compositing = parseCompositing(a.composite);
@@ -54,8 +53,10 @@ Result<MethodDesc> buildMethod(const RenderArgs& a) {
   m.compositing = compositing.value();
   if (m.allocation == AllocationPolicy::Importance) {
     ImportanceParams ip = a.importance;
-    if (!(ip.alpha >= 0.0f && ip.alpha <= 1.0f)) return makeError("--importance-alpha: must be in [0, 1]");
-    if (!(ip.nLimit >= 1.0f && ip.nLimit <= 1e6f)) return makeError("--n-limit: must be in [1, 1e6]");
+    if (!(ip.alpha >= 0.0f && ip.alpha <= 1.0f))
+      return makeError("--importance-alpha: must be in [0, 1]");
+    if (!(ip.nLimit >= 1.0f && ip.nLimit <= 1e6f))
+      return makeError("--n-limit: must be in [1, 1e6]");
     if (!(ip.peripheryExponent > 0.0f && ip.peripheryExponent <= 100.0f))
       return makeError("--periphery-d: must be in (0, 100]");
     if (!(ip.noise >= 0.0f && ip.noise <= 1.0f)) return makeError("--noise: must be in [0, 1]");
@@ -71,10 +72,12 @@ Result<MethodDesc> buildMethod(const RenderArgs& a) {
     ip.useNoise = !a.noNoise;
     m.importance = ip;
   } else if (!a.importanceMap.empty() || !a.importanceFactors.empty()) {
-    return makeError("--importance-map/--importance-factors: only for importance methods (vkb, vkb-fill)");
+    return makeError(
+        "--importance-map/--importance-factors: only for importance methods (vkb, vkb-fill)");
   }
   if (m.occupancyWords > 0) {
-    if (a.occupancyD < 1 || a.occupancyD > 64) return makeError("--occupancy-d: must be in [1, 64]");
+    if (a.occupancyD < 1 || a.occupancyD > 64)
+      return makeError("--occupancy-d: must be in [1, 64]");
     m.occupancyWords = a.occupancyD;
   }
   return m;
@@ -148,7 +151,9 @@ int run(const RenderArgs& a) {
         char suffix[32];
         std::snprintf(suffix, sizeof suffix, views > 1 ? "_v%03d.png" : ".png", v);
         const std::pair<const char*, const std::vector<float>*> factors[] = {
-            {"importance", &imp.importance}, {"depth", &imp.depth}, {"periphery", &imp.periphery},
+            {"importance", &imp.importance},
+            {"depth", &imp.depth},
+            {"periphery", &imp.periphery},
             {"fresnel", &imp.fresnel}};
         for (const auto& [name, values] : factors)
           writeMap((dir / (std::string(name) + suffix)).string(), *values, ro.width, ro.height,
@@ -219,7 +224,8 @@ Runner addRenderCommand(CLI::App& app) {
   cmd->add_option("--importance-alpha", args->importance.alpha, "vkb Eq. 3 alpha (default 0.375)");
   cmd->add_option("--n-limit", args->importance.nLimit, "vkb Eq. 3 N_limit (default 20)");
   cmd->add_option("--periphery-d", args->importance.peripheryExponent, "vkb Eq. 4 d (default 3)");
-  cmd->add_option("--fovea", args->fovea, "vkb Eq. 4 centre o in pixels X,Y (default: image centre)")
+  cmd->add_option("--fovea", args->fovea,
+                  "vkb Eq. 4 centre o in pixels X,Y (default: image centre)")
       ->delimiter(',')
       ->expected(2);
   cmd->add_option("--noise", args->importance.noise, "vkb Eq. 6 lambda (default 0.1)");

@@ -12,21 +12,27 @@
 namespace mfr::cli {
 
 void SceneOptions::add(CLI::App& app) {
-  app.add_option("scene", source, "Scene file (.gltf .glb .obj .ply .json) or procedural:NAME[?k=v&...]")
+  app.add_option("scene", source,
+                 "Scene file (.gltf .glb .obj .ply .json) or procedural:NAME[?k=v&...]")
       ->required();
   app.add_option("--width", width, "Image width in pixels (1-16384)");
   app.add_option("--height", height, "Image height in pixels (1-16384)");
-  app.add_option("--camera", camera, "EX,EY,EZ,TX,TY,TZ[,UX,UY,UZ[,FOV]]: eye, target, up, fov (deg)")
+  app.add_option("--camera", camera,
+                 "EX,EY,EZ,TX,TY,TZ[,UX,UY,UZ[,FOV]]: eye, target, up, fov (deg)")
       ->delimiter(',')
       ->expected(6, 10);
   app.add_option("--view", view, "Use the scene file's camera number N (0-based)");
   app.add_option("--orbit", orbit, "Render N views on a circle around the scene");
   app.add_option("--threads", threads, "Worker threads (default: all cores)");
   app.add_option("--seed", seed, "Seed for procedural scenes and noise (default 1)");
-  app.add_option("--alpha", alpha, "Override every material's alpha (render the whole scene transparent)");
-  app.add_option("--background", background, "Background R,G,B (linear, 0-1)")->delimiter(',')->expected(3);
-  app.add_option("--transmission-floor", transmissionFloor,
-                 "Alpha floor for KHR_materials_transmission glass (alpha = max(floor, 1 - transmission))");
+  app.add_option("--alpha", alpha,
+                 "Override every material's alpha (render the whole scene transparent)");
+  app.add_option("--background", background, "Background R,G,B (linear, 0-1)")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option(
+      "--transmission-floor", transmissionFloor,
+      "Alpha floor for KHR_materials_transmission glass (alpha = max(floor, 1 - transmission))");
   app.add_flag("--quiet,-q", quiet, "No progress or summary on the terminal");
   app.add_flag("--json", json, "Print machine-readable JSON on stdout");
 }
@@ -38,8 +44,9 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
     return true;
   };
   if (o.width < 1 || o.height < 1 || o.width > kMaxImageSize || o.height > kMaxImageSize)
-    return makeError("--width/--height " + std::to_string(o.width) + "x" + std::to_string(o.height) +
-                     ": must be in [1, " + std::to_string(kMaxImageSize) + "]");
+    return makeError("--width/--height " + std::to_string(o.width) + "x" +
+                     std::to_string(o.height) + ": must be in [1, " +
+                     std::to_string(kMaxImageSize) + "]");
   if (o.threads < 0 || o.threads > 1024)
     return makeError("--threads " + std::to_string(o.threads) + ": must be in [1, 1024]");
   if (o.orbit < 0 || o.orbit > 10000)
@@ -133,8 +140,8 @@ void Progress::loop() {
       bar = "[" + std::string(filled, '#') + std::string(width - filled, '.') + "] " +
             std::to_string(done_) + "/" + std::to_string(total_) + " ";
     }
-    std::fprintf(stderr, "\r\033[K%c %s%s  %.1fs", spinner[tick++ % 4], bar.c_str(),
-                 stage_.c_str(), elapsed);
+    std::fprintf(stderr, "\r\033[K%c %s%s  %.1fs", spinner[tick++ % 4], bar.c_str(), stage_.c_str(),
+                 elapsed);
     std::fflush(stderr);
     printed_ = true;
   }

@@ -9,8 +9,7 @@ float srgbToLinear(float encoded) {
 }
 
 float linearToSrgb(float linear) {
-  return linear <= 0.0031308f ? linear * 12.92f
-                              : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+  return linear <= 0.0031308f ? linear * 12.92f : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
 }
 
 ColorTables ColorTables::build() {

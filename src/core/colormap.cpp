@@ -31,7 +31,8 @@ glm::vec3 colormap(Colormap map, float t) {
       {-50.76852536473588f, 29.04658282127291f, 4.23415299384598f},
       {18.65570506591883f, -11.48977351997711f, -5.601961508734096f}};
   const glm::vec3* c = map == Colormap::Viridis ? viridis : magma;
-  const glm::vec3 v = c[0] + t * (c[1] + t * (c[2] + t * (c[3] + t * (c[4] + t * (c[5] + t * c[6])))));
+  const glm::vec3 v =
+      c[0] + t * (c[1] + t * (c[2] + t * (c[3] + t * (c[4] + t * (c[5] + t * c[6])))));
   return glm::clamp(v, glm::vec3(0.0f), glm::vec3(1.0f));
 }
 

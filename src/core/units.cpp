@@ -23,11 +23,16 @@ Result<uint64_t> parseByteSize(const std::string& text) {
     if (!std::isspace(static_cast<unsigned char>(text[j])))
       unit += static_cast<char>(std::tolower(static_cast<unsigned char>(text[j])));
   double scale = 0.0;
-  if (unit.empty() || unit == "b") scale = 1.0;
-  else if (unit == "k" || unit == "kb" || unit == "kib") scale = 1024.0;
-  else if (unit == "m" || unit == "mb" || unit == "mib") scale = 1024.0 * 1024.0;
-  else if (unit == "g" || unit == "gb" || unit == "gib") scale = 1024.0 * 1024.0 * 1024.0;
-  else return bad();
+  if (unit.empty() || unit == "b")
+    scale = 1.0;
+  else if (unit == "k" || unit == "kb" || unit == "kib")
+    scale = 1024.0;
+  else if (unit == "m" || unit == "mb" || unit == "mib")
+    scale = 1024.0 * 1024.0;
+  else if (unit == "g" || unit == "gb" || unit == "gib")
+    scale = 1024.0 * 1024.0 * 1024.0;
+  else
+    return bad();
   const double bytes = std::floor(value * scale);
   if (bytes < 1.0) return makeError("budget '" + text + "': must be at least 1 byte");
   if (bytes > 1024.0 * 1024.0 * 1024.0 * 1024.0)

@@ -4,7 +4,8 @@
 //   counted k     k(p) = min(n(p), k), exact memory from the count pass (K+B-SB, sec. 3.3); k as
 //                 for fixed k unless explicit;
 //   dynamic k     the largest global k whose exact memory fits M, read off the depth-complexity
-//                 histogram (dynamic k-buffer, [VPF15] as summarised by the variable k-buffer paper);
+//                 histogram (dynamic k-buffer, [VPF15] as summarised by the variable k-buffer
+//                 paper);
 //   importance    k(p) = floor(P(p) F(M)), P(p) = I(p) / sum I (variable k-buffer, Eqs. 1-2); the
 //                 fill variant gives every covered pixel one slot, the rest by importance capped
 //                 at n(p), and hands freed and remainder slots to the pixels with the largest unmet
@@ -21,7 +22,9 @@
 namespace mfr::detail {
 namespace {
 
-std::string bytesText(uint64_t b) { return std::to_string(b) + " B"; }
+std::string bytesText(uint64_t b) {
+  return std::to_string(b) + " B";
+}
 
 std::string sizeText(const RasterFrame& f) {
   return std::to_string(f.width()) + "x" + std::to_string(f.height());
@@ -30,10 +33,14 @@ std::string sizeText(const RasterFrame& f) {
 // Store of a pixel: the K+B-SB rule picks the heap when the pixel overflows and k > 16.
 StoreKind pickStore(StoreChoice choice, uint32_t n, uint32_t k) {
   switch (choice) {
-    case StoreChoice::Append: return StoreKind::Append;
-    case StoreChoice::MaxArray: return StoreKind::MaxArray;
-    case StoreChoice::MaxHeap: return StoreKind::MaxHeap;
-    default: return (n > k && k > 16) ? StoreKind::MaxHeap : StoreKind::MaxArray;
+    case StoreChoice::Append:
+      return StoreKind::Append;
+    case StoreChoice::MaxArray:
+      return StoreKind::MaxArray;
+    case StoreChoice::MaxHeap:
+      return StoreKind::MaxHeap;
+    default:
+      return (n > k && k > 16) ? StoreKind::MaxHeap : StoreKind::MaxArray;
   }
 }
 
@@ -121,14 +128,16 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
         if (!budget) return makeError(name + ": needs a budget or an explicit k");
         k = std::min<uint64_t>(slotsInBudget / pixels, 1u << 20);
         if (k == 0)
-          return makeError("budget " + bytesText(*budget) + ": too small for one fragment per "
-                           "pixel with " + name + " at " + sizeText(frame) + " (needs " +
+          return makeError("budget " + bytesText(*budget) +
+                           ": too small for one fragment per "
+                           "pixel with " +
+                           name + " at " + sizeText(frame) + " (needs " +
                            bytesText(overhead + pixels * kNodeBytes) + ")");
       }
       if (k == 0) return makeError(name + ": k must be at least 1");
       if (k * pixels > slotsInBudget)
-        return makeError("budget " + bytesText(*budget) + ": " + name + " with k = " +
-                         std::to_string(k) + " needs " +
+        return makeError("budget " + bytesText(*budget) + ": " + name +
+                         " with k = " + std::to_string(k) + " needs " +
                          bytesText(overhead + k * pixels * kNodeBytes) + " at " + sizeText(frame));
       a.globalK = static_cast<uint32_t>(k);
       a.slots = k * pixels;
@@ -152,8 +161,8 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
         // never above the largest n(p): a larger k buys nothing
         uint64_t maxN = 1;
         for (uint32_t c : n) maxN = std::max<uint64_t>(maxN, c);
-        const uint64_t kLimit = std::min<uint64_t>(
-            {method.k.value_or(kHistogramBins - 1), kHistogramBins - 1, maxN});
+        const uint64_t kLimit =
+            std::min<uint64_t>({method.k.value_or(kHistogramBins - 1), kHistogramBins - 1, maxN});
         for (uint64_t candidate = kLimit; candidate >= 1 && k == 0; --candidate) {
           uint64_t need = 0;
           for (uint64_t bin = 1; bin < kHistogramBins; ++bin)
@@ -161,16 +170,18 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
           if (need <= slotsInBudget) k = candidate;
         }
         if (k == 0)
-          return makeError("budget " + bytesText(*budget) + ": too small for one fragment per "
-                           "covered pixel with " + name + " at " + sizeText(frame) + " (needs " +
+          return makeError("budget " + bytesText(*budget) +
+                           ": too small for one fragment per "
+                           "covered pixel with " +
+                           name + " at " + sizeText(frame) + " (needs " +
                            bytesText(overhead + covered * kNodeBytes) + ")");
       }
       if (k == 0) return makeError(name + ": k must be at least 1");
       a.slots = sumCapped(k);
       if (a.slots > slotsInBudget)
-        return makeError("budget " + bytesText(*budget) + ": " + name + " with k = " +
-                         std::to_string(k) + " needs " + bytesText(overhead + a.slots * kNodeBytes) +
-                         " at " + sizeText(frame));
+        return makeError("budget " + bytesText(*budget) + ": " + name +
+                         " with k = " + std::to_string(k) + " needs " +
+                         bytesText(overhead + a.slots * kNodeBytes) + " at " + sizeText(frame));
       a.globalK = static_cast<uint32_t>(k);
       for (size_t p = 0; p < pixels; ++p)
         a.capacity[p] = static_cast<uint32_t>(std::min<uint64_t>(n[p], k));
@@ -179,8 +190,10 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
     case AllocationPolicy::Importance: {
       if (!budget) return makeError(name + ": needs a budget");
       if (slotsInBudget < covered)
-        return makeError("budget " + bytesText(*budget) + ": too small for one fragment per "
-                         "covered pixel with " + name + " at " + sizeText(frame) + " (needs " +
+        return makeError("budget " + bytesText(*budget) +
+                         ": too small for one fragment per "
+                         "covered pixel with " +
+                         name + " at " + sizeText(frame) + " (needs " +
                          bytesText(overhead + covered * kNodeBytes) + ")");
       double total = 0.0;
       for (float i : importance) total += i;
@@ -188,8 +201,8 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
       if (!method.fillUnusedSlots) {  // the paper's rule, Eq. 1
         if (total > 0.0)
           for (size_t p = 0; p < pixels; ++p)
-            k[p] = static_cast<uint64_t>(std::floor(importance[p] / total *
-                                                    static_cast<double>(slotsInBudget)));
+            k[p] = static_cast<uint64_t>(
+                std::floor(importance[p] / total * static_cast<double>(slotsInBudget)));
       } else {
         // fill: one slot for every covered pixel first (like DHOIT's allocation), the rest by
         // importance, capped at n(p), then the freed and remainder slots to the unmet pixels

@@ -104,9 +104,11 @@ struct CaptureSink {
     }
     Lock::lock(stores, p);
     FragmentNode evicted = 0;
-    switch (storeInsert<Access>(alloc.kind[p], s, stores.counts[p], alloc.capacity[p], node,
-                                evicted)) {
-      case InsertOutcome::Inserted: ++counters.inserted; break;
+    switch (
+        storeInsert<Access>(alloc.kind[p], s, stores.counts[p], alloc.capacity[p], node, evicted)) {
+      case InsertOutcome::Inserted:
+        ++counters.inserted;
+        break;
       case InsertOutcome::Replaced:
         ++counters.inserted;
         ++counters.evicted;
@@ -168,13 +170,15 @@ CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,
   const bool kplus = method.culling == CullingTest::KPlus;
   // one instantiation per combination, so each inner loop carries only the tests it needs
   if (hybrid) {
-    if (occ) return kplus ? runCapture<true, true, true>(frame, allocation, occupancy, mode, stores)
-                          : runCapture<true, true, false>(frame, allocation, occupancy, mode, stores);
+    if (occ)
+      return kplus ? runCapture<true, true, true>(frame, allocation, occupancy, mode, stores)
+                   : runCapture<true, true, false>(frame, allocation, occupancy, mode, stores);
     return kplus ? runCapture<true, false, true>(frame, allocation, occupancy, mode, stores)
                  : runCapture<true, false, false>(frame, allocation, occupancy, mode, stores);
   }
-  if (occ) return kplus ? runCapture<false, true, true>(frame, allocation, occupancy, mode, stores)
-                        : runCapture<false, true, false>(frame, allocation, occupancy, mode, stores);
+  if (occ)
+    return kplus ? runCapture<false, true, true>(frame, allocation, occupancy, mode, stores)
+                 : runCapture<false, true, false>(frame, allocation, occupancy, mode, stores);
   return kplus ? runCapture<false, false, true>(frame, allocation, occupancy, mode, stores)
                : runCapture<false, false, false>(frame, allocation, occupancy, mode, stores);
 }

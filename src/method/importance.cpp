@@ -26,21 +26,23 @@ ImportanceMaps computeImportance(int width, int height, const std::vector<uint32
   m.fresnel.assign(pixels, 0.0f);
   m.noise.assign(pixels, 0.0f);
   const glm::vec2 fovea = p.fovea.value_or(glm::vec2(width * 0.5f, height * 0.5f));
-  const float diagonal = 1.1f * std::sqrt(static_cast<float>(width) * width +
-                                          static_cast<float>(height) * height);
+  const float diagonal =
+      1.1f * std::sqrt(static_cast<float>(width) * width + static_cast<float>(height) * height);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const size_t i = static_cast<size_t>(y) * width + x;
       if (n[i] == 0) continue;
-      const float id = p.useDepth ? p.alpha + (1.0f - p.alpha) *
-                                                  std::min(1.0f, static_cast<float>(n[i]) / p.nLimit)
-                                  : 1.0f;
+      const float id =
+          p.useDepth
+              ? p.alpha + (1.0f - p.alpha) * std::min(1.0f, static_cast<float>(n[i]) / p.nLimit)
+              : 1.0f;
       const glm::vec2 centre(x + 0.5f, y + 0.5f);
       const float iper =
           p.usePeriphery
               ? 1.0f - std::pow(2.0f * glm::length(centre - fovea) / diagonal, p.peripheryExponent)
               : 1.0f;
-      const float cosine = previousCosine.empty() ? 1.0f : std::clamp(previousCosine[i], 0.0f, 1.0f);
+      const float cosine =
+          previousCosine.empty() ? 1.0f : std::clamp(previousCosine[i], 0.0f, 1.0f);
       const float ifr = p.useFresnel ? 1.0f - std::pow(1.0f - cosine, 5.0f) * 0.5f : 1.0f;
       const float noise = p.useNoise ? p.noise * (importanceNoise(p.seed, i) - 0.5f) : 0.0f;
       m.depth[i] = id;

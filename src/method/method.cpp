@@ -62,23 +62,36 @@ Result<MethodDesc> methodPreset(const std::string& fullName) {
 
 const char* toString(AllocationPolicy a) {
   switch (a) {
-    case AllocationPolicy::Unbounded: return "unbounded";
-    case AllocationPolicy::FixedK: return "fixed-k";
-    case AllocationPolicy::CountedK: return "counted-k";
-    case AllocationPolicy::DynamicK: return "dynamic-k";
-    default: return "importance";
+    case AllocationPolicy::Unbounded:
+      return "unbounded";
+    case AllocationPolicy::FixedK:
+      return "fixed-k";
+    case AllocationPolicy::CountedK:
+      return "counted-k";
+    case AllocationPolicy::DynamicK:
+      return "dynamic-k";
+    default:
+      return "importance";
   }
 }
 const char* toString(StoreChoice s) {
   switch (s) {
-    case StoreChoice::Append: return "append";
-    case StoreChoice::MaxArray: return "max-array";
-    case StoreChoice::MaxHeap: return "max-heap";
-    default: return "per-pixel";
+    case StoreChoice::Append:
+      return "append";
+    case StoreChoice::MaxArray:
+      return "max-array";
+    case StoreChoice::MaxHeap:
+      return "max-heap";
+    default:
+      return "per-pixel";
   }
 }
-const char* toString(CullingTest c) { return c == CullingTest::None ? "none" : "kplus"; }
-const char* toString(Compositing c) { return c == Compositing::KBuffer ? "kbuffer" : "hybrid"; }
+const char* toString(CullingTest c) {
+  return c == CullingTest::None ? "none" : "kplus";
+}
+const char* toString(Compositing c) {
+  return c == Compositing::KBuffer ? "kbuffer" : "hybrid";
+}
 
 Result<Compositing> parseCompositing(const std::string& text) {
   if (text == "kbuffer") return Compositing::KBuffer;

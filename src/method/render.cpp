@@ -124,8 +124,8 @@ std::vector<float> nearestCosine(const RasterFrame& frame) {
 std::vector<uint32_t> countFragments(const RasterFrame& frame) {
   std::vector<uint32_t> counts(frame.pixelCount(), 0);
   frame.forEachTile([&](int tile) {
-    frame.rasterizeTile<ShadeMode::Coverage>(
-        tile, CoverageSink{[&](uint32_t p, float) { ++counts[p]; }});
+    frame.rasterizeTile<ShadeMode::Coverage>(tile,
+                                             CoverageSink{[&](uint32_t p, float) { ++counts[p]; }});
   });
   return counts;
 }
@@ -198,9 +198,8 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   });
 
   // resolve
-  out.image = timer.run("resolve", [&] {
-    return resolve(frame, method, alloc, stores, options.background);
-  });
+  out.image = timer.run("resolve",
+                        [&] { return resolve(frame, method, alloc, stores, options.background); });
 
   // statistics
   stats.fragmentSlots = alloc.reservedSlots;

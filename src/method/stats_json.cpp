@@ -13,9 +13,8 @@ nlohmann::json statsToJson(const RenderStats& s) {
   j["fragments_captured"] = s.captured;
   j["fragments_lost"] = s.lost;
   j["fragments_lost_percent"] = s.lostPercent();
-  j["culled"] = {{"occupancy", s.culledOccupancy},
-                 {"kplus", s.culledKPlus},
-                 {"in_store", s.rejectedInStore}};
+  j["culled"] = {
+      {"occupancy", s.culledOccupancy}, {"kplus", s.culledKPlus}, {"in_store", s.rejectedInStore}};
   j["inserted"] = s.inserted;
   j["evicted"] = s.evicted;
   j["covered_pixels"] = s.coveredPixels;

@@ -18,7 +18,9 @@ int resolveThreads(int threads) {
   return hw > 0 ? static_cast<int>(hw) : 1;
 }
 
-int RasterFrame::arenaThreads() const { return std::min(threads_, resolveThreads(0)); }
+int RasterFrame::arenaThreads() const {
+  return std::min(threads_, resolveThreads(0));
+}
 
 namespace {
 
@@ -38,12 +40,18 @@ constexpr float kGuardBand = 8.0f;
 // Signed distances to the six clip planes (inside >= 0).
 inline float planeDistance(const glm::vec4& c, int plane) {
   switch (plane) {
-    case 0: return c.z + c.w;  // near
-    case 1: return c.w - c.z;  // far
-    case 2: return kGuardBand * c.w + c.x;
-    case 3: return kGuardBand * c.w - c.x;
-    case 4: return kGuardBand * c.w + c.y;
-    default: return kGuardBand * c.w - c.y;
+    case 0:
+      return c.z + c.w;  // near
+    case 1:
+      return c.w - c.z;  // far
+    case 2:
+      return kGuardBand * c.w + c.x;
+    case 3:
+      return kGuardBand * c.w - c.x;
+    case 4:
+      return kGuardBand * c.w + c.y;
+    default:
+      return kGuardBand * c.w - c.y;
   }
 }
 
@@ -107,8 +115,10 @@ bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVert
     if ((dy == 0 && dx > 0) || dy < 0) t.topLeft |= static_cast<uint8_t>(1u << i);
   }
   // pixel centres c*256+128 inside [min, max] of the fixed-point bounds
-  const int32_t minFx = std::min({t.x[0], t.x[1], t.x[2]}), maxFx = std::max({t.x[0], t.x[1], t.x[2]});
-  const int32_t minFy = std::min({t.y[0], t.y[1], t.y[2]}), maxFy = std::max({t.y[0], t.y[1], t.y[2]});
+  const int32_t minFx = std::min({t.x[0], t.x[1], t.x[2]}),
+                maxFx = std::max({t.x[0], t.x[1], t.x[2]});
+  const int32_t minFy = std::min({t.y[0], t.y[1], t.y[2]}),
+                maxFy = std::max({t.y[0], t.y[1], t.y[2]});
   auto ceilDiv = [](int64_t a, int64_t b) { return a >= 0 ? (a + b - 1) / b : -((-a) / b); };
   auto floorDiv = [](int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
   t.minX = static_cast<int32_t>(std::max<int64_t>(0, ceilDiv(minFx - 128, 256)));
@@ -158,8 +168,9 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
                             std::isfinite(c.up.x) && std::isfinite(c.up.y) && std::isfinite(c.up.z);
   if (!cameraFinite || glm::length(c.target - c.eye) <= 0.0f ||
       glm::length(glm::cross(c.target - c.eye, c.up)) <= 0.0f)
-    return makeError("camera: eye, target and up must be finite, eye != target, up not parallel "
-                     "to the view direction");
+    return makeError(
+        "camera: eye, target and up must be finite, eye != target, up not parallel "
+        "to the view direction");
   if (!(c.fovYDegrees > 0.0f && c.fovYDegrees < 180.0f))
     return makeError("camera: field of view must be in (0, 180) degrees");
   if (c.zNear < 0.0f || c.zFar < 0.0f || (c.zNear > 0.0f && c.zFar > 0.0f && c.zFar <= c.zNear))
@@ -247,10 +258,10 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   frame.binOffsets_.assign(static_cast<size_t>(frame.tileCount()) + 1, 0);
   auto forTiles = [&](const TriangleSetup& t, auto&& fn) {
     for (int ty = t.minY / tileSize; ty <= t.maxY / tileSize; ++ty)
-      for (int tx = t.minX / tileSize; tx <= t.maxX / tileSize; ++tx)
-        fn(ty * frame.tilesX_ + tx);
+      for (int tx = t.minX / tileSize; tx <= t.maxX / tileSize; ++tx) fn(ty * frame.tilesX_ + tx);
   };
-  for (const TriangleSetup& t : frame.setups_) forTiles(t, [&](int tile) { ++frame.binOffsets_[tile + 1]; });
+  for (const TriangleSetup& t : frame.setups_)
+    forTiles(t, [&](int tile) { ++frame.binOffsets_[tile + 1]; });
   for (size_t i = 1; i < frame.binOffsets_.size(); ++i)
     frame.binOffsets_[i] += frame.binOffsets_[i - 1];
   frame.binned_.resize(frame.binOffsets_.back());

@@ -27,7 +27,8 @@ Camera fitClipPlanes(const Camera& camera, const Bounds& bounds) {
   const glm::vec3 forward = glm::normalize(camera.target - camera.eye);
   const float centerDepth = glm::dot(bounds.center() - camera.eye, forward);
   if (fitted.zNear <= 0.0f) fitted.zNear = std::max(centerDepth - radius * 1.01f, radius * 1e-3f);
-  if (fitted.zFar <= 0.0f) fitted.zFar = std::max(centerDepth + radius * 1.01f, fitted.zNear * 2.0f);
+  if (fitted.zFar <= 0.0f)
+    fitted.zFar = std::max(centerDepth + radius * 1.01f, fitted.zNear * 2.0f);
   return fitted;
 }
 

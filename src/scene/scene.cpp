@@ -41,7 +41,8 @@ Result<void> validateScene(const Scene& scene) {
       return makeError(name + ": material index " + std::to_string(m) + " out of range");
   for (size_t i = 0; i < scene.positions.size(); ++i)
     if (!finite(scene.positions[i]))
-      return makeError(name + ": vertex " + std::to_string(i) + " has a NaN or infinite coordinate");
+      return makeError(name + ": vertex " + std::to_string(i) +
+                       " has a NaN or infinite coordinate");
   for (size_t i = 0; i < scene.normals.size(); ++i)
     if (!finite(scene.normals[i]))
       return makeError(name + ": normal " + std::to_string(i) + " is NaN or infinite");

@@ -33,9 +33,13 @@ enum class StoreKind : uint8_t { Append, MaxArray, MaxHeap };
 /// Plain memory access (one owner per pixel).
 struct PlainAccess {
   template <class T>
-  static T load(const T& v) { return v; }
+  static T load(const T& v) {
+    return v;
+  }
   template <class T>
-  static void store(T& v, T x) { v = x; }
+  static void store(T& v, T x) {
+    v = x;
+  }
   static uint32_t loadCount(const uint32_t& c) { return c; }
   static void publishCount(uint32_t& c, uint32_t x) { c = x; }
 };
@@ -50,7 +54,9 @@ struct AtomicAccess {
     return std::atomic_ref<T>(const_cast<T&>(v)).load(std::memory_order_relaxed);
   }
   template <class T>
-  static void store(T& v, T x) { std::atomic_ref<T>(v).store(x, std::memory_order_relaxed); }
+  static void store(T& v, T x) {
+    std::atomic_ref<T>(v).store(x, std::memory_order_relaxed);
+  }
   static uint32_t loadCount(const uint32_t& c) {
     return std::atomic_ref<uint32_t>(const_cast<uint32_t&>(c)).load(std::memory_order_acquire);
   }
@@ -159,9 +165,12 @@ template <class Access = PlainAccess>
 inline InsertOutcome storeInsert(StoreKind kind, FragmentNode* slots, uint32_t& count,
                                  uint32_t capacity, FragmentNode node, FragmentNode& evicted) {
   switch (kind) {
-    case StoreKind::Append: return appendInsert(slots, count, node);
-    case StoreKind::MaxArray: return maxArrayInsert<Access>(slots, count, capacity, node, evicted);
-    default: return maxHeapInsert<Access>(slots, count, capacity, node, evicted);
+    case StoreKind::Append:
+      return appendInsert(slots, count, node);
+    case StoreKind::MaxArray:
+      return maxArrayInsert<Access>(slots, count, capacity, node, evicted);
+    default:
+      return maxHeapInsert<Access>(slots, count, capacity, node, evicted);
   }
 }
 

@@ -4,8 +4,8 @@
 // Per pixel, three passes before the capture:
 //   depth range: nearest and farthest fragment depth zn, zf (a Coverage raster pass);
 //   fill:        bit j of the pixel's S = 32*d bucket bitmap is set when a fragment falls into
-//                bucket j = min(S-1, floor((z - zn) / (zf - zn) * S))   (j = 0 when zf == zn, so the
-//                far bound maps to the last bucket and a zero range does not divide by zero);
+//                bucket j = min(S-1, floor((z - zn) / (zf - zn) * S))   (j = 0 when zf == zn, so
+//                the far bound maps to the last bucket and a zero range does not divide by zero);
 //   count:       Kernighan's bit counting walks the occupied buckets to the k(p)-th one, j_k.
 // The capture then rejects every fragment whose bucket is beyond j_k. The bucket function is
 // monotone in z and shared by fill and test, so every one of the k nearest fragments lies

@@ -51,8 +51,12 @@ inline uint8_t encodeSrgb8(const ColorTables& t, float linear) {
   code -= c < t.lowerBound[code];
   return static_cast<uint8_t>(code);
 }
-inline uint8_t encodeSrgb8(float linear) { return encodeSrgb8(ColorTables::get(), linear); }
-inline float decodeSrgb8(uint8_t code) { return ColorTables::get().srgb8ToLinear[code]; }
+inline uint8_t encodeSrgb8(float linear) {
+  return encodeSrgb8(ColorTables::get(), linear);
+}
+inline float decodeSrgb8(uint8_t code) {
+  return ColorTables::get().srgb8ToLinear[code];
+}
 
 inline uint8_t unorm8(float v) {
   const float c = saturate(v);

@@ -52,22 +52,24 @@ class [[nodiscard]] Result<void> {
   bool ok_ = true;
 };
 
-inline Error makeError(std::string message) { return Error{std::move(message)}; }
+inline Error makeError(std::string message) {
+  return Error{std::move(message)};
+}
 
 }  // namespace mfr
 
 /// Always-on check of a programmer invariant (not of user input).
-#define MFR_CHECK(cond)                                                                 \
-  do {                                                                                  \
-    if (!(cond)) {                                                                      \
+#define MFR_CHECK(cond)                                                                      \
+  do {                                                                                       \
+    if (!(cond)) {                                                                           \
       std::fprintf(stderr, "%s:%d: internal check failed: %s\n", __FILE__, __LINE__, #cond); \
-      std::abort();                                                                     \
-    }                                                                                   \
+      std::abort();                                                                          \
+    }                                                                                        \
   } while (0)
 
 /// Propagate an error from an expression returning Result<...>.
-#define MFR_TRY(expr)                         \
-  do {                                        \
-    auto&& mfr_try_result_ = (expr);          \
+#define MFR_TRY(expr)                                     \
+  do {                                                    \
+    auto&& mfr_try_result_ = (expr);                      \
     if (!mfr_try_result_) return mfr_try_result_.error(); \
   } while (0)

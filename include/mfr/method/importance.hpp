@@ -1,11 +1,9 @@
 // Importance maps of the variable k-buffer (Vasilakis, Vardis, Papaioannou, Moustakas, "Variable
 // k-buffer using Importance Maps", sec. 3.2, Eqs. 3-6):
-//   I_d   = alpha + (1 - alpha) * min(1, n(p) / N_limit)                       (3) depth complexity
-//   I_per = 1 - (2 |p - o| / (1.1 sqrt(w^2 + h^2)))^d                          (4) periphery
-//   I_f   = 1 - (1 - n_prev . e)^5 / 2                                          (5) Fresnel, nearest
-//                                                                                   fragment of the
-//                                                                                   previous frame
-//   I     = max(0, I_per * I_d * I_f + lambda * (xi - 0.5))                     (6) noise
+//   (3) depth complexity  I_d   = alpha + (1 - alpha) * min(1, n(p) / N_limit)
+//   (4) periphery         I_per = 1 - (2 |p - o| / (1.1 sqrt(w^2 + h^2)))^d
+//   (5) Fresnel           I_f   = 1 - (1 - n_prev . e)^5 / 2   (nearest fragment, previous frame)
+//   (6) with noise        I     = max(0, I_per * I_d * I_f + lambda * (xi - 0.5))
 // Pixels without fragments get I = 0 (they need no storage). Each factor can be switched off
 // (it then contributes 1, or 0 for the noise).
 #pragma once
@@ -19,12 +17,12 @@
 namespace mfr {
 
 struct ImportanceParams {
-  float alpha = 0.375f;         // Eq. 3 range bias (paper: 0.25-0.5)
-  float nLimit = 20.0f;         // Eq. 3 anticipated maximum layer count (paper: 20-30)
-  float peripheryExponent = 3;  // Eq. 4 d
+  float alpha = 0.375f;            // Eq. 3 range bias (paper: 0.25-0.5)
+  float nLimit = 20.0f;            // Eq. 3 anticipated maximum layer count (paper: 20-30)
+  float peripheryExponent = 3;     // Eq. 4 d
   std::optional<glm::vec2> fovea;  // Eq. 4 o in pixels (default: image centre)
-  float noise = 0.1f;           // Eq. 6 lambda
-  uint64_t seed = 1;            // Eq. 6 xi
+  float noise = 0.1f;              // Eq. 6 lambda
+  uint64_t seed = 1;               // Eq. 6 xi
   bool useDepth = true, usePeriphery = true, useFresnel = true, useNoise = true;
 };
 

@@ -4,14 +4,18 @@
 // overhead S_p of the method (over all |P| = width * height pixels: full-screen buffers) and its
 // image-level overhead S_i are paid. Per-pixel words by component:
 //
-//   counter   4 B  fragments stored so far (also the count pass's counter)    every method
-//   offset    4 B  first slot of the pixel's region (prefix sum)        abuffer, kplus-sb, dynamic, vkb
-//   lock      4 B  spin-lock semaphore                k+-buffer family, vkb; any method captured
-//                  fragment-parallel (it stands in for fkb's / the A-buffer's GPU atomics)
-//   occupancy 12 + 4d B  zn, zf, k-th bucket, 32d-bit bitmap                 +occupancy
-//   tail      20 B  hybrid tail: sum(alpha * rgb) 3 x f32, sum(alpha) f32, count u32   hybrid
-//   previous  1 B  |n.v| of the previous frame's nearest fragment, unorm8    vkb (Fresnel term)
-//   image     4096 B  depth-complexity histogram, 1024 x u32                 kplus-dynamic
+//   word       bytes   what                                           who
+//   counter    4       fragments stored so far (the count pass's too)  every method
+//   offset     4       first slot of the pixel's region (prefix sum)   abuffer, kplus-sb, dynamic,
+//                                                                      vkb
+//   lock       4       spin-lock semaphore                             k+ family, vkb; any method
+//                                                                      in fragment-parallel mode
+//                                                                      (for fkb / abuffer it stands
+//                                                                      in for the GPU's atomics)
+//   occupancy  12+4d   zn, zf, k-th bucket, 32d-bit bitmap             +occupancy
+//   tail       20      sum(alpha rgb) 3 x f32, sum(alpha) f32, u32 t   hybrid
+//   previous   1       |n.v| of the previous frame's nearest, unorm8   vkb (Fresnel term)
+//   image      4096    depth-complexity histogram, 1024 x u32          kplus-dynamic (per image)
 // The variable k-buffer's importance map lives in the offset word (importance, then k(p), then the
 // prefix sum, computed in place), so it costs no extra bytes; the count pass's n(p) is the counter.
 //
@@ -46,7 +50,7 @@ inline constexpr uint64_t kHistogramBins = 1024;
 
 struct MemoryModel {
   uint64_t counter = 4, offset = 0, lock = 0, occupancy = 0, tail = 0, previous = 0;  // per pixel
-  uint64_t image = 0;                                                   // bytes per image
+  uint64_t image = 0;  // bytes per image
 
   /// `fragmentParallel`: methods without a lock word of their own (fkb, abuffer) need one per
   /// pixel when fragments of a pixel arrive from several threads (it stands in for the GPU's

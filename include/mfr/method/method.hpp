@@ -16,16 +16,16 @@ namespace mfr {
 
 /// How many fragment slots each pixel gets.
 enum class AllocationPolicy : uint8_t {
-  Unbounded,  // count pass, exact slots for every fragment (A-buffer / S-buffer)
-  FixedK,     // the same k pre-allocated for every pixel (k-buffer, k+-buffer)
-  CountedK,   // count pass capped at k, prefix-sum offsets, exact memory (K+B-SB)
-  DynamicK,   // largest global k whose exact memory fits the budget, from the histogram
-  Importance, // k(p) = floor(P(p) F(M)) from an importance map (variable k-buffer)
+  Unbounded,   // count pass, exact slots for every fragment (A-buffer / S-buffer)
+  FixedK,      // the same k pre-allocated for every pixel (k-buffer, k+-buffer)
+  CountedK,    // count pass capped at k, prefix-sum offsets, exact memory (K+B-SB)
+  DynamicK,    // largest global k whose exact memory fits the budget, from the histogram
+  Importance,  // k(p) = floor(P(p) F(M)) from an importance map (variable k-buffer)
 };
 
 /// Which store holds a pixel's fragments.
 enum class StoreChoice : uint8_t {
-  Append,    // exact-size arrays (only with Unbounded)
+  Append,  // exact-size arrays (only with Unbounded)
   MaxArray,
   MaxHeap,
   PerPixel,  // K+B-SB rule: max-heap when n(p) > k(p) and k(p) > 16, else max-array
@@ -49,7 +49,7 @@ struct MethodDesc {
   bool perPixelLock = false;  // spin-lock word per pixel (k+-buffer family)
   int occupancyWords = 0;     // 0: no occupancy culling; d > 0: 32*d buckets
   Compositing compositing = Compositing::KBuffer;
-  std::optional<uint32_t> k;  // explicit k (otherwise derived from the budget)
+  std::optional<uint32_t> k;    // explicit k (otherwise derived from the budget)
   ImportanceParams importance;  // Importance allocation only
   /// Importance allocation: one slot for every covered pixel, the rest by importance capped at
   /// n(p), and the freed and floor() remainder slots to the pixels with the largest unmet

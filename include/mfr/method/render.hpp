@@ -55,8 +55,8 @@ struct RenderStats {
   uint64_t captured = 0;  // fragments in the final cores
   uint64_t lost = 0;      // generated - captured
   uint64_t coveredPixels = 0;
-  uint32_t kMin = 0, kMax = 0;  // slots over covered pixels
-  std::optional<uint32_t> globalK;  // fixed / counted / dynamic k
+  uint32_t kMin = 0, kMax = 0;                 // slots over covered pixels
+  std::optional<uint32_t> globalK;             // fixed / counted / dynamic k
   std::optional<uint32_t> maxDepthComplexity;  // when a count pass ran
   std::optional<double> meanDepthComplexity;   // over covered pixels
   std::vector<PassTime> passes;
@@ -67,8 +67,8 @@ struct RenderStats {
 };
 
 struct RenderOutput {
-  ImageRGB image;                       // linear RGB, composited over the background
-  std::vector<uint32_t> kMap;           // slots per pixel
+  ImageRGB image;                         // linear RGB, composited over the background
+  std::vector<uint32_t> kMap;             // slots per pixel
   std::vector<uint32_t> depthComplexity;  // n(p), when a count pass ran (else empty)
   ImportanceMaps importance;              // importance allocation only
   std::vector<float> nearestCosine;       // importance allocation: this frame's nearest |n.v|

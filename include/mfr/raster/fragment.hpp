@@ -25,11 +25,15 @@ using FragmentNode = uint64_t;
 inline FragmentNode makeNode(float depth, uint32_t rgba) {
   return (static_cast<uint64_t>(std::bit_cast<uint32_t>(depth)) << 32) | rgba;
 }
-inline FragmentNode makeNode(const Fragment& f) { return makeNode(f.depth, f.rgba); }
+inline FragmentNode makeNode(const Fragment& f) {
+  return makeNode(f.depth, f.rgba);
+}
 inline float nodeDepth(FragmentNode node) {
   return std::bit_cast<float>(static_cast<uint32_t>(node >> 32));
 }
-inline uint32_t nodeColor(FragmentNode node) { return static_cast<uint32_t>(node); }
+inline uint32_t nodeColor(FragmentNode node) {
+  return static_cast<uint32_t>(node);
+}
 
 /// The "empty" node: farther than any real fragment (depth bits of +inf).
 inline constexpr FragmentNode kFarNode = 0x7f800000ull << 32;

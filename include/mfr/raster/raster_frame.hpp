@@ -2,7 +2,8 @@
 //   - pixel centres at (x + 0.5, y + 0.5); vertices snapped to 1/256 pixel (8 sub-pixel bits);
 //   - a fill rule that covers a pixel centre on a shared edge exactly once (top-left in the image's
 //     y-down coordinates, which is GL's lower-left-origin rule seen upside down);
-//   - clipping in homogeneous clip space against near and far (z = -w, z = w) and an x/y guard band;
+//   - clipping in homogeneous clip space against near and far (z = -w, z = w) and an x/y
+//     guard band;
 //   - perspective-correct attributes, depth = window z in [0, 1] interpolated linearly in screen;
 //   - no back-face culling (transparent geometry shows both sides).
 // Set-up transforms, clips and bins the triangles once per frame into square tiles; every capture
@@ -47,13 +48,13 @@ struct ShadeMaterial {
 
 /// Everything the inner loop needs of one (clipped) screen-space triangle.
 struct TriangleSetup {
-  int32_t x[3], y[3];            // fixed-point window coordinates (1/256 px), y down, area > 0
+  int32_t x[3], y[3];              // fixed-point window coordinates (1/256 px), y down, area > 0
   int32_t minX, minY, maxX, maxY;  // inclusive pixel bounds of covered centres, clamped to viewport
-  float z[3];                    // window depth
-  float invW[3];                 // 1 / clip w
-  glm::vec3 normalW[3];          // view-space normal / w
-  glm::vec2 uvW[3];              // uv / w
-  float invArea;                 // 1 / (twice the fixed-point area)
+  float z[3];                      // window depth
+  float invW[3];                   // 1 / clip w
+  glm::vec3 normalW[3];            // view-space normal / w
+  glm::vec2 uvW[3];                // uv / w
+  float invArea;                   // 1 / (twice the fixed-point area)
   uint32_t prim;
   uint32_t material;
   uint8_t topLeft;  // bit i set: edge opposite vertex i is a top or left edge

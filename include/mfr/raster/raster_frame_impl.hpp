@@ -93,8 +93,9 @@ template <ShadeMode Mode>
   return true;
 }
 
-[[gnu::always_inline]] inline void RasterFrame::shade(const TriangleSetup& t, float l0, float l1, float l2, int px,
-                               int py, const glm::vec4& base, Fragment& f) const {
+[[gnu::always_inline]] inline void RasterFrame::shade(const TriangleSetup& t, float l0, float l1,
+                                                      float l2, int px, int py,
+                                                      const glm::vec4& base, Fragment& f) const {
   // headlight: the light sits at the eye, so diffuse = |n.v| (scalar code: glm's vec3 is not
   // vectorised and this is the hottest loop of every capture pass)
   const float nx = t.normalW[0].x * l0 + t.normalW[1].x * l1 + t.normalW[2].x * l2;

@@ -35,7 +35,8 @@ std::vector<Camera> orbit(const Camera& camera, int views);
 glm::mat4 viewMatrix(const Camera& camera);
 glm::mat4 projectionMatrix(const Camera& camera, int width, int height);
 
-/// World-space ray through the centre of pixel (x, y) (row 0 at the top): origin and unit direction.
+/// World-space ray through the centre of pixel (x, y) (row 0 at the top): origin and unit
+/// direction.
 struct Ray {
   glm::vec3 origin;
   glm::vec3 direction;

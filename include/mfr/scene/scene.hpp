@@ -47,7 +47,7 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Texture> textures;
 
-  std::vector<Camera> cameras;  // cameras the file defines (may be empty)
+  std::vector<Camera> cameras;          // cameras the file defines (may be empty)
   std::optional<Camera> defaultCamera;  // procedural scenes frame themselves
 
   glm::vec3 background{1.0f, 1.0f, 1.0f};  // linear RGB behind everything
