@@ -160,7 +160,10 @@ TEST(FragmentNode, OrderIsDepthThenColor) {
   EXPECT_TRUE(makeNode(1.0f, 0xffffffffu) < kFarNode);
 }
 
-TEST(BoundedStores, KeepExactlyTheKNearestOfAnyStream) {
+// Runs every store kind, capacity, seed, arrival order and k+ setting over its random stream and
+// hands the outcome to `check(k, stream, run, what)`; stops at the first fatal failure.
+template <class Check>
+void forEveryStreamCase(Check&& check) {
   for (const StoreKind kind : {StoreKind::MaxArray, StoreKind::MaxHeap})
     for (const uint32_t k : kCapacities)
       for (uint32_t seed = 0; seed < kSeeds; ++seed)
@@ -170,41 +173,41 @@ TEST(BoundedStores, KeepExactlyTheKNearestOfAnyStream) {
             const std::string what = label(kind, k, seed, order, kplus);
             StoreRun run;
             runStream(kind, k, stream, kplus, what, run);
-            if (HasFatalFailure()) return;
-            std::vector<FragmentNode> expected = stream;
-            const size_t keep = std::min<size_t>(k, stream.size());
-            std::partial_sort(expected.begin(), expected.begin() + keep, expected.end());
-            expected.resize(keep);
-            ASSERT_EQ(sortedByDepthThenColor(run.kept), expected) << what;
+            if (::testing::Test::HasFatalFailure()) return;
+            check(k, stream, run, what);
+            if (::testing::Test::HasFatalFailure()) return;
           }
 }
 
+TEST(BoundedStores, KeepExactlyTheKNearestOfAnyStream) {
+  forEveryStreamCase([](uint32_t k, const std::vector<FragmentNode>& stream, const StoreRun& run,
+                        const std::string& what) {
+    std::vector<FragmentNode> expected = stream;
+    const size_t keep = std::min<size_t>(k, stream.size());
+    std::partial_sort(expected.begin(), expected.begin() + keep, expected.end());
+    expected.resize(keep);
+    ASSERT_EQ(sortedByDepthThenColor(run.kept), expected) << what;
+  });
+}
+
 TEST(BoundedStores, KeptEvictedAndRejectedNodesPartitionTheStream) {
-  for (const StoreKind kind : {StoreKind::MaxArray, StoreKind::MaxHeap})
-    for (const uint32_t k : kCapacities)
-      for (uint32_t seed = 0; seed < kSeeds; ++seed)
-        for (const Order order : {Order::Random, Order::Ascending, Order::Descending})
-          for (const bool kplus : {false, true}) {
-            const std::vector<FragmentNode> stream = randomStream(seed, k, order);
-            const std::string what = label(kind, k, seed, order, kplus);
-            StoreRun run;
-            runStream(kind, k, stream, kplus, what, run);
-            if (HasFatalFailure()) return;
-            std::vector<FragmentNode> all = run.kept;
-            all.insert(all.end(), run.evicted.begin(), run.evicted.end());
-            all.insert(all.end(), run.rejected.begin(), run.rejected.end());
-            std::vector<FragmentNode> input = stream;
-            std::sort(all.begin(), all.end());
-            std::sort(input.begin(), input.end());
-            ASSERT_EQ(all, input) << what;
-            // nothing leaves a store that belongs to the k nearest
-            const size_t keep = std::min<size_t>(k, stream.size());
-            if (keep > 0) {
-              const FragmentNode kth = input[keep - 1];
-              for (const FragmentNode n : run.evicted) ASSERT_FALSE(nearer(n, kth)) << what;
-              for (const FragmentNode n : run.rejected) ASSERT_FALSE(nearer(n, kth)) << what;
-            }
-          }
+  forEveryStreamCase([](uint32_t k, const std::vector<FragmentNode>& stream, const StoreRun& run,
+                        const std::string& what) {
+    std::vector<FragmentNode> all = run.kept;
+    all.insert(all.end(), run.evicted.begin(), run.evicted.end());
+    all.insert(all.end(), run.rejected.begin(), run.rejected.end());
+    std::vector<FragmentNode> input = stream;
+    std::sort(all.begin(), all.end());
+    std::sort(input.begin(), input.end());
+    ASSERT_EQ(all, input) << what;
+    // nothing leaves a store that belongs to the k nearest
+    const size_t keep = std::min<size_t>(k, stream.size());
+    if (keep > 0) {
+      const FragmentNode kth = input[keep - 1];
+      for (const FragmentNode n : run.evicted) ASSERT_FALSE(nearer(n, kth)) << what;
+      for (const FragmentNode n : run.rejected) ASSERT_FALSE(nearer(n, kth)) << what;
+    }
+  });
 }
 
 TEST(BoundedStores, DescendingStreamEvictsOnEveryInsertionOnceFull) {
