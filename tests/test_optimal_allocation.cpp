@@ -6,7 +6,10 @@
 
 #include "mfr/core/color.hpp"
 #include "mfr/method/compositing.hpp"
+#include "mfr/method/memory_model.hpp"
 #include "mfr/method/optimal_allocation.hpp"
+#include "mfr/method/render.hpp"
+#include "mfr/scene/load.hpp"
 
 namespace mfr {
 namespace {
@@ -136,6 +139,50 @@ TEST(OptimalAllocation, PublishedGreedyIsNotOptimalOnThisCounterexample) {
   EXPECT_NEAR(best, 0.30, 1e-12);
   EXPECT_NEAR(greedy, 0.45, 1e-12);
   EXPECT_NEAR(hull, best, 1e-12);
+}
+
+double linearMse(const ImageRGB& a, const ImageRGB& b) {
+  double sum = 0.0;
+  for (size_t i = 0; i < a.pixels.size(); ++i) {
+    const glm::vec3 d = a.pixels[i] - b.pixels[i];
+    sum += glm::dot(d, d);
+  }
+  return sum / (3.0 * a.pixels.size());
+}
+
+TEST(OptimalPreset, BeatsTheOtherAllocationsWithinTheSameBudget) {
+  auto scene = loadScene("procedural:hairball?strands=300");
+  ASSERT_TRUE(scene.ok());
+  RasterOptions ro{96, 96, 16, 2};
+  auto frame = RasterFrame::build(*scene, *scene->defaultCamera, ro);
+  const RenderOutput truth = *render(*frame, methodPreset("abuffer").value(), {});
+  RenderOptions o;
+  o.budgetBytes = 400000;
+  auto run = [&](const std::string& name) {
+    MethodDesc m = methodPreset(name).value();
+    m.compositing = Compositing::Hybrid;
+    auto out = render(*frame, m, o);
+    EXPECT_TRUE(out.ok()) << name << ": " << (out.ok() ? "" : out.error().message);
+    return std::move(out.value());
+  };
+  const RenderOutput optimal = run("optimal"), greedy = run("optimal-greedy");
+  const RenderOutput dynamic = run("kplus-dynamic"), fill = run("vkb-fill");
+  const uint64_t slots =
+      MemoryModel::of(methodPreset("optimal").value()).fragmentSlots(400000, 96 * 96);
+  uint64_t sumK = 0;
+  for (size_t p = 0; p < optimal.kMap.size(); ++p) {
+    sumK += optimal.kMap[p];
+    if (truth.depthComplexity[p] > 0) {
+      EXPECT_GE(optimal.kMap[p], 1u);
+    }
+  }
+  EXPECT_LE(sumK, slots);
+  EXPECT_LE(optimal.stats.bytesUsed, 400000u);
+  const double eOptimal = linearMse(optimal.image, truth.image);
+  EXPECT_GT(eOptimal, 0.0);
+  EXPECT_LT(eOptimal, linearMse(dynamic.image, truth.image));
+  EXPECT_LT(eOptimal, linearMse(fill.image, truth.image));
+  EXPECT_LT(linearMse(greedy.image, truth.image), linearMse(dynamic.image, truth.image));
 }
 
 }  // namespace

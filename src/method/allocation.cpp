@@ -10,6 +10,7 @@
 //                 fill variant gives every covered pixel one slot, the rest by importance capped
 //                 at n(p), and hands freed and remainder slots to the pixels with the largest unmet
 //                 importance;
+//   optimal       k(p) from the offline oracle (optimal_allocation.hpp) over an A-buffer pre-pass;
 //   unbounded     k(p) = n(p) (A-buffer / S-buffer).
 // Offsets are an exclusive prefix sum of k(p) in tile-major order (the S-buffer's clustering of
 // pixels by tiles, for locality).
@@ -90,7 +91,8 @@ void fillByImportance(const std::vector<uint32_t>& n, const std::vector<float>& 
 
 Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
                             const MemoryModel& memory, std::optional<uint64_t> budget,
-                            const std::vector<uint32_t>& n, const std::vector<float>& importance) {
+                            const std::vector<uint32_t>& n, const std::vector<float>& importance,
+                            const std::vector<uint32_t>& oracleK) {
   const uint64_t pixels = frame.pixelCount();
   const uint64_t overhead = memory.overhead(pixels);
   const std::string& name = method.name;
@@ -223,6 +225,21 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
         a.slots += a.capacity[p];
       }
       MFR_CHECK(a.reservedSlots <= slotsInBudget);
+      break;
+    }
+    case AllocationPolicy::Optimal: {  // k(p) chosen by the oracle (render.cpp) within F(M)
+      if (!budget) return makeError(name + ": needs a budget");
+      if (slotsInBudget < covered)
+        return makeError("budget " + bytesText(*budget) +
+                         ": too small for one fragment per "
+                         "covered pixel with " +
+                         name + " at " + sizeText(frame) + " (needs " +
+                         bytesText(overhead + covered * kNodeBytes) + ")");
+      for (size_t p = 0; p < pixels; ++p) {
+        a.capacity[p] = oracleK[p];
+        a.slots += oracleK[p];
+      }
+      MFR_CHECK(a.slots <= slotsInBudget);
       break;
     }
   }

@@ -3,8 +3,8 @@
 namespace mfr {
 
 std::vector<std::string> presetNames() {
-  return {"zbuffer",  "abuffer",       "fkb", "kplus-array", "kplus-heap",
-          "kplus-sb", "kplus-dynamic", "vkb", "vkb-fill"};
+  return {"zbuffer",       "abuffer", "fkb",      "kplus-array", "kplus-heap",    "kplus-sb",
+          "kplus-dynamic", "vkb",     "vkb-fill", "optimal",     "optimal-greedy"};
 }
 
 Result<MethodDesc> methodPreset(const std::string& fullName) {
@@ -46,6 +46,13 @@ Result<MethodDesc> methodPreset(const std::string& fullName) {
     m.culling = CullingTest::KPlus;
     m.perPixelLock = true;
     m.fillUnusedSlots = name == "vkb-fill";
+  } else if (name == "optimal" || name == "optimal-greedy") {
+    m.allocation = AllocationPolicy::Optimal;
+    m.store = StoreChoice::PerPixel;
+    m.culling = CullingTest::KPlus;
+    m.perPixelLock = true;
+    m.compositing = Compositing::Hybrid;  // the oracle minimises the hybrid error
+    m.publishedGreedy = name == "optimal-greedy";
   } else {
     std::string known;
     for (const std::string& n : presetNames()) known += (known.empty() ? "" : ", ") + n;

@@ -30,7 +30,8 @@ struct Allocation {
 Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
                             const MemoryModel& memory, std::optional<uint64_t> budget,
                             const std::vector<uint32_t>& fragmentCounts,
-                            const std::vector<float>& importance);
+                            const std::vector<float>& importance,
+                            const std::vector<uint32_t>& oracleK);
 
 struct CaptureCounters {
   uint64_t generated = 0, culledOccupancy = 0, culledKPlus = 0, rejected = 0, inserted = 0,

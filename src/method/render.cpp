@@ -10,6 +10,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "mfr/method/optimal_allocation.hpp"
 #include "pipeline.hpp"
 
 namespace mfr {
@@ -96,6 +97,38 @@ ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method,
   return image;
 }
 
+// The optimal k-buffer's pre-pass: n(p) and the k(p) of the allocator over hybrid error curves.
+Result<std::pair<std::vector<uint32_t>, std::vector<uint32_t>>> optimalK(
+    const RasterFrame& frame, const MethodDesc& method, const RenderOptions& options,
+    uint64_t slots) {
+  RenderOptions exact;
+  exact.keepStores = true;
+  exact.background = options.background;
+  auto truth = render(frame, methodPreset("abuffer").value(), exact);
+  if (!truth) return truth.error();
+  const size_t pixels = frame.pixelCount();
+  std::vector<std::vector<double>> curves(pixels);
+  uint64_t covered = 0;
+  for (uint32_t c : truth->depthComplexity) covered += c > 0;
+  if (slots < covered)
+    return std::make_pair(std::move(truth->depthComplexity), std::vector<uint32_t>());
+  frame.forEachTile([&](int tile) {
+    const TileRect r = frame.tileRect(tile);
+    std::vector<FragmentNode> local;
+    for (int y = r.y0; y <= r.y1; ++y)
+      for (int x = r.x0; x <= r.x1; ++x) {
+        const size_t p = static_cast<size_t>(y) * frame.width() + x;
+        const FragmentNode* first = truth->nodes.data() + truth->offsets[p];
+        local.assign(first, first + truth->counts[p]);
+        std::sort(local.begin(), local.end());
+        curves[p] = hybridErrorCurve(local.data(), truth->counts[p], options.background);
+      }
+  });
+  std::vector<uint32_t> k = method.publishedGreedy ? allocateOptimalGreedy(curves, slots)
+                                                   : allocateOptimalHull(curves, slots);
+  return std::make_pair(std::move(truth->depthComplexity), std::move(k));
+}
+
 }  // namespace
 
 double RenderStats::totalMs() const {
@@ -148,7 +181,9 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
       MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
 
   // count pass
-  if (method.allocation != AllocationPolicy::FixedK)
+  // (the optimal oracle counts in its own A-buffer pre-pass)
+  if (method.allocation != AllocationPolicy::FixedK &&
+      !(method.allocation == AllocationPolicy::Optimal && options.budgetBytes))
     out.depthComplexity = timer.run("count", [&] { return countFragments(frame); });
 
   // importance (variable k-buffer): the previous frame's nearest |n.v| (a preceding frame from
@@ -165,10 +200,20 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
     });
   }
 
+  // optimal k-buffer (offline oracle): exact A-buffer, per-pixel hybrid error curves, allocation
+  std::vector<uint32_t> oracleK;
+  if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes) {
+    const uint64_t slots = memory.fragmentSlots(*options.budgetBytes, pixels);
+    auto chosen = timer.run("oracle", [&] { return optimalK(frame, method, options, slots); });
+    if (!chosen) return chosen.error();
+    out.depthComplexity = std::move(chosen->first);
+    oracleK = std::move(chosen->second);
+  }
+
   // allocate
   auto allocated = timer.run("allocate", [&] {
     return detail::allocate(frame, method, memory, options.budgetBytes, out.depthComplexity,
-                            out.importance.importance);
+                            out.importance.importance, oracleK);
   });
   if (!allocated) return allocated.error();
   detail::Allocation& alloc = allocated.value();

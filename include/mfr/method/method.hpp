@@ -21,6 +21,7 @@ enum class AllocationPolicy : uint8_t {
   CountedK,    // count pass capped at k, prefix-sum offsets, exact memory (K+B-SB)
   DynamicK,    // largest global k whose exact memory fits the budget, from the histogram
   Importance,  // k(p) = floor(P(p) F(M)) from an importance map (variable k-buffer)
+  Optimal,     // offline oracle: k(p) minimising the hybrid error from an exact A-buffer pre-pass
 };
 
 /// Which store holds a pixel's fragments.
@@ -55,10 +56,12 @@ struct MethodDesc {
   /// n(p), and the freed and floor() remainder slots to the pixels with the largest unmet
   /// importance (vkb-fill), instead of the paper's exact rule.
   bool fillUnusedSlots = false;
+  /// Optimal allocation: DHOIT's Algorithm 1 as published instead of the convex-hull allocator.
+  bool publishedGreedy = false;
 };
 
 /// Preset names: zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, vkb,
-/// vkb-fill, each bounded one optionally followed by "+occupancy".
+/// vkb-fill, optimal, optimal-greedy, each bounded one optionally followed by "+occupancy".
 std::vector<std::string> presetNames();
 
 /// Looks up a preset ("kplus-heap", "fkb+occupancy", ...). Errors list the known names.
