@@ -113,6 +113,12 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
   };
   uint64_t covered = 0;
   for (uint32_t c : n) covered += c > 0;
+  // the budget cannot give one node to every (covered) pixel
+  auto tooSmall = [&](const char* which, uint64_t count) {
+    return makeError("budget " + bytesText(*budget) + ": too small for one fragment per " + which +
+                     " with " + name + " at " + sizeText(frame) + " (needs " +
+                     bytesText(overhead + count * kNodeBytes) + ")");
+  };
 
   switch (method.allocation) {
     case AllocationPolicy::Unbounded: {
@@ -129,12 +135,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
       if (!method.k) {
         if (!budget) return makeError(name + ": needs a budget or an explicit k");
         k = std::min<uint64_t>(slotsInBudget / pixels, 1u << 20);
-        if (k == 0)
-          return makeError("budget " + bytesText(*budget) +
-                           ": too small for one fragment per "
-                           "pixel with " +
-                           name + " at " + sizeText(frame) + " (needs " +
-                           bytesText(overhead + pixels * kNodeBytes) + ")");
+        if (k == 0) return tooSmall("pixel", pixels);
       }
       if (k == 0) return makeError(name + ": k must be at least 1");
       if (k * pixels > slotsInBudget)
@@ -171,12 +172,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
             need += histogram[bin] * std::min(bin, candidate);
           if (need <= slotsInBudget) k = candidate;
         }
-        if (k == 0)
-          return makeError("budget " + bytesText(*budget) +
-                           ": too small for one fragment per "
-                           "covered pixel with " +
-                           name + " at " + sizeText(frame) + " (needs " +
-                           bytesText(overhead + covered * kNodeBytes) + ")");
+        if (k == 0) return tooSmall("covered pixel", covered);
       }
       if (k == 0) return makeError(name + ": k must be at least 1");
       a.slots = sumCapped(k);
@@ -191,12 +187,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
     }
     case AllocationPolicy::Importance: {
       if (!budget) return makeError(name + ": needs a budget");
-      if (slotsInBudget < covered)
-        return makeError("budget " + bytesText(*budget) +
-                         ": too small for one fragment per "
-                         "covered pixel with " +
-                         name + " at " + sizeText(frame) + " (needs " +
-                         bytesText(overhead + covered * kNodeBytes) + ")");
+      if (slotsInBudget < covered) return tooSmall("covered pixel", covered);
       double total = 0.0;
       for (float i : importance) total += i;
       std::vector<uint64_t> k(pixels, 0);
@@ -229,12 +220,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
     }
     case AllocationPolicy::Optimal: {  // k(p) chosen by the oracle (render.cpp) within F(M)
       if (!budget) return makeError(name + ": needs a budget");
-      if (slotsInBudget < covered)
-        return makeError("budget " + bytesText(*budget) +
-                         ": too small for one fragment per "
-                         "covered pixel with " +
-                         name + " at " + sizeText(frame) + " (needs " +
-                         bytesText(overhead + covered * kNodeBytes) + ")");
+      if (slotsInBudget < covered) return tooSmall("covered pixel", covered);
       for (size_t p = 0; p < pixels; ++p) {
         a.capacity[p] = oracleK[p];
         a.slots += oracleK[p];
