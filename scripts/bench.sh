@@ -16,7 +16,7 @@ if [[ $# -gt 0 && $1 != -* ]]; then
 fi
 out=bench-results
 plots="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/plots"
-benches=(abuffer k_sweep occupancy capture_modes presets)
+benches=(abuffer k_sweep occupancy capture_modes presets dkb)
 
 mkdir -p "$out"
 status=0
@@ -40,7 +40,7 @@ done
 
 if command -v gnuplot >/dev/null 2>&1; then
   for name in "${benches[@]}"; do
-    [[ -f $out/$name.csv ]] || continue
+    [[ -f $out/$name.csv && -f $plots/$name.gnuplot ]] || continue
     if gnuplot -c "$plots/$name.gnuplot" "$out/$name.csv" "$out/$name.png"; then
       echo "plot: $out/$name.png"
     else

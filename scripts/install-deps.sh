@@ -9,6 +9,7 @@ packages=(
   libcli11-dev          # command line
   nlohmann-json3-dev    # JSON scenes, --json, stats
   libglm-dev            # vector maths
+  libeigen3-dev         # the deep k-buffer's network (training and inference)
   libstb-dev            # PNG/JPEG read (textures), PNG write
   libtinygltf-dev       # glTF 2.0 loader
   libtinyobjloader-dev  # Wavefront OBJ + MTL loader
@@ -16,6 +17,7 @@ packages=(
   libgtest-dev libgmock-dev
   libbenchmark-dev
   gnuplot-nox           # benchmark plots (scripts/bench.sh)
+  python3               # evaluation tables (scripts/eval_tables.py)
   chromium              # the mfr compare report in headless Chromium (tests/report_chromium_test.sh)
 )
 

@@ -23,7 +23,8 @@ namespace fs = std::filesystem;
 struct CompareArgs {
   SceneOptions scene;
   std::string budgets;
-  std::string methods = "fkb,kplus-dynamic,vkb,vkb-fill";
+  std::string methods = "fkb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,optimal";
+  std::string model;
   std::string out;
   std::string composite = "kbuffer";
   std::string capture = "tile";
@@ -122,12 +123,18 @@ void printSummary(const CompareResult& r) {
 }
 
 int run(const CompareArgs& a, const std::string& version) {
-  if (a.scene.orbit != 0) return fail("--orbit: compare renders one view (use --camera or --view)");
+  if (a.scene.orbit != 0 && a.scene.orbitView < 0)
+    return fail("--orbit: compare renders one view (add --orbit-view I, or use --camera / --view)");
   if (a.out.empty()) return fail("--out: an output folder is required");
   CompareOptions options;
   options.scene = a.scene.source;
   options.seed = a.scene.seed;
   options.flipPixelsPerDegree = a.pixelsPerDegree;
+  if (!a.model.empty()) {
+    auto model = loadDkbModel(a.model);
+    if (!model) return fail(model.error().message);
+    options.model = model.value();
+  }
   if (!(a.pixelsPerDegree > 0.0 && std::isfinite(a.pixelsPerDegree)))
     return fail("--ppd: must be a positive number");
 
@@ -248,6 +255,8 @@ Runner addCompareCommand(CLI::App& app) {
   cmd->add_option("--out,-o", args->out, "Output folder (created if missing)")->required();
   cmd->add_option("--composite", args->composite, "kbuffer or hybrid (the bounded methods)");
   cmd->add_option("--capture", args->capture, "tile (default) or parallel");
+  cmd->add_option("--model", args->model,
+                  "Deep k-buffer model (.mfrnn, from mfr train; default: the built-in model)");
   cmd->add_option("--ppd", args->pixelsPerDegree, "FLIP pixels per degree (default 67.02)");
   const CLI::App* root = &app;
   return [args, root] { return run(*args, root->version()); };

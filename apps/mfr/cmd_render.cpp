@@ -32,6 +32,7 @@ struct RenderArgs {
   // variable k-buffer
   std::string importanceMap;
   std::string importanceFactors;
+  std::string model;  // deep k-buffer
   ImportanceParams importance;
   std::vector<double> fovea;
   bool noDepthTerm = false, noPeripheryTerm = false, noFresnelTerm = false, noNoise = false;
@@ -51,6 +52,16 @@ Result<MethodDesc> buildMethod(const RenderArgs& a) {
   auto compositing = parseCompositing(a.composite);
   if (!compositing) return makeError("--composite: " + compositing.error().message);
   m.compositing = compositing.value();
+  const bool deep = m.allocation == AllocationPolicy::Importance &&
+                    m.importanceSource == ImportanceSource::Network;
+  if (!a.model.empty()) {
+    if (!deep) return makeError("--model: only for the deep k-buffer methods (dkb, dkb-fill)");
+    auto model = loadDkbModel(a.model);
+    if (!model) return model.error();
+    m.model = model.value();
+  }
+  if (deep && !a.importanceFactors.empty())
+    return makeError("--importance-factors: the deep k-buffer's importance has no factors");
   if (m.allocation == AllocationPolicy::Importance) {
     ImportanceParams ip = a.importance;
     if (!(ip.alpha >= 0.0f && ip.alpha <= 1.0f))
@@ -73,7 +84,8 @@ Result<MethodDesc> buildMethod(const RenderArgs& a) {
     m.importance = ip;
   } else if (!a.importanceMap.empty() || !a.importanceFactors.empty()) {
     return makeError(
-        "--importance-map/--importance-factors: only for importance methods (vkb, vkb-fill)");
+        "--importance-map/--importance-factors: only for importance methods (vkb, vkb-fill, dkb, "
+        "dkb-fill)");
   }
   if (m.occupancyWords > 0) {
     if (a.occupancyD < 1 || a.occupancyD > 64)
@@ -221,6 +233,8 @@ Runner addRenderCommand(CLI::App& app) {
                   "vkb: write the importance map I(p) (colour-mapped PNG)");
   cmd->add_option("--importance-factors", args->importanceFactors,
                   "vkb: write each importance factor as a PNG into this folder");
+  cmd->add_option("--model", args->model,
+                  "dkb: network model (.mfrnn from mfr train; default: the built-in model)");
   cmd->add_option("--importance-alpha", args->importance.alpha, "vkb Eq. 3 alpha (default 0.375)");
   cmd->add_option("--n-limit", args->importance.nLimit, "vkb Eq. 3 N_limit (default 20)");
   cmd->add_option("--periphery-d", args->importance.peripheryExponent, "vkb Eq. 4 d (default 3)");

@@ -12,5 +12,7 @@ Runner addRenderCommand(CLI::App& app);
 Runner addInfoCommand(CLI::App& app);
 Runner addMetricsCommand(CLI::App& app);
 Runner addCompareCommand(CLI::App& app);
+Runner addDatasetCommand(CLI::App& app);
+Runner addTrainCommand(CLI::App& app);
 
 }  // namespace mfr::cli

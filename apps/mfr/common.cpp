@@ -7,14 +7,16 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "mfr/method/deep_importance.hpp"
 #include "mfr/raster/raster_frame.hpp"
 
 namespace mfr::cli {
 
-void SceneOptions::add(CLI::App& app) {
-  app.add_option("scene", source,
-                 "Scene file (.gltf .glb .obj .ply .json) or procedural:NAME[?k=v&...]")
-      ->required();
+void SceneOptions::add(CLI::App& app, bool sceneArgument) {
+  if (sceneArgument)
+    app.add_option("scene", source,
+                   "Scene file (.gltf .glb .obj .ply .json) or procedural:NAME[?k=v&...]")
+        ->required();
   app.add_option("--width", width, "Image width in pixels (1-16384)");
   app.add_option("--height", height, "Image height in pixels (1-16384)");
   app.add_option("--camera", camera,
@@ -23,6 +25,9 @@ void SceneOptions::add(CLI::App& app) {
       ->expected(6, 10);
   app.add_option("--view", view, "Use the scene file's camera number N (0-based)");
   app.add_option("--orbit", orbit, "Render N views on a circle around the scene");
+  app.add_option("--orbit-view", orbitView, "With --orbit N: only view I of the N (0-based)");
+  app.add_option("--zoom", zoom,
+                 "Move the camera Z times closer to its target (default 1; 2 = half the distance)");
   app.add_option("--threads", threads, "Worker threads (default: all cores)");
   app.add_option("--seed", seed, "Seed for procedural scenes and noise (default 1)");
   app.add_option("--alpha", alpha,
@@ -51,6 +56,11 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
     return makeError("--threads " + std::to_string(o.threads) + ": must be in [1, 1024]");
   if (o.orbit < 0 || o.orbit > 10000)
     return makeError("--orbit " + std::to_string(o.orbit) + ": must be in [1, 10000]");
+  if (o.orbitView >= 0 && o.orbitView >= o.orbit)
+    return makeError("--orbit-view " + std::to_string(o.orbitView) + ": needs --orbit N with N > " +
+                     std::to_string(o.orbitView));
+  if (!(o.zoom >= 0.01 && o.zoom <= 100.0)) return makeError("--zoom: must be in [0.01, 100]");
+  if (o.orbitView < -1) return makeError("--orbit-view: must be a view index (0-based)");
   if (o.alpha && !(*o.alpha >= 0.0 && *o.alpha <= 1.0))
     return makeError("--alpha: must be in [0, 1]");
   if (!finiteAll(o.background) || !finiteAll(o.camera))
@@ -89,7 +99,9 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
   } else {
     camera = frameBounds(sceneBounds(scene));
   }
+  camera.eye = camera.target + (camera.eye - camera.target) / static_cast<float>(o.zoom);
   prepared.cameras = o.orbit > 0 ? orbit(camera, o.orbit) : std::vector<Camera>{camera};
+  if (o.orbitView >= 0) prepared.cameras = {prepared.cameras[o.orbitView]};
   return prepared;
 }
 
@@ -150,6 +162,13 @@ void Progress::loop() {
 int fail(const std::string& message) {
   std::fprintf(stderr, "mfr: error: %s\n", message.c_str());
   return 1;
+}
+
+Result<std::shared_ptr<const learn::Model>> loadDkbModel(const std::string& path) {
+  auto model = learn::readModel(path);
+  if (!model) return model.error();
+  if (auto fits = checkDkbModel(model.value(), path); !fits) return fits.error();
+  return std::make_shared<const learn::Model>(std::move(model.value()));
 }
 
 }  // namespace mfr::cli

@@ -3,6 +3,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -12,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "mfr/core/result.hpp"
+#include "mfr/learn/model_file.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr::cli {
@@ -24,6 +26,8 @@ struct SceneOptions {
   std::vector<double> camera;  // eye(3) target(3) [up(3) [fov]]
   int view = -1;               // camera of the file, by index
   int orbit = 0;               // N views around the scene
+  int orbitView = -1;          // with orbit: only this one of the N views
+  double zoom = 1.0;           // camera distance to its target divided by this
   int threads = 0;
   uint64_t seed = 1;
   std::optional<double> alpha;
@@ -32,7 +36,8 @@ struct SceneOptions {
   bool quiet = false;
   bool json = false;
 
-  void add(CLI::App& app);
+  /// Registers the options (and the positional scene unless the command takes several).
+  void add(CLI::App& app, bool sceneArgument = true);
 };
 
 struct PreparedScene {
@@ -65,6 +70,9 @@ class Progress {
   bool printed_ = false;
   std::thread thread_;
 };
+
+/// Reads a model file for the deep k-buffer and checks that it fits (errors name the path).
+Result<std::shared_ptr<const learn::Model>> loadDkbModel(const std::string& path);
 
 /// Prints "mfr: error: <message>" and returns the exit code 1.
 int fail(const std::string& message);

@@ -13,6 +13,8 @@ int main(int argc, char** argv) {
   const mfr::cli::Runner info = mfr::cli::addInfoCommand(app);
   const mfr::cli::Runner metrics = mfr::cli::addMetricsCommand(app);
   const mfr::cli::Runner compare = mfr::cli::addCompareCommand(app);
+  const mfr::cli::Runner dataset = mfr::cli::addDatasetCommand(app);
+  const mfr::cli::Runner train = mfr::cli::addTrainCommand(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -23,6 +25,8 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("info")) return info();
     if (app.got_subcommand("metrics")) return metrics();
     if (app.got_subcommand("compare")) return compare();
+    if (app.got_subcommand("dataset")) return dataset();
+    if (app.got_subcommand("train")) return train();
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mfr: error: %s\n", e.what());
     return 1;

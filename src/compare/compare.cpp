@@ -130,6 +130,7 @@ Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptio
     MethodDesc m = preset.value();
     m.compositing = options.compositing;
     m.importance.seed = options.seed;
+    m.model = options.model;
     methods.push_back(m);
   }
   std::set<uint64_t> seenBudgets;

@@ -11,7 +11,10 @@ MemoryModel MemoryModel::of(const MethodDesc& method, bool fragmentParallel) {
   m.lock = method.perPixelLock || fragmentParallel ? 4 : 0;
   m.occupancy = method.occupancyWords > 0 ? OccupancyMap::bytesPerPixel(method.occupancyWords) : 0;
   m.tail = method.compositing == Compositing::Hybrid ? 20 : 0;
-  m.previous = method.allocation == AllocationPolicy::Importance ? 1 : 0;
+  m.previous = method.allocation == AllocationPolicy::Importance &&
+                       method.importanceSource == ImportanceSource::Heuristic
+                   ? 1
+                   : 0;
   m.image = method.allocation == AllocationPolicy::DynamicK ? kHistogramBins * 4 : 0;
   return m;
 }

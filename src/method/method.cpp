@@ -3,8 +3,9 @@
 namespace mfr {
 
 std::vector<std::string> presetNames() {
-  return {"zbuffer",       "abuffer", "fkb",      "kplus-array", "kplus-heap",    "kplus-sb",
-          "kplus-dynamic", "vkb",     "vkb-fill", "optimal",     "optimal-greedy"};
+  return {"zbuffer",  "abuffer",       "fkb",           "kplus-array", "kplus-heap",
+          "kplus-sb", "kplus-dynamic", "vkb",           "vkb-fill",    "dkb",
+          "dkb-fill", "optimal",       "optimal-greedy"};
 }
 
 Result<MethodDesc> methodPreset(const std::string& fullName) {
@@ -46,6 +47,14 @@ Result<MethodDesc> methodPreset(const std::string& fullName) {
     m.culling = CullingTest::KPlus;
     m.perPixelLock = true;
     m.fillUnusedSlots = name == "vkb-fill";
+  } else if (name == "dkb" || name == "dkb-fill") {
+    m.allocation = AllocationPolicy::Importance;
+    m.importanceSource = ImportanceSource::Network;
+    m.store = StoreChoice::PerPixel;
+    m.culling = CullingTest::KPlus;
+    m.perPixelLock = true;
+    m.compositing = Compositing::Hybrid;  // deep hybrid transparency (DHOIT sec. 3.3)
+    m.fillUnusedSlots = name == "dkb-fill";
   } else if (name == "optimal" || name == "optimal-greedy") {
     m.allocation = AllocationPolicy::Optimal;
     m.store = StoreChoice::PerPixel;
@@ -77,8 +86,10 @@ const char* toString(AllocationPolicy a) {
       return "counted-k";
     case AllocationPolicy::DynamicK:
       return "dynamic-k";
-    default:
+    case AllocationPolicy::Importance:
       return "importance";
+    default:
+      return "optimal";
   }
 }
 const char* toString(StoreChoice s) {

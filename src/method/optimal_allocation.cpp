@@ -9,7 +9,8 @@
 
 namespace mfr {
 
-std::vector<double> hybridErrorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3 background) {
+std::vector<double> errorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3 background,
+                               Compositing compositing) {
   std::vector<double> err(n, 0.0);
   if (n == 0) return err;
   // prefix: core colour and transmittance; suffix: tail sums
@@ -30,6 +31,7 @@ std::vector<double> hybridErrorCurve(const FragmentNode* sorted, uint32_t n, glm
   const glm::dvec3 bg(background);
   auto hybrid = [&](uint32_t k) {
     const uint32_t t = n - k;
+    if (compositing == Compositing::KBuffer) return core[k] + T[k] * bg;  // tail dropped
     if (t == 0 || tailAlpha[k] <= 0.0) return core[k] + T[k] * bg;
     const glm::dvec3 colour = tailColor[k] / tailAlpha[k];
     const double alpha =
@@ -42,6 +44,10 @@ std::vector<double> hybridErrorCurve(const FragmentNode* sorted, uint32_t n, glm
     err[k - 1] = glm::dot(d, d);
   }
   return err;
+}
+
+std::vector<double> hybridErrorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3 background) {
+  return errorCurve(sorted, n, background, Compositing::Hybrid);
 }
 
 double allocationError(const std::vector<std::vector<double>>& curves,

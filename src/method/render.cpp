@@ -10,7 +10,10 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "mfr/learn/model_file.hpp"
+#include "mfr/method/deep_importance.hpp"
 #include "mfr/method/optimal_allocation.hpp"
+#include "mfr/method/optimal_oracle.hpp"
 #include "pipeline.hpp"
 
 namespace mfr {
@@ -40,27 +43,18 @@ class PassTimer {
   std::vector<PassTime>& passes_;
 };
 
-template <class PixelFn>
-struct CoverageSink {
-  PixelFn fn;
-  bool accept(uint32_t, float) const { return true; }
-  void emit(const Fragment& f) { fn(f.pixel, f.depth); }
-};
-template <class PixelFn>
-CoverageSink(PixelFn) -> CoverageSink<PixelFn>;
-
 void buildOccupancy(const RasterFrame& frame, const detail::Allocation& alloc, OccupancyMap& occ,
                     PassTimer& timer) {
   timer.run("depth_range", [&] {
     frame.forEachTile([&](int tile) {
       frame.rasterizeTile<ShadeMode::Coverage>(
-          tile, CoverageSink{[&](uint32_t p, float z) { occ.expandRange(p, z); }});
+          tile, CoverageAll{[&](uint32_t p, float z) { occ.expandRange(p, z); }});
     });
   });
   timer.run("occupancy_fill", [&] {
     frame.forEachTile([&](int tile) {
       frame.rasterizeTile<ShadeMode::Coverage>(
-          tile, CoverageSink{[&](uint32_t p, float z) { occ.mark(p, z); }});
+          tile, CoverageAll{[&](uint32_t p, float z) { occ.mark(p, z); }});
     });
   });
   timer.run("occupancy_count", [&] {
@@ -97,36 +91,18 @@ ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method,
   return image;
 }
 
-// The optimal k-buffer's pre-pass: n(p) and the k(p) of the allocator over hybrid error curves.
+// The optimal k-buffer's pre-pass: n(p) and the k(p) of the allocator over hybrid error curves
+// (no k when the budget cannot give every covered pixel a slot: allocate() reports that).
 Result<std::pair<std::vector<uint32_t>, std::vector<uint32_t>>> optimalK(
     const RasterFrame& frame, const MethodDesc& method, const RenderOptions& options,
     uint64_t slots) {
-  RenderOptions exact;
-  exact.keepStores = true;
-  exact.background = options.background;
-  auto truth = render(frame, methodPreset("abuffer").value(), exact);
-  if (!truth) return truth.error();
-  const size_t pixels = frame.pixelCount();
-  std::vector<std::vector<double>> curves(pixels);
-  uint64_t covered = 0;
-  for (uint32_t c : truth->depthComplexity) covered += c > 0;
-  if (slots < covered)
-    return std::make_pair(std::move(truth->depthComplexity), std::vector<uint32_t>());
-  frame.forEachTile([&](int tile) {
-    const TileRect r = frame.tileRect(tile);
-    std::vector<FragmentNode> local;
-    for (int y = r.y0; y <= r.y1; ++y)
-      for (int x = r.x0; x <= r.x1; ++x) {
-        const size_t p = static_cast<size_t>(y) * frame.width() + x;
-        const FragmentNode* first = truth->nodes.data() + truth->offsets[p];
-        local.assign(first, first + truth->counts[p]);
-        std::sort(local.begin(), local.end());
-        curves[p] = hybridErrorCurve(local.data(), truth->counts[p], options.background);
-      }
-  });
-  std::vector<uint32_t> k = method.publishedGreedy ? allocateOptimalGreedy(curves, slots)
-                                                   : allocateOptimalHull(curves, slots);
-  return std::make_pair(std::move(truth->depthComplexity), std::move(k));
+  auto oracle = frameErrorCurves(frame, options.background, method.compositing);
+  if (!oracle) return oracle.error();
+  if (slots < oracle->coveredPixels)
+    return std::make_pair(std::move(oracle->n), std::vector<uint32_t>());
+  std::vector<uint32_t> k = method.publishedGreedy ? allocateOptimalGreedy(oracle->curves, slots)
+                                                   : allocateOptimalHull(oracle->curves, slots);
+  return std::make_pair(std::move(oracle->n), std::move(k));
 }
 
 }  // namespace
@@ -158,7 +134,7 @@ std::vector<uint32_t> countFragments(const RasterFrame& frame) {
   std::vector<uint32_t> counts(frame.pixelCount(), 0);
   frame.forEachTile([&](int tile) {
     frame.rasterizeTile<ShadeMode::Coverage>(tile,
-                                             CoverageSink{[&](uint32_t p, float) { ++counts[p]; }});
+                                             CoverageAll{[&](uint32_t p, float) { ++counts[p]; }});
   });
   return counts;
 }
@@ -182,13 +158,42 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
 
   // count pass
   // (the optimal oracle counts in its own A-buffer pre-pass)
-  if (method.allocation != AllocationPolicy::FixedK &&
-      !(method.allocation == AllocationPolicy::Optimal && options.budgetBytes))
+  // (the deep k-buffer's count pass also finds the image's depth range, a network input)
+  const bool deep = method.allocation == AllocationPolicy::Importance &&
+                    method.importanceSource == ImportanceSource::Network;
+  ImageFeatureStats imageFeatures;
+  if (deep)
+    out.depthComplexity =
+        timer.run("count", [&] { return countWithDepthRange(frame, imageFeatures); });
+  else if (method.allocation != AllocationPolicy::FixedK &&
+           !(method.allocation == AllocationPolicy::Optimal && options.budgetBytes))
     out.depthComplexity = timer.run("count", [&] { return countFragments(frame); });
 
   // importance (variable k-buffer): the previous frame's nearest |n.v| (a preceding frame from
   // the same camera unless the caller hands one over), then the map
-  if (method.allocation == AllocationPolicy::Importance) {
+  if (deep) {
+    if (!options.budgetBytes) return makeError(method.name + ": needs a budget");
+    std::shared_ptr<const learn::Model> model = method.model;
+    if (!model) {
+      auto builtin = builtinDkbModel();
+      if (!builtin) return builtin.error();
+      model = builtin.value();
+    } else if (auto fits = checkDkbModel(*model, "of " + method.name); !fits) {
+      return fits.error();
+    }
+    // features and inference run fused per tile; the wall time is split between the two passes
+    // in proportion to their CPU time
+    double featureCpu = 0.0, inferenceCpu = 0.0;
+    const auto start = std::chrono::steady_clock::now();
+    out.importance.importance = predictImportance(
+        frame, *model, imageFeatures, memory.fragmentSlots(*options.budgetBytes, pixels),
+        &featureCpu, &inferenceCpu);
+    const double wall =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    const double cpu = featureCpu + inferenceCpu;
+    stats.passes.push_back({"features", cpu > 0.0 ? wall * featureCpu / cpu : wall});
+    stats.passes.push_back({"inference", cpu > 0.0 ? wall * inferenceCpu / cpu : 0.0});
+  } else if (method.allocation == AllocationPolicy::Importance) {
     out.nearestCosine = timer.run("nearest_normal", [&] { return nearestCosine(frame); });
     const std::vector<float>& previous =
         options.previousNearestCosine && options.previousNearestCosine->size() == pixels

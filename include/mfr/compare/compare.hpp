@@ -35,6 +35,8 @@ struct CompareOptions {
   double flipPixelsPerDegree = kFlipDefaultPixelsPerDegree;
   /// Importance methods (vkb, vkb-fill): seed of the noise term (Eq. 6).
   uint64_t seed = 1;
+  /// Deep k-buffer methods (dkb, dkb-fill): the network (null: the built-in model).
+  std::shared_ptr<const learn::Model> model;
   /// Called before each step: (what, steps done, steps in all). May be empty.
   std::function<void(const std::string& stage, int done, int total)> progress;
 };

@@ -7,9 +7,10 @@
 //   word       bytes   what                                           who
 //   counter    4       fragments stored so far (the count pass's too)  every method
 //   offset     4       first slot of the pixel's region (prefix sum)   abuffer, kplus-sb, dynamic,
-//                                                                      vkb
-//   lock       4       spin-lock semaphore                             k+ family, vkb; any method
-//                                                                      in fragment-parallel mode
+//                                                                      vkb, dkb
+//   lock       4       spin-lock semaphore                             k+ family, vkb, dkb; any
+//                                                                      method in fragment-parallel
+//                                                                      mode
 //                                                                      (for fkb / abuffer it stands
 //                                                                      in for the GPU's atomics)
 //   occupancy  12+4d   zn, zf, k-th bucket, 32d-bit bitmap             +occupancy
@@ -18,6 +19,8 @@
 //   image      4096    depth-complexity histogram, 1024 x u32          kplus-dynamic (per image)
 // The variable k-buffer's importance map lives in the offset word (importance, then k(p), then the
 // prefix sum, computed in place), so it costs no extra bytes; the count pass's n(p) is the counter.
+// The deep k-buffer's features live in a per-worker 16x16-tile scratch (deep_importance.hpp), and
+// its predicted importance in the offset word like vkb's; it needs no previous-frame normal.
 //
 // The node pool, per allocation policy (pixels in tile-major order, 8 B per slot):
 //

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,13 +15,17 @@
 
 namespace mfr {
 
+namespace learn {
+struct Model;
+}
+
 /// How many fragment slots each pixel gets.
 enum class AllocationPolicy : uint8_t {
   Unbounded,   // count pass, exact slots for every fragment (A-buffer / S-buffer)
   FixedK,      // the same k pre-allocated for every pixel (k-buffer, k+-buffer)
   CountedK,    // count pass capped at k, prefix-sum offsets, exact memory (K+B-SB)
   DynamicK,    // largest global k whose exact memory fits the budget, from the histogram
-  Importance,  // k(p) = floor(P(p) F(M)) from an importance map (variable k-buffer)
+  Importance,  // k(p) = floor(P(p) F(M)) from an importance map (variable / deep k-buffer)
   Optimal,     // offline oracle: k(p) minimising the hybrid error from an exact A-buffer pre-pass
 };
 
@@ -37,6 +42,12 @@ enum class CullingTest : uint8_t {
   KPlus,  // reject a fragment not nearer than the current maximum of a full store, re-check inside
 };
 
+/// Where an importance allocation's map comes from.
+enum class ImportanceSource : uint8_t {
+  Heuristic,  // depth complexity x periphery x Fresnel + noise (variable k-buffer)
+  Network,    // the deep k-buffer's MLP over 12 per-pixel features
+};
+
 enum class Compositing : uint8_t {
   KBuffer,  // sort the captured fragments, composite front to back, drop the rest
   Hybrid,   // sorted core + order-independent tail (hybrid transparency)
@@ -50,8 +61,11 @@ struct MethodDesc {
   bool perPixelLock = false;  // spin-lock word per pixel (k+-buffer family)
   int occupancyWords = 0;     // 0: no occupancy culling; d > 0: 32*d buckets
   Compositing compositing = Compositing::KBuffer;
-  std::optional<uint32_t> k;    // explicit k (otherwise derived from the budget)
-  ImportanceParams importance;  // Importance allocation only
+  std::optional<uint32_t> k;  // explicit k (otherwise derived from the budget)
+  ImportanceSource importanceSource = ImportanceSource::Heuristic;  // Importance allocation only
+  ImportanceParams importance;                                      // heuristic importance only
+  /// Network importance: the model (null: the built-in model, builtinDkbModel()).
+  std::shared_ptr<const learn::Model> model;
   /// Importance allocation: one slot for every covered pixel, the rest by importance capped at
   /// n(p), and the freed and floor() remainder slots to the pixels with the largest unmet
   /// importance (vkb-fill), instead of the paper's exact rule.
@@ -61,7 +75,8 @@ struct MethodDesc {
 };
 
 /// Preset names: zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, vkb,
-/// vkb-fill, optimal, optimal-greedy, each bounded one optionally followed by "+occupancy".
+/// vkb-fill, dkb, dkb-fill, optimal, optimal-greedy, each bounded one optionally followed by
+/// "+occupancy".
 std::vector<std::string> presetNames();
 
 /// Looks up a preset ("kplus-heap", "fkb+occupancy", ...). Errors list the known names.

@@ -11,8 +11,7 @@
 //     per slot; from k = 1 everywhere the steepest segments are bought first, and the last one
 //     partially at its best affordable k. Exact on convex curves, and never worse than the greedy
 //     on the counterexamples of tests/test_optimal_allocation.cpp.
-// Not yet a preset: the pipeline integration (an A-buffer pre-pass feeding the allocation) is the
-// next step of the optimal / deep k-buffer issue.
+// Presets optimal / optimal-greedy run them on an exact A-buffer pre-pass (optimal_oracle.hpp).
 #pragma once
 
 #include <cstdint>
@@ -20,6 +19,7 @@
 
 #include <glm/glm.hpp>
 
+#include "mfr/method/method.hpp"
 #include "mfr/raster/fragment.hpp"
 
 namespace mfr {
@@ -27,6 +27,11 @@ namespace mfr {
 /// err(k) for k = 1..n of one pixel (index k - 1), squared linear-RGB distance of the hybrid
 /// result with k core fragments to the exact result; `sorted` nearest first.
 std::vector<double> hybridErrorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3 background);
+
+/// The same for either compositing rule: with kbuffer compositing the fragments beyond k are
+/// dropped (the oracle is then optimal for the k-buffer's resolve instead).
+std::vector<double> errorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3 background,
+                               Compositing compositing);
 
 /// Sum of err over pixels for an allocation (k = 0 only for empty curves).
 double allocationError(const std::vector<std::vector<double>>& curves,

@@ -141,6 +141,16 @@ struct EmitAll {
 template <class F>
 EmitAll(F) -> EmitAll<F>;
 
+/// Adapts a callable taking (pixel, depth) to the sink protocol, for Coverage-mode passes.
+template <class F>
+struct CoverageAll {
+  F fn;
+  bool accept(uint32_t, float) const { return true; }
+  void emit(const Fragment& f) { fn(f.pixel, f.depth); }
+};
+template <class F>
+CoverageAll(F) -> CoverageAll<F>;
+
 /// Resolves a number of threads: 0 means all hardware threads.
 int resolveThreads(int threads);
 

@@ -1,0 +1,197 @@
+// mfr train: trains the deep k-buffer's network (DHOIT sec. 3.1.3) on .mfrds datasets,
+// deterministically from a seed, validating on held-out scenes; writes the model (.mfrnn), a
+// per-epoch log (CSV) and a PNG loss curve.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <set>
+
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "mfr/core/image.hpp"
+#include "mfr/core/plot.hpp"
+#include "mfr/learn/dataset.hpp"
+#include "mfr/learn/model_file.hpp"
+#include "mfr/method/deep_importance.hpp"
+
+namespace mfr::cli {
+namespace {
+
+struct TrainArgs {
+  std::vector<std::string> datasets;
+  std::string out;
+  std::string log;
+  std::string lossCurve;
+  std::vector<std::string> validationScenes;
+  learn::TrainOptions train;
+  bool quiet = false;
+};
+
+struct Split {
+  Eigen::MatrixXf trainX, trainY, validX, validY;
+  std::vector<std::string> trainScenes, validScenes;
+};
+
+// Loads every dataset and splits the samples by scene name.
+Result<Split> loadSplit(const TrainArgs& a) {
+  std::vector<learn::Dataset> sets;
+  std::vector<std::string> order;  // scene names in order of appearance
+  for (const std::string& path : a.datasets) {
+    auto data = learn::readDataset(path);
+    if (!data) return data.error();
+    for (const std::string& s : data->scenes)
+      if (std::find(order.begin(), order.end(), s) == order.end()) order.push_back(s);
+    sets.push_back(std::move(data.value()));
+  }
+  std::set<std::string> valid(a.validationScenes.begin(), a.validationScenes.end());
+  if (valid.count("none"))
+    valid.clear();
+  else if (valid.empty() && order.size() > 1)
+    valid.insert(order.back());
+  for (const std::string& v : valid)
+    if (std::find(order.begin(), order.end(), v) == order.end())
+      return makeError("--validation-scene '" + v + "': not in the datasets");
+  Split split;
+  for (const std::string& s : order)
+    (valid.count(s) ? split.validScenes : split.trainScenes).push_back(s);
+  if (split.trainScenes.empty()) return makeError("--validation-scene: no scene left to train on");
+  size_t trainCount = 0, validCount = 0;
+  for (const learn::Dataset& d : sets)
+    for (const learn::DatasetSample& s : d.samples)
+      (valid.count(d.scenes[s.scene]) ? validCount : trainCount)++;
+  if (trainCount == 0) return makeError("the datasets hold no training samples");
+  split.trainX.resize(kDkbFeatureCount, static_cast<Eigen::Index>(trainCount));
+  split.trainY.resize(1, static_cast<Eigen::Index>(trainCount));
+  split.validX.resize(kDkbFeatureCount, static_cast<Eigen::Index>(validCount));
+  split.validY.resize(1, static_cast<Eigen::Index>(validCount));
+  Eigen::Index t = 0, v = 0;
+  for (const learn::Dataset& d : sets)
+    for (const learn::DatasetSample& s : d.samples) {
+      const bool isValid = valid.count(d.scenes[s.scene]) > 0;
+      Eigen::MatrixXf& x = isValid ? split.validX : split.trainX;
+      Eigen::MatrixXf& y = isValid ? split.validY : split.trainY;
+      const Eigen::Index i = isValid ? v++ : t++;
+      for (int c = 0; c < kDkbFeatureCount; ++c) x(c, i) = s.features[c];
+      y(0, i) = s.target;
+    }
+  return split;
+}
+
+Result<void> writeLossCurve(const std::string& path, const std::vector<learn::EpochLog>& logs) {
+  PlotSeries train{"training MSE", {}, {}, glm::vec3(0.12f, 0.47f, 0.71f)};
+  PlotSeries valid{"validation MSE (held-out scenes)", {}, {}, glm::vec3(0.85f, 0.37f, 0.0f)};
+  for (const learn::EpochLog& e : logs) {
+    train.x.push_back(e.epoch);
+    train.y.push_back(e.trainLoss);
+    valid.x.push_back(e.epoch);
+    valid.y.push_back(e.validationLoss);
+  }
+  PlotOptions options;
+  options.title = "deep k-buffer training loss";
+  options.xLabel = "epoch";
+  options.yLabel = "mean squared error";
+  options.logY = true;
+  std::vector<PlotSeries> series{train};
+  if (std::isfinite(valid.y.front())) series.push_back(valid);
+  auto image = plotLines(series, options);
+  if (!image) return makeError("--loss-curve " + path + ": " + image.error().message);
+  return writePng(path, image.value());
+}
+
+int runTrain(TrainArgs& a) {
+  const learn::TrainOptions& o = a.train;
+  if (o.epochs < 1 || o.epochs > 100000) return fail("--epochs: must be in [1, 100000]");
+  if (o.batchSize < 1 || o.batchSize > (1 << 20)) return fail("--batch: must be in [1, 1048576]");
+  if (!(o.learningRate > 0.0f && o.learningRate <= 10.0f))
+    return fail("--learning-rate: must be in (0, 10]");
+  if (!(o.momentum >= 0.0f && o.momentum < 1.0f)) return fail("--momentum: must be in [0, 1)");
+  if (!(o.regularization.l1FirstHidden >= 0.0f && o.regularization.l2SecondHidden >= 0.0f))
+    return fail("--l1/--l2: must be non-negative numbers");
+  if (a.out.empty()) return fail("--out: empty path");
+  if (a.log.empty()) a.log = a.out + ".log.csv";
+  if (a.lossCurve.empty()) a.lossCurve = a.out + ".loss.png";
+
+  auto split = loadSplit(a);
+  if (!split) return fail(split.error().message);
+  learn::Mlp net = learn::makeMlp(learn::kDkbLayers, o.seed);
+  std::ofstream log(a.log);
+  if (!log) return fail("--log " + a.log + ": cannot open for writing");
+  log << "epoch,train_mse,validation_mse,seconds\n";
+  Progress progress(!a.quiet);
+  const auto logs = learn::train(
+      net, split->trainX, split->trainY, split->validX, split->validY, o,
+      [&](const learn::EpochLog& e) {
+        log << e.epoch << ',' << e.trainLoss << ',' << e.validationLoss << ',' << e.seconds << '\n';
+        log.flush();
+        char text[128];
+        std::snprintf(text, sizeof text, "training: train %.4g, validation %.4g", e.trainLoss,
+                      e.validationLoss);
+        progress.set(text, e.epoch, o.epochs);
+      });
+  progress.clear();
+  if (logs.empty() || !std::isfinite(logs.back().trainLoss))
+    return fail("training diverged (non-finite loss); lower --learning-rate or --momentum");
+  const learn::EpochLog& last = logs.back();
+  nlohmann::json meta = {
+      {"features", kDkbFeatureSet},
+      {"feature_normalisation", "include/mfr/method/dkb_features.hpp"},
+      {"target", "K_M(p) / max_q K_M(q) per view and budget (include/mfr/learn/dataset.hpp)"},
+      {"layers", learn::kDkbLayers},
+      {"activations", "relu, relu, sigmoid"},
+      {"training",
+       {{"datasets", a.datasets},
+        {"train_scenes", split->trainScenes},
+        {"validation_scenes", split->validScenes},
+        {"train_samples", split->trainX.cols()},
+        {"validation_samples", split->validX.cols()},
+        {"epochs", o.epochs},
+        {"batch", o.batchSize},
+        {"learning_rate", o.learningRate},
+        {"momentum", o.momentum},
+        {"l1_first_hidden", o.regularization.l1FirstHidden},
+        {"l2_second_hidden", o.regularization.l2SecondHidden},
+        {"seed", o.seed},
+        {"final_train_mse", last.trainLoss},
+        {"final_validation_mse", std::isfinite(last.validationLoss)
+                                     ? nlohmann::json(last.validationLoss)
+                                     : nlohmann::json(nullptr)}}}};
+  auto written = learn::writeModel(a.out, learn::Model{net, meta.dump(2)});
+  if (!written) return fail(written.error().message);
+  if (auto curve = writeLossCurve(a.lossCurve, logs); !curve) return fail(curve.error().message);
+  if (!a.quiet)
+    std::printf("%s: %d epochs, %lld training / %lld validation samples, MSE %.5g / %.5g\n",
+                a.out.c_str(), last.epoch, static_cast<long long>(split->trainX.cols()),
+                static_cast<long long>(split->validX.cols()), last.trainLoss, last.validationLoss);
+  return 0;
+}
+
+}  // namespace
+
+Runner addTrainCommand(CLI::App& app) {
+  auto args = std::make_shared<TrainArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "train", "Train the deep k-buffer's network on datasets from mfr dataset (deterministic)");
+  cmd->add_option("datasets", args->datasets, "Datasets (.mfrds)")->required();
+  cmd->add_option("--out,-o", args->out, "Output model (.mfrnn)")->required();
+  cmd->add_option("--log", args->log, "Per-epoch CSV log (default: OUT.log.csv)");
+  cmd->add_option("--loss-curve", args->lossCurve, "Loss curve PNG (default: OUT.loss.png)");
+  cmd->add_option("--validation-scene", args->validationScenes,
+                  "Scene held out for validation (repeatable; default: the last scene; 'none')");
+  cmd->add_option("--epochs", args->train.epochs, "Epochs (default 20)");
+  cmd->add_option("--batch", args->train.batchSize, "Mini-batch size (default 512, the paper's)");
+  cmd->add_option("--learning-rate", args->train.learningRate,
+                  "SGD learning rate (default 1e-3, the paper's)");
+  cmd->add_option("--momentum", args->train.momentum, "SGD momentum (default 0: plain SGD)");
+  cmd->add_option("--l1", args->train.regularization.l1FirstHidden,
+                  "L1 weight on the first hidden layer (default 1e-5)");
+  cmd->add_option("--l2", args->train.regularization.l2SecondHidden,
+                  "L2 weight on the second hidden layer (default 1e-4)");
+  cmd->add_option("--seed", args->train.seed, "Seed of the initial weights and shuffling");
+  cmd->add_flag("--quiet,-q", args->quiet, "No progress or summary");
+  return [args] { return runTrain(*args); };
+}
+
+}  // namespace mfr::cli

@@ -1,0 +1,68 @@
+// The deep k-buffer's training set (DHOIT sec. 3.1.1-3.1.2): per-pixel network inputs paired with
+// the optimal k-buffer's allocation, over scenes x views x budgets.
+//
+// Target scaling: the paper's target is K_M(p) / F(M), numbers near 1 / |P| that a sigmoid output
+// and a mean-squared loss barely see. The runtime only uses I(p) / sum I, so any per-image factor
+// is free; we use t(p) = K_M(p) / max_q K_M(q) over the covered pixels of the same view and budget,
+// which spans [0, 1] (the sigmoid's range) and keeps k(p) proportional to t(p).
+//
+// File format (.mfrds), little-endian:
+//   offset  size   field
+//   0       8      magic "MFRDS\0\0\0"
+//   8       4      u32 version (kDatasetVersion)
+//   12      4      u32 feature count (12)
+//   16      4      u32 S, number of scenes (1..65536)
+//   ...            S x { u32 length (1..4096), UTF-8 name }
+//   ...     4      u32 metadata length m (<= 1 MiB), then m bytes of JSON (how it was generated)
+//   ...     8      u64 N, number of samples (<= 2^32)
+//   ...            N x 68-byte samples: u32 scene, u32 view, u32 budget step, u32 pixel,
+//                  f32 features[12] (dkb_features.hpp), f32 target t(p)
+//   end            (no trailing bytes)
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "mfr/core/result.hpp"
+#include "mfr/method/dkb_features.hpp"
+
+namespace mfr::learn {
+
+inline constexpr uint32_t kDatasetVersion = 1;
+
+struct DatasetSample {
+  uint32_t scene = 0;       // index into Dataset::scenes
+  uint32_t view = 0;        // camera index within the scene
+  uint32_t budgetStep = 0;  // 0 = one fragment per covered pixel ... steps - 1 = all fragments
+  uint32_t pixel = 0;       // y * width + x
+  PixelFeatures features{};
+  float target = 0.0f;
+};
+
+struct Dataset {
+  std::vector<std::string> scenes;
+  std::string metadata;  // JSON
+  std::vector<DatasetSample> samples;
+};
+
+Result<void> writeDataset(const std::string& path, const Dataset& data);
+/// Checks magic, version, feature count, lengths, scene indices, finite values; errors name path.
+Result<Dataset> readDataset(const std::string& path);
+
+/// F(M) of budget step s of `steps`: from one slot per covered pixel to every fragment, evenly.
+uint64_t budgetStepSlots(uint64_t coveredPixels, uint64_t fragments, int step, int steps);
+
+struct ViewSamplingOptions {
+  int budgetSteps = 5;
+  double sampleFraction = 0.2;  // of the covered pixels, per view and budget
+  uint64_t seed = 1;
+  glm::vec3 background{1.0f};
+};
+
+/// Features and optimal targets of one rendered view, for every budget step, sampled.
+Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t scene,
+                                              uint32_t view, const ViewSamplingOptions& options);
+
+}  // namespace mfr::learn

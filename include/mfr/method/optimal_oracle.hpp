@@ -1,0 +1,28 @@
+// The optimal k-buffer's pre-pass over a frame (DHOIT sec. 3.1.2): an exact A-buffer, each pixel's
+// fragments sorted, and its hybrid error curve err_p(k) (optimal_allocation.hpp). The curves do
+// not depend on the budget, so one pre-pass serves any number of budgets (mfr dataset).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/core/result.hpp"
+#include "mfr/method/method.hpp"
+#include "mfr/raster/raster_frame.hpp"
+
+namespace mfr {
+
+struct FrameErrorCurves {
+  std::vector<std::vector<double>> curves;  // per pixel, err(k) for k = 1..n(p)
+  std::vector<uint32_t> n;                  // n(p)
+  uint64_t coveredPixels = 0;
+  uint64_t fragments = 0;  // sum n(p)
+};
+
+/// `compositing`: the rule whose error the curves measure (the optimal k-buffer of DHOIT: hybrid).
+Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 background,
+                                          Compositing compositing = Compositing::Hybrid);
+
+}  // namespace mfr

@@ -1,0 +1,190 @@
+// The deep k-buffer's training set: generation from a rendered view (features + optimal targets,
+// DHOIT sec. 3.1.1-3.1.2) and the .mfrds file format (dataset.hpp).
+#include "mfr/learn/dataset.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+
+#include "mfr/method/optimal_allocation.hpp"
+#include "mfr/method/optimal_oracle.hpp"
+
+namespace mfr::learn {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "the file formats are little-endian");
+
+constexpr char kMagic[8] = {'M', 'F', 'R', 'D', 'S', 0, 0, 0};
+constexpr uint32_t kMaxScenes = 65536, kMaxName = 4096, kMaxMetadata = 1u << 20;
+constexpr size_t kSampleBytes = 4 * 4 + 4 * kDkbFeatureCount + 4;
+
+uint64_t mix(uint64_t x) {  // SplitMix64 finaliser
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+
+// Uniform in [0, 1) from the sample's coordinates: independent of threads and of other samples.
+double sampleUniform(uint64_t seed, uint32_t scene, uint32_t view, uint32_t step, uint32_t pixel) {
+  uint64_t h = mix(seed);
+  h = mix(h ^ scene);
+  h = mix(h ^ (static_cast<uint64_t>(view) << 32 | step));
+  h = mix(h ^ pixel);
+  return static_cast<double>(h >> 11) * 0x1.0p-53;
+}
+
+template <class T>
+void put(std::string& out, T v) {
+  out.append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+class Reader {
+ public:
+  Reader(const std::string& bytes, const std::string& path) : bytes_(bytes), path_(path) {}
+  template <class T>
+  bool get(T& v) {
+    if (bytes_.size() - pos_ < sizeof(T)) return false;
+    std::memcpy(&v, bytes_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return true;
+  }
+  bool getString(std::string& s, size_t n) {
+    if (bytes_.size() - pos_ < n) return false;
+    s.assign(bytes_.data() + pos_, n);
+    pos_ += n;
+    return true;
+  }
+  size_t remaining() const { return bytes_.size() - pos_; }
+  Error error(const std::string& what) const {
+    return makeError("dataset " + path_ + ": " + what + " (at byte " + std::to_string(pos_) + ")");
+  }
+
+ private:
+  const std::string& bytes_;
+  const std::string& path_;
+  size_t pos_ = 0;
+};
+
+}  // namespace
+
+uint64_t budgetStepSlots(uint64_t coveredPixels, uint64_t fragments, int step, int steps) {
+  if (steps <= 1) return fragments;
+  const double t = static_cast<double>(step) / (steps - 1);
+  return coveredPixels +
+         static_cast<uint64_t>(std::llround(t * static_cast<double>(fragments - coveredPixels)));
+}
+
+Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t scene,
+                                              uint32_t view, const ViewSamplingOptions& options) {
+  auto oracle = frameErrorCurves(frame, options.background);
+  if (!oracle) return oracle.error();
+  const std::vector<FeatureAccumulator> pixels = accumulateFeatures(frame);
+  const ImageFeatureStats image = imageFeatureStats(pixels);
+  std::vector<DatasetSample> samples;
+  if (image.coveredPixels == 0) return samples;
+  for (int step = 0; step < options.budgetSteps; ++step) {
+    const uint64_t slots =
+        budgetStepSlots(image.coveredPixels, image.fragments, step, options.budgetSteps);
+    const std::vector<uint32_t> k = allocateOptimalHull(oracle->curves, slots);
+    const uint32_t kMax = *std::max_element(k.begin(), k.end());
+    for (uint32_t p = 0; p < pixels.size(); ++p) {
+      if (pixels[p].n == 0) continue;
+      const uint32_t s = static_cast<uint32_t>(step);
+      if (sampleUniform(options.seed, scene, view, s, p) >= options.sampleFraction) continue;
+      DatasetSample sample;
+      sample.scene = scene;
+      sample.view = view;
+      sample.budgetStep = s;
+      sample.pixel = p;
+      sample.features = pixelFeatures(pixels[p], image, slots);
+      sample.target = static_cast<float>(k[p]) / static_cast<float>(kMax);
+      samples.push_back(sample);
+    }
+  }
+  return samples;
+}
+
+Result<void> writeDataset(const std::string& path, const Dataset& data) {
+  std::string out;
+  out.reserve(64 + data.samples.size() * kSampleBytes);
+  out.append(kMagic, sizeof kMagic);
+  put<uint32_t>(out, kDatasetVersion);
+  put<uint32_t>(out, kDkbFeatureCount);
+  put<uint32_t>(out, static_cast<uint32_t>(data.scenes.size()));
+  for (const std::string& name : data.scenes) {
+    put<uint32_t>(out, static_cast<uint32_t>(name.size()));
+    out += name;
+  }
+  put<uint32_t>(out, static_cast<uint32_t>(data.metadata.size()));
+  out += data.metadata;
+  put<uint64_t>(out, data.samples.size());
+  for (const DatasetSample& s : data.samples) {
+    put(out, s.scene);
+    put(out, s.view);
+    put(out, s.budgetStep);
+    put(out, s.pixel);
+    for (float f : s.features) put(out, f);
+    put(out, s.target);
+  }
+  std::ofstream file(path, std::ios::binary);
+  if (!file) return makeError("dataset " + path + ": cannot open for writing");
+  file.write(out.data(), static_cast<std::streamsize>(out.size()));
+  if (!file) return makeError("dataset " + path + ": write failed");
+  return {};
+}
+
+Result<Dataset> readDataset(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  if (!file) return makeError("dataset " + path + ": cannot open (missing or unreadable)");
+  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  Reader in(bytes, path);
+  std::string magic;
+  if (!in.getString(magic, sizeof kMagic) || std::memcmp(magic.data(), kMagic, sizeof kMagic) != 0)
+    return makeError("dataset " + path + ": not an mfr dataset (bad magic)");
+  uint32_t version = 0, features = 0, sceneCount = 0;
+  if (!in.get(version)) return in.error("truncated header");
+  if (version != kDatasetVersion)
+    return in.error("version " + std::to_string(version) + " is not supported (this build reads " +
+                    std::to_string(kDatasetVersion) + ")");
+  if (!in.get(features) || !in.get(sceneCount)) return in.error("truncated header");
+  if (features != kDkbFeatureCount)
+    return in.error(std::to_string(features) + " features per sample, expected 12");
+  if (sceneCount == 0 || sceneCount > kMaxScenes) return in.error("bad scene count");
+  Dataset data;
+  for (uint32_t i = 0; i < sceneCount; ++i) {
+    uint32_t length = 0;
+    std::string name;
+    if (!in.get(length) || length == 0 || length > kMaxName || !in.getString(name, length))
+      return in.error("truncated or bad scene name");
+    data.scenes.push_back(std::move(name));
+  }
+  uint32_t metadataLength = 0;
+  if (!in.get(metadataLength) || metadataLength > kMaxMetadata ||
+      !in.getString(data.metadata, metadataLength))
+    return in.error("truncated or bad metadata");
+  uint64_t count = 0;
+  if (!in.get(count)) return in.error("truncated sample count");
+  if (count > in.remaining() / kSampleBytes)
+    return in.error("truncated: " + std::to_string(count) + " samples declared, room for " +
+                    std::to_string(in.remaining() / kSampleBytes));
+  if (in.remaining() != count * kSampleBytes) return in.error("trailing bytes after the samples");
+  data.samples.resize(count);
+  for (uint64_t i = 0; i < count; ++i) {
+    DatasetSample& s = data.samples[i];
+    (void)(in.get(s.scene) && in.get(s.view) && in.get(s.budgetStep) && in.get(s.pixel));
+    for (float& f : s.features) (void)in.get(f);
+    (void)in.get(s.target);
+    if (s.scene >= sceneCount) return in.error("sample " + std::to_string(i) + ": bad scene");
+    bool finite = std::isfinite(s.target) && s.target >= 0.0f && s.target <= 1.0f;
+    for (float f : s.features) finite = finite && std::isfinite(f);
+    if (!finite)
+      return in.error("sample " + std::to_string(i) + ": non-finite or out-of-range value");
+  }
+  return data;
+}
+
+}  // namespace mfr::learn

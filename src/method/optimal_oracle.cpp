@@ -1,0 +1,40 @@
+// The optimal k-buffer's pre-pass (DHOIT sec. 3.1.2): exact A-buffer, sorted pixels, error curves.
+#include "mfr/method/optimal_oracle.hpp"
+
+#include <algorithm>
+
+#include "mfr/method/optimal_allocation.hpp"
+#include "mfr/method/render.hpp"
+
+namespace mfr {
+
+Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 background,
+                                          Compositing compositing) {
+  RenderOptions exact;
+  exact.keepStores = true;
+  exact.background = background;
+  auto truth = render(frame, methodPreset("abuffer").value(), exact);
+  if (!truth) return truth.error();
+  FrameErrorCurves out;
+  out.curves.resize(frame.pixelCount());
+  frame.forEachTile([&](int tile) {
+    const TileRect r = frame.tileRect(tile);
+    std::vector<FragmentNode> local;
+    for (int y = r.y0; y <= r.y1; ++y)
+      for (int x = r.x0; x <= r.x1; ++x) {
+        const size_t p = static_cast<size_t>(y) * frame.width() + x;
+        const FragmentNode* first = truth->nodes.data() + truth->offsets[p];
+        local.assign(first, first + truth->counts[p]);
+        std::sort(local.begin(), local.end());
+        out.curves[p] = errorCurve(local.data(), truth->counts[p], background, compositing);
+      }
+  });
+  out.n = std::move(truth->depthComplexity);
+  for (uint32_t c : out.n) {
+    out.coveredPixels += c > 0;
+    out.fragments += c;
+  }
+  return out;
+}
+
+}  // namespace mfr
