@@ -177,7 +177,6 @@ std::string shapeProblem(const std::vector<int>& sizes) {
   return "";
 }
 
-
 // --- decoding steps ---------------------------------------------------------------------------
 
 /// Reads layer l's weights (row-major) and biases starting at `p`.
