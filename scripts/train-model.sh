@@ -7,7 +7,7 @@
 # Writes WORK_DIR/procedural.mfrds, then models/dkb-default.mfrnn with its training log
 # (models/dkb-default.log.csv) and loss curve (models/dkb-default.loss.png). Deterministic: the
 # same binary gives the same bytes (the thread count does not matter). Rebuild afterwards to
-# compile the new model into the library. About 1 minute for the dataset and MODEL_TIME for the
+# compile the new model into the library. About 1 minute for the dataset and about 9 minutes for the
 # training on 2 cores.
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -78,6 +78,23 @@ TEST(OptimalAllocation, ErrorCurveMatchesHybridCompositingAndEndsAtZero) {
   }
 }
 
+TEST(OptimalAllocation, KBufferErrorCurveDropsTheTail) {
+  std::mt19937 rng(9);
+  const glm::vec3 bg(0.2f, 0.5f, 1.0f);
+  for (int trial = 0; trial < 50; ++trial) {
+    const std::vector<FragmentNode> px = randomPixel(rng, 1 + trial % 7);
+    const uint32_t n = static_cast<uint32_t>(px.size());
+    const std::vector<double> e = errorCurve(px.data(), n, bg, Compositing::KBuffer);
+    ASSERT_EQ(e.size(), n);
+    EXPECT_EQ(e.back(), 0.0);
+    const glm::vec3 exact = compositeKBuffer(px.data(), n, bg);
+    for (uint32_t k = 1; k < n; ++k) {
+      const glm::vec3 d = exact - compositeKBuffer(px.data(), k, bg);
+      EXPECT_NEAR(e[k - 1], glm::dot(d, d), 1e-5) << "k=" << k;
+    }
+  }
+}
+
 TEST(OptimalAllocation, BothAllocatorsRespectTheBudgetAndKeepOneFragmentPerPixel) {
   std::mt19937 rng(9);
   for (int trial = 0; trial < 200; ++trial) {
@@ -183,6 +200,26 @@ TEST(OptimalPreset, BeatsTheOtherAllocationsWithinTheSameBudget) {
   EXPECT_LT(eOptimal, linearMse(dynamic.image, truth.image));
   EXPECT_LT(eOptimal, linearMse(fill.image, truth.image));
   EXPECT_LT(linearMse(greedy.image, truth.image), linearMse(dynamic.image, truth.image));
+}
+
+TEST(OptimalPreset, WithKBufferCompositingMinimisesTheKBufferError) {
+  auto scene = loadScene("procedural:hairball?strands=300");
+  ASSERT_TRUE(scene.ok());
+  auto frame = RasterFrame::build(*scene, *scene->defaultCamera, RasterOptions{96, 96, 16, 2});
+  const RenderOutput truth = *render(*frame, methodPreset("abuffer").value(), {});
+  RenderOptions o;
+  o.budgetBytes = 300000;
+  auto error = [&](const std::string& name) {
+    MethodDesc m = methodPreset(name).value();
+    m.compositing = Compositing::KBuffer;
+    auto out = render(*frame, m, o);
+    EXPECT_TRUE(out.ok()) << name;
+    return linearMse(out->image, truth.image);
+  };
+  const double optimal = error("optimal");
+  EXPECT_GT(optimal, 0.0);
+  for (const char* other : {"kplus-dynamic", "vkb-fill", "kplus-sb"})
+    EXPECT_LT(optimal, error(other)) << other;
 }
 
 }  // namespace
