@@ -1,6 +1,7 @@
 // mfr train: trains the deep k-buffer's network (DHOIT sec. 3.1.3) on .mfrds datasets,
 // deterministically from a seed, validating on held-out scenes; writes the model (.mfrnn), a
 // per-epoch log (CSV) and a PNG loss curve.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
