@@ -209,7 +209,11 @@ TEST_F(CompareLibrary, JsonHasTheDocumentedLayout) {
   EXPECT_EQ(j["width"], kSize);
   EXPECT_EQ(j["height"], kSize);
   EXPECT_EQ(j["budget_bytes"], kSmall);
-  EXPECT_EQ(j["compositing"], "kbuffer");
+  EXPECT_EQ(j["compositing"], "per-method");  // no override: each preset's own rule
+  for (const nlohmann::json& run : j["methods"]) {
+    const MethodDesc preset = methodPreset(run["name"].get<std::string>()).value();
+    EXPECT_EQ(run["compositing"], toString(preset.compositing)) << run["name"];
+  }
   EXPECT_EQ(j["ground_truth"]["image"], "ground_truth.png");
   EXPECT_EQ(j["ground_truth"]["depth_complexity_image"], "ground_truth_depth_complexity.png");
   EXPECT_EQ(j["ground_truth"]["mse"], 0.0);

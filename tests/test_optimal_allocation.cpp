@@ -113,9 +113,9 @@ TEST(OptimalAllocation, BothAllocatorsRespectTheBudgetAndKeepOneFragmentPerPixel
   }
 }
 
-TEST(OptimalAllocation, ExactOnConvexCurvesAndNeverBelowTheTrueOptimum) {
+TEST(OptimalAllocation, HullIsExactOnConvexCurves) {
   std::mt19937 rng(11);
-  int convexCases = 0;
+  int convexCases = 0, compared = 0;
   for (int trial = 0; trial < 300; ++trial) {
     std::vector<std::vector<double>> curves;
     uint64_t total = 0;
@@ -127,19 +127,139 @@ TEST(OptimalAllocation, ExactOnConvexCurvesAndNeverBelowTheTrueOptimum) {
       allConvex = allConvex && convex(curves.back());
       total += px.size();
     }
-    convexCases += allConvex;
+    if (!allConvex) continue;
+    ++convexCases;
     for (uint64_t slots = curves.size(); slots <= total; ++slots) {
       const double best = exhaustiveMinimum(curves, slots);
-      const double hull = allocationError(curves, allocateOptimalHull(curves, slots));
-      const double greedy = allocationError(curves, allocateOptimalGreedy(curves, slots));
-      EXPECT_GE(hull, best - 1e-12);
-      EXPECT_GE(greedy, best - 1e-12);
-      if (allConvex) {
-        EXPECT_NEAR(hull, best, 1e-12) << "trial " << trial << " slots " << slots;
-      }
+      EXPECT_NEAR(allocationError(curves, allocateOptimalHull(curves, slots)), best, 1e-12)
+          << "trial " << trial << " slots " << slots;
+      ++compared;
     }
   }
   EXPECT_GT(convexCases, 20);
+  EXPECT_GT(compared, 100);
+}
+
+// Random curves with err(n) = 0 and otherwise arbitrary values: most are not convex.
+std::vector<std::vector<double>> randomCurves(std::mt19937& rng, int pixels, uint32_t maxN) {
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<std::vector<double>> curves;
+  for (int p = 0; p < pixels; ++p) {
+    const uint32_t n = 1 + rng() % maxN;
+    std::vector<double> e(n, 0.0);
+    for (uint32_t i = 0; i + 1 < n; ++i) e[i] = u(rng);
+    curves.push_back(e);
+  }
+  return curves;
+}
+
+// The claim of the optimal oracle: lower bound <= true minimum <= returned <= published greedy,
+// and returned == minimum whenever the reported gap is 0.
+void checkOracleClaims(const std::vector<std::vector<double>>& curves, uint64_t slots,
+                       const OracleOptions& options, int& exactCases, int& hullSuboptimal,
+                       const std::string& what) {
+  const double best = exhaustiveMinimum(curves, slots);
+  const double greedy = allocationError(curves, allocateOptimalGreedy(curves, slots));
+  const double hull = allocationError(curves, allocateOptimalHull(curves, slots));
+  const OracleAllocation a = allocateOptimal(curves, slots, options);
+  expectValid(curves, a.k, slots);
+  EXPECT_NEAR(a.error, allocationError(curves, a.k), 1e-12) << what;
+  EXPECT_LE(a.lagrangianBound, best + 1e-12) << what;
+  EXPECT_LE(a.lowerBound, best + 1e-12) << what;
+  EXPECT_GE(a.error, best - 1e-12) << what;
+  EXPECT_LE(a.error, greedy + 1e-12) << what;
+  EXPECT_LE(a.error, hull + 1e-12) << what;
+  EXPECT_GE(a.gap(), 0.0) << what;
+  if (a.exact) {
+    EXPECT_EQ(a.gap(), 0.0) << what;
+    EXPECT_NEAR(a.error, best, 1e-12) << what;
+    ++exactCases;
+  }
+  if (a.gap() == 0.0) {
+    EXPECT_NEAR(a.error, best, 1e-12) << what;
+  }
+  hullSuboptimal += hull > best + 1e-9;
+}
+
+TEST(OptimalOracle, ExactOnRandomNonConvexCurves) {
+  std::mt19937 rng(2024);
+  int cases = 0, exact = 0, hullSuboptimal = 0, nonconvex = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const auto curves = randomCurves(rng, 2 + trial % 3, 5);
+    uint64_t total = 0;
+    for (const auto& e : curves) {
+      total += e.size();
+      nonconvex += !errorCurveIsConvex(e);
+    }
+    for (uint64_t slots = curves.size(); slots <= total; ++slots, ++cases)
+      checkOracleClaims(curves, slots, {}, exact, hullSuboptimal,
+                        "trial " + std::to_string(trial) + " slots " + std::to_string(slots));
+  }
+  EXPECT_GT(cases, 1000);
+  EXPECT_GT(nonconvex, 500);
+  EXPECT_GT(hullSuboptimal, 50);  // the hull alone is not optimal here ...
+  EXPECT_EQ(exact, cases);        // ... the exact step always is, within its cell limit
+}
+
+TEST(OptimalOracle, WithoutTheExactStepStillBoundedAndNeverWorseThanGreedy) {
+  std::mt19937 rng(77);
+  OracleOptions noDp;
+  noDp.maxDpCells = 0;
+  int cases = 0, exact = 0, hullSuboptimal = 0, withGap = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const auto curves = randomCurves(rng, 3, 4);
+    uint64_t total = 0;
+    for (const auto& e : curves) total += e.size();
+    for (uint64_t slots = curves.size(); slots <= total; ++slots, ++cases) {
+      checkOracleClaims(curves, slots, noDp, exact, hullSuboptimal,
+                        "trial " + std::to_string(trial) + " slots " + std::to_string(slots));
+      withGap += allocateOptimal(curves, slots, noDp).gap() > 0.0;
+    }
+  }
+  EXPECT_GT(cases, 500);
+  EXPECT_GT(withGap, 50);  // the bound is reported, not hidden
+}
+
+TEST(OptimalOracle, ExactOnRealHybridAndKBufferCurves) {
+  // curves from random pixels composited as the renderer does (8-bit colours, both rules)
+  std::mt19937 rng(31);
+  int cases = 0, exact = 0, hullSuboptimal = 0, nonconvex = 0;
+  for (Compositing rule : {Compositing::Hybrid, Compositing::KBuffer})
+    for (int trial = 0; trial < 150; ++trial) {
+      std::vector<std::vector<double>> curves;
+      uint64_t total = 0;
+      for (int p = 0; p < 3; ++p) {
+        const std::vector<FragmentNode> px = randomPixel(rng, 1 + (trial + 2 * p) % 6);
+        curves.push_back(errorCurve(px.data(), static_cast<uint32_t>(px.size()),
+                                    glm::vec3(0.9f, 0.8f, 1.0f), rule));
+        nonconvex += !errorCurveIsConvex(curves.back());
+        total += px.size();
+      }
+      for (uint64_t slots = curves.size(); slots <= total; ++slots, ++cases)
+        checkOracleClaims(curves, slots, {}, exact, hullSuboptimal,
+                          "trial " + std::to_string(trial) + " slots " + std::to_string(slots));
+    }
+  EXPECT_GT(cases, 500);
+  EXPECT_GT(nonconvex, 0);  // real curves are not all convex
+  EXPECT_EQ(exact, cases);
+}
+
+TEST(OptimalOracle, LargeFramesUseTheCoreAndStayWithinTheBudget) {
+  // many pixels: the exhaustive search is out of reach, the bound and the budget are not
+  std::mt19937 rng(5);
+  const auto curves = randomCurves(rng, 20000, 12);
+  uint64_t total = 0;
+  for (const auto& e : curves) total += e.size();
+  const uint64_t slots = curves.size() + (total - curves.size()) / 3;
+  const OracleAllocation a = allocateOptimal(curves, slots);
+  expectValid(curves, a.k, slots);
+  EXPECT_TRUE(a.exact);
+  EXPECT_STREQ(a.solver, "hull+dp");
+  EXPECT_GT(a.corePixels, 0u);
+  EXPECT_LT(a.corePixels, curves.size() / 2);  // reduced-cost fixing fixes most pixels
+  EXPECT_LE(a.lagrangianBound, a.error);
+  EXPECT_LE(a.error, allocationError(curves, allocateOptimalHull(curves, slots)) + 1e-9);
+  EXPECT_LE(a.error, allocationError(curves, allocateOptimalGreedy(curves, slots)) + 1e-9);
 }
 
 TEST(OptimalAllocation, PublishedGreedyIsNotOptimalOnThisCounterexample) {
@@ -200,6 +320,17 @@ TEST(OptimalPreset, BeatsTheOtherAllocationsWithinTheSameBudget) {
   EXPECT_LT(eOptimal, linearMse(dynamic.image, truth.image));
   EXPECT_LT(eOptimal, linearMse(fill.image, truth.image));
   EXPECT_LT(linearMse(greedy.image, truth.image), linearMse(dynamic.image, truth.image));
+  // the oracle's report: the proven minimum, never above the published greedy's error
+  ASSERT_TRUE(optimal.stats.oracle.has_value());
+  ASSERT_TRUE(greedy.stats.oracle.has_value());
+  const OracleReport& report = *optimal.stats.oracle;
+  EXPECT_TRUE(report.exact);
+  EXPECT_EQ(report.gap(), 0.0);
+  EXPECT_LE(report.lagrangianBound, report.error);
+  EXPECT_LE(report.error, greedy.stats.oracle->error + 1e-12);
+  EXPECT_LE(greedy.stats.oracle->lowerBound, report.error + 1e-12);
+  EXPECT_GT(report.nonconvexPixels, 0u);  // real hybrid curves are not all convex
+  EXPECT_FALSE(dynamic.stats.oracle.has_value());
 }
 
 TEST(OptimalPreset, WithKBufferCompositingMinimisesTheKBufferError) {

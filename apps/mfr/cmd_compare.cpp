@@ -26,7 +26,7 @@ struct CompareArgs {
   std::string methods = "fkb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,optimal";
   std::string model;
   std::string out;
-  std::string composite = "kbuffer";
+  std::string composite;  // empty: each preset's own rule
   std::string capture = "tile";
   double pixelsPerDegree = kFlipDefaultPixelsPerDegree;
 };
@@ -130,11 +130,6 @@ int run(const CompareArgs& a, const std::string& version) {
   options.scene = a.scene.source;
   options.seed = a.scene.seed;
   options.flipPixelsPerDegree = a.pixelsPerDegree;
-  if (!a.model.empty()) {
-    auto model = loadDkbModel(a.model);
-    if (!model) return fail(model.error().message);
-    options.model = model.value();
-  }
   if (!(a.pixelsPerDegree > 0.0 && std::isfinite(a.pixelsPerDegree)))
     return fail("--ppd: must be a positive number");
 
@@ -148,6 +143,18 @@ int run(const CompareArgs& a, const std::string& version) {
     options.methods.push_back(name);
   }
   if (options.methods.empty()) return fail("--methods: the method list is empty");
+  if (!a.model.empty()) {  // the model must be used by some method, not silently ignored
+    bool used = false;
+    for (const std::string& name : options.methods)
+      used = used || checkMethodOption(MethodOption::Model, methodPreset(name).value());
+    if (!used)
+      return fail(std::string("--model: none of the methods uses it (only ") +
+                  methodOptionRule(MethodOption::Model).appliesTo + ": " +
+                  presetsAccepting(MethodOption::Model) + ")");
+    auto model = loadDkbModel(a.model);
+    if (!model) return fail(model.error().message);
+    options.model = model.value();
+  }
   // budgets
   for (const std::string& text : splitList(a.budgets)) {
     if (text.empty()) return fail("--budget '" + a.budgets + "': empty budget in the list");
@@ -158,9 +165,11 @@ int run(const CompareArgs& a, const std::string& version) {
     options.budgets.push_back(bytes.value());
   }
   if (options.budgets.empty()) return fail("--budget: no budget given (e.g. --budget 20MB,40MB)");
-  auto compositing = parseCompositing(a.composite);
-  if (!compositing) return fail("--composite: " + compositing.error().message);
-  options.compositing = compositing.value();
+  if (!a.composite.empty()) {
+    auto compositing = parseCompositing(a.composite);
+    if (!compositing) return fail("--composite: " + compositing.error().message);
+    options.compositing = compositing.value();
+  }
   if (a.capture == "parallel")
     options.capture = CaptureMode::FragmentParallel;
   else if (a.capture != "tile")
@@ -251,9 +260,11 @@ Runner addCompareCommand(CLI::App& app) {
                   "Memory budgets, comma-separated, e.g. 20MB,40MB (MB = 2^20 bytes)")
       ->required();
   cmd->add_option("--methods,-m", args->methods,
-                  "Methods, comma-separated (default fkb,kplus-dynamic,vkb,vkb-fill)");
+                  "Methods, comma-separated (default " + args->methods + "). " + presetHelp());
   cmd->add_option("--out,-o", args->out, "Output folder (created if missing)")->required();
-  cmd->add_option("--composite", args->composite, "kbuffer or hybrid (the bounded methods)");
+  cmd->add_option("--composite", args->composite,
+                  "kbuffer or hybrid for every method (default: each preset's own rule, hybrid "
+                  "for dkb* and optimal*, else kbuffer)");
   cmd->add_option("--capture", args->capture, "tile (default) or parallel");
   cmd->add_option("--model", args->model,
                   "Deep k-buffer model (.mfrnn, from mfr train; default: the built-in model)");

@@ -11,6 +11,7 @@
 #include "common.hpp"
 #include "mfr/core/colormap.hpp"
 #include "mfr/core/units.hpp"
+#include "mfr/method/method_options.hpp"
 #include "mfr/method/render.hpp"
 #include "mfr/method/stats_json.hpp"
 
@@ -26,7 +27,7 @@ struct RenderArgs {
   std::string method = "abuffer";
   std::string budget;
   std::optional<uint32_t> k;
-  std::string composite = "kbuffer";
+  std::string composite;  // empty: the preset's own rule
   int occupancyD = 1;
   std::string capture = "tile";
   // variable k-buffer
@@ -36,32 +37,53 @@ struct RenderArgs {
   ImportanceParams importance;
   std::vector<double> fovea;
   bool noDepthTerm = false, noPeripheryTerm = false, noFresnelTerm = false, noNoise = false;
+  const CLI::App* command = nullptr;  // which options were given
+  bool given(const char* flag) const { return command->count(flag) > 0; }
 };
+
+// An option given for a method it does not apply to is an error, not silently ignored.
+Result<void> checkApplicable(const RenderArgs& a, const MethodDesc& m) {
+  const std::pair<const char*, MethodOption> flags[] = {
+      {"--k", MethodOption::K},
+      {"--occupancy-d", MethodOption::OccupancyD},
+      {"--model", MethodOption::Model},
+      {"--importance-map", MethodOption::ImportanceMap},
+      {"--importance-factors", MethodOption::ImportanceParams},
+      {"--importance-alpha", MethodOption::ImportanceParams},
+      {"--n-limit", MethodOption::ImportanceParams},
+      {"--periphery-d", MethodOption::ImportanceParams},
+      {"--fovea", MethodOption::ImportanceParams},
+      {"--noise", MethodOption::ImportanceParams},
+      {"--no-depth-term", MethodOption::ImportanceParams},
+      {"--no-periphery-term", MethodOption::ImportanceParams},
+      {"--no-fresnel-term", MethodOption::ImportanceParams},
+      {"--no-noise", MethodOption::ImportanceParams}};
+  for (const auto& [flag, option] : flags)
+    if (a.given(flag))
+      if (auto ok = checkMethodOption(option, m, flag); !ok) return ok.error();
+  return {};
+}
 
 Result<MethodDesc> buildMethod(const RenderArgs& a) {
   auto method = methodPreset(a.method);
   if (!method) return method.error();
   MethodDesc m = method.value();
+  if (auto ok = checkApplicable(a, m); !ok) return ok.error();
   if (a.k) {
     if (*a.k < 1 || *a.k > (1u << 20)) return makeError("--k: must be in [1, 1048576]");
-    if (m.allocation == AllocationPolicy::Unbounded)
-      return makeError("--k: the abuffer keeps every fragment; pick a bounded method");
     if (m.name.rfind("zbuffer", 0) == 0 && *a.k != 1) return makeError("--k: zbuffer has k = 1");
     m.k = *a.k;
   }
-  auto compositing = parseCompositing(a.composite);
-  if (!compositing) return makeError("--composite: " + compositing.error().message);
-  m.compositing = compositing.value();
-  const bool deep = m.allocation == AllocationPolicy::Importance &&
-                    m.importanceSource == ImportanceSource::Network;
+  if (!a.composite.empty()) {  // otherwise the preset's own rule
+    auto compositing = parseCompositing(a.composite);
+    if (!compositing) return makeError("--composite: " + compositing.error().message);
+    m.compositing = compositing.value();
+  }
   if (!a.model.empty()) {
-    if (!deep) return makeError("--model: only for the deep k-buffer methods (dkb, dkb-fill)");
     auto model = loadDkbModel(a.model);
     if (!model) return model.error();
     m.model = model.value();
   }
-  if (deep && !a.importanceFactors.empty())
-    return makeError("--importance-factors: the deep k-buffer's importance has no factors");
   if (m.allocation == AllocationPolicy::Importance) {
     ImportanceParams ip = a.importance;
     if (!(ip.alpha >= 0.0f && ip.alpha <= 1.0f))
@@ -82,10 +104,6 @@ Result<MethodDesc> buildMethod(const RenderArgs& a) {
     ip.useFresnel = !a.noFresnelTerm;
     ip.useNoise = !a.noNoise;
     m.importance = ip;
-  } else if (!a.importanceMap.empty() || !a.importanceFactors.empty()) {
-    return makeError(
-        "--importance-map/--importance-factors: only for importance methods (vkb, vkb-fill, dkb, "
-        "dkb-fill)");
   }
   if (m.occupancyWords > 0) {
     if (a.occupancyD < 1 || a.occupancyD > 64)
@@ -186,6 +204,8 @@ int run(const RenderArgs& a) {
     stats["view"] = v;
     stats["compositing"] = toString(method->compositing);
     stats["capture"] = a.capture;
+    stats["threads"] = frame->threads();
+    stats["tile_workers"] = frame->arenaThreads();
     allStats.push_back(stats);
     if (!a.scene.quiet && !a.scene.json) {
       const RenderStats& s = result->stats;
@@ -220,21 +240,26 @@ Runner addRenderCommand(CLI::App& app) {
                   "Write the fragments-per-pixel map (colour-mapped PNG with legend)");
   cmd->add_option("--k-map", args->kMap, "Write the per-pixel k as a colour-mapped PNG");
   cmd->add_option("--stats-json", args->statsJson, "Write the run's statistics as JSON");
-  cmd->add_option("--method,-m", args->method,
-                  "zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, vkb, "
-                  "vkb-fill (+occupancy)");
+  cmd->add_option("--method,-m", args->method, presetHelp());
   cmd->add_option("--budget,-M", args->budget, "Memory budget, e.g. 20MB (MB = 2^20 bytes)");
-  cmd->add_option("--k", args->k, "Explicit k (otherwise derived from the budget)");
-  cmd->add_option("--composite", args->composite, "kbuffer or hybrid");
-  cmd->add_option("--occupancy-d", args->occupancyD, "Occupancy map: 32*d buckets (default 1)");
+  cmd->add_option("--k", args->k,
+                  "Explicit k (otherwise derived from the budget)" + appliesTo(MethodOption::K));
+  cmd->add_option("--composite", args->composite,
+                  "kbuffer or hybrid (default: the preset's own rule, hybrid for dkb* and "
+                  "optimal*, else kbuffer)");
+  cmd->add_option("--occupancy-d", args->occupancyD,
+                  "Occupancy map: 32*d buckets (default 1)" + appliesTo(MethodOption::OccupancyD));
   cmd->add_option("--capture", args->capture,
                   "tile (tile-owned, lock-free) or parallel (fragment-parallel, spin-locks)");
-  cmd->add_option("--importance-map", args->importanceMap,
-                  "vkb: write the importance map I(p) (colour-mapped PNG)");
+  cmd->add_option(
+      "--importance-map", args->importanceMap,
+      "Write the importance map I(p) (colour-mapped PNG)" + appliesTo(MethodOption::ImportanceMap));
   cmd->add_option("--importance-factors", args->importanceFactors,
-                  "vkb: write each importance factor as a PNG into this folder");
+                  "Write each importance factor as a PNG into this folder" +
+                      appliesTo(MethodOption::ImportanceParams));
   cmd->add_option("--model", args->model,
-                  "dkb: network model (.mfrnn from mfr train; default: the built-in model)");
+                  "Network model (.mfrnn from mfr train; default: the built-in model)" +
+                      appliesTo(MethodOption::Model));
   cmd->add_option("--importance-alpha", args->importance.alpha, "vkb Eq. 3 alpha (default 0.375)");
   cmd->add_option("--n-limit", args->importance.nLimit, "vkb Eq. 3 N_limit (default 20)");
   cmd->add_option("--periphery-d", args->importance.peripheryExponent, "vkb Eq. 4 d (default 3)");
@@ -247,6 +272,7 @@ Runner addRenderCommand(CLI::App& app) {
   cmd->add_flag("--no-periphery-term", args->noPeripheryTerm, "vkb: switch off I_per");
   cmd->add_flag("--no-fresnel-term", args->noFresnelTerm, "vkb: switch off I_f");
   cmd->add_flag("--no-noise", args->noNoise, "vkb: switch off the noise of Eq. 6");
+  args->command = cmd;
   return [args] { return run(*args); };
 }
 

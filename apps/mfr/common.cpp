@@ -71,6 +71,9 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
     if (b < 0.0 || b > 1.0) return makeError("--background: components must be in [0, 1]");
   if (o.camera.size() != 0 && o.camera.size() != 6 && o.camera.size() != 9 && o.camera.size() != 10)
     return makeError("--camera: expected 6, 9 or 10 numbers");
+  if (o.view < -1) return makeError("--view: must be a camera index (0-based)");
+  if (!o.camera.empty() && o.view >= 0)
+    return makeError("--view and --camera: give one camera, not both");
 
   LoadOptions load;
   load.seed = o.seed;
@@ -157,6 +160,16 @@ void Progress::loop() {
     std::fflush(stderr);
     printed_ = true;
   }
+}
+
+std::string appliesTo(MethodOption option) {
+  return " (applies to: " + presetsAccepting(option) + ")";
+}
+
+std::string presetHelp() {
+  std::string list;
+  for (const std::string& name : presetNames()) list += (list.empty() ? "" : ", ") + name;
+  return "Method: " + list + " (each bounded one also NAME+occupancy)";
 }
 
 int fail(const std::string& message) {

@@ -14,6 +14,7 @@
 
 #include "mfr/core/result.hpp"
 #include "mfr/learn/model_file.hpp"
+#include "mfr/method/method_options.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr::cli {
@@ -73,6 +74,12 @@ class Progress {
 
 /// Reads a model file for the deep k-buffer and checks that it fits (errors name the path).
 Result<std::shared_ptr<const learn::Model>> loadDkbModel(const std::string& path);
+
+/// " (applies to: fkb, kplus-array, ...)" for an option's help text, from the option table.
+std::string appliesTo(MethodOption option);
+
+/// "Method: zbuffer, abuffer, ... (each bounded one also NAME+occupancy)" from the preset list.
+std::string presetHelp();
 
 /// Prints "mfr: error: <message>" and returns the exit code 1.
 int fail(const std::string& message);

@@ -47,11 +47,11 @@ const char* captureName(CaptureMode c) {
   return c == CaptureMode::TileOwned ? "tile" : "parallel";
 }
 
-nlohmann::json runToJson(const CompareRun& run, Compositing compositing) {
+nlohmann::json runToJson(const CompareRun& run) {
   nlohmann::json j;
   j["name"] = run.method;
   j["budget_bytes"] = run.budgetBytes ? nlohmann::json(*run.budgetBytes) : nlohmann::json(nullptr);
-  j["compositing"] = toString(compositing);
+  j["compositing"] = toString(run.compositing);
   if (run.error) {
     j["error"] = *run.error;
     return j;
@@ -128,7 +128,7 @@ Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptio
     if (!preset) return preset.error();
     if (!seenMethods.insert(name).second) return makeError("method '" + name + "': listed twice");
     MethodDesc m = preset.value();
-    m.compositing = options.compositing;
+    if (options.compositing) m.compositing = *options.compositing;
     m.importance.seed = options.seed;
     m.model = options.model;
     methods.push_back(m);
@@ -190,6 +190,7 @@ Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptio
     for (const MethodDesc& method : methods) {
       CompareRun& run = cb.runs.emplace_back();
       run.method = method.name;
+      run.compositing = method.compositing;
       run.budgetBytes = budget;
       run.budgetSlots = MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel)
                             .fragmentSlots(budget, pixels);
@@ -248,19 +249,19 @@ nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersi
   j["scene"] = r.scene;
   j["width"] = r.width;
   j["height"] = r.height;
-  j["compositing"] = toString(r.compositing);
+  j["compositing"] = r.compositing ? toString(*r.compositing) : "per-method";
   j["capture"] = captureName(r.capture);
   j["flip_pixels_per_degree"] = r.flipPixelsPerDegree;
   j["budget_bytes"] =
       r.budgets.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.budgets[0].budgetBytes);
-  nlohmann::json gt = runToJson(r.groundTruth, Compositing::KBuffer);
+  nlohmann::json gt = runToJson(r.groundTruth);
   gt["depth_complexity_image"] = r.depthComplexityFile;
   j["ground_truth"] = gt;
   j["k_map_scale"] = r.kMapScale;
   nlohmann::json budgets = nlohmann::json::array();
   for (const CompareBudget& cb : r.budgets) {
     nlohmann::json runs = nlohmann::json::array();
-    for (const CompareRun& run : cb.runs) runs.push_back(runToJson(run, r.compositing));
+    for (const CompareRun& run : cb.runs) runs.push_back(runToJson(run));
     budgets.push_back(
         {{"budget_bytes", cb.budgetBytes}, {"budget_label", cb.label}, {"methods", runs}});
   }
@@ -287,9 +288,9 @@ std::string compareToCsv(const CompareResult& r) {
          "total_ms";
   for (const std::string& p : passes) csv << ",time_" << p << "_ms";
   csv << ",error\n";
-  const auto row = [&](const CompareRun& run, Compositing compositing) {
+  const auto row = [&](const CompareRun& run) {
     csv << (run.budgetBytes ? std::to_string(*run.budgetBytes) : std::string()) << ','
-        << csvField(run.method) << ',' << toString(compositing) << ',';
+        << csvField(run.method) << ',' << toString(run.compositing) << ',';
     if (run.error) {
       csv << "error";
       for (size_t i = 0; i < 20 + passes.size(); ++i) csv << ',';
@@ -313,9 +314,9 @@ std::string compareToCsv(const CompareResult& r) {
     }
     csv << ",\n";
   };
-  row(r.groundTruth, Compositing::KBuffer);
+  row(r.groundTruth);
   for (const CompareBudget& cb : r.budgets)
-    for (const CompareRun& run : cb.runs) row(run, r.compositing);
+    for (const CompareRun& run : cb.runs) row(run);
   return csv.str();
 }
 

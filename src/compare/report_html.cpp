@@ -238,11 +238,13 @@ std::string svgPlot(const std::string& title, const std::string& yLabel, bool al
     if (!zeroBased) ay.lo = std::min(ay.lo, yTicks.front());
     ay.hi = std::max(ay.hi, yTicks.back());
   }
-  // frame and grid
+  // frame and grid; the frame carries the axes' ranges (data-*) so the plot can be read back
   svg += format(
       "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"#fcfcfc\" "
-      "stroke=\"#333\" stroke-width=\"1\"/>",
-      x0, y1, x1 - x0, y0 - y1);
+      "stroke=\"#333\" stroke-width=\"1\" data-x-scale=\"%s\" data-x-lo=\"%.17g\" "
+      "data-x-hi=\"%.17g\" data-y-scale=\"%s\" data-y-lo=\"%.17g\" data-y-hi=\"%.17g\"/>",
+      x0, y1, x1 - x0, y0 - y1, ax.log ? "log" : "linear", ax.lo, ax.hi, ay.log ? "log" : "linear",
+      ay.lo, ay.hi);
   for (double t : yTicks) {
     const double y = ay.map(t, y0, y1);
     if (y < y1 - 0.5 || y > y0 + 0.5) continue;
@@ -275,8 +277,9 @@ std::string svgPlot(const std::string& title, const std::string& yLabel, bool al
   svg +=
       format("<text transform=\"translate(18 %.1f) rotate(-90)\" text-anchor=\"middle\">%s</text>",
              (y0 + y1) / 2, escape(yText).c_str());
-  // series
+  // series; each point carries its exact values (data-x, data-y) next to its drawn position
   for (const Series& s : series) {
+    svg += "<g class=\"series\" data-series=\"" + escape(s.name) + "\">";
     std::string path;
     for (const auto& [x, y] : s.points) {
       path += path.empty() ? "M" : " L";
@@ -286,7 +289,9 @@ std::string svgPlot(const std::string& title, const std::string& yLabel, bool al
       svg += format("<path d=\"%s\" fill=\"none\" stroke=\"%s\" stroke-width=\"2\"/>", path.c_str(),
                     s.colour.c_str());
     for (const auto& [x, y] : s.points)
-      svg += markerSvg(s.marker, ax.map(x, x0, x1), ay.map(y, y0, y1), s.colour);
+      svg += format("<g class=\"point\" data-x=\"%.17g\" data-y=\"%.17g\">", x, y) +
+             markerSvg(s.marker, ax.map(x, x0, x1), ay.map(y, y0, y1), s.colour) + "</g>";
+    svg += "</g>";
   }
   // legend
   double ly = y1 + 8;
@@ -440,7 +445,14 @@ std::string resultsTable(const CompareResult& r, const CompareBudget& cb) {
          format("%.1f", s.totalMs()) + "</td><td class=\"passes\">" + passes(s) + "</td></tr>";
   }
   for (const CompareRun& run : cb.runs) {
-    t += "<tr><td>" + escape(run.method) + "</td>";
+    t += "<tr><td>" + escape(run.method) + "<small> " + toString(run.compositing) + "</small>";
+    if (run.ok() && run.stats.oracle) {
+      const OracleReport& o = *run.stats.oracle;
+      t += o.exact ? std::string("<small>oracle: proven minimum</small>")
+                   : "<small>oracle: error &le; lower bound " + sci(o.lowerBound) + " + gap " +
+                         sci(o.gap()) + "</small>";
+    }
+    t += "</td>";
     if (!run.ok()) {
       t += "<td class=\"err\" colspan=\"13\">failed: " + escape(*run.error) + "</td></tr>";
       continue;
@@ -557,7 +569,10 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
   h += "<h1>Multi-fragment rendering under a memory budget</h1>\n";
   h += "<p class=\"subtitle\">Scene <code>" + escape(r.scene) + "</code> &middot; " + size +
        " pixels &middot; budget" + (r.budgets.size() > 1 ? "s " : " ") + budgetsText +
-       " &middot; " + escape(toString(r.compositing)) + " compositing</p>\n";
+       " &middot; " +
+       (r.compositing ? escape(toString(*r.compositing)) + " compositing"
+                      : std::string("each method's own compositing")) +
+       "</p>\n";
 
   // set-up
   h += "<h2 id=\"setup\">1&ensp;Set-up</h2>\n<table class=\"meta\">\n";
@@ -572,10 +587,16 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
   }
   h += " &mdash; binary units, 1&#8201;MiB = 2<sup>20</sup>&#8201;B</td></tr>\n";
   h += "<tr><th>Methods</th><td>" + methodsText + "</td></tr>\n";
-  h += "<tr><th>Compositing</th><td>" + escape(toString(r.compositing)) +
-       (r.compositing == Compositing::Hybrid
-            ? " (sorted core + order-independent tail, 20&#8201;B/pixel of tail accumulators)"
-            : " (captured fragments sorted and blended front to back; the rest dropped)") +
+  const char* kHybridText =
+      " (sorted core + order-independent tail, 20&#8201;B/pixel of tail accumulators)";
+  const char* kKBufferText =
+      " (captured fragments sorted and blended front to back; the rest dropped)";
+  h += "<tr><th>Compositing</th><td>" +
+       (r.compositing ? escape(toString(*r.compositing)) +
+                            (*r.compositing == Compositing::Hybrid ? kHybridText : kKBufferText)
+                      : std::string("each preset's own rule: hybrid") + kHybridText +
+                            " for dkb* and optimal*, kbuffer" + kKBufferText +
+                            " for the others (per run in the tables)") +
        "</td></tr>\n";
   h += "<tr><th>Capture</th><td>" +
        std::string(r.capture == CaptureMode::TileOwned
@@ -699,7 +720,12 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
        "k<sup>+</sup>-buffer (max-array / max-heap / K+B-SB counted k / dynamic k from the "
        "depth-complexity histogram); <code>vkb</code> variable k-buffer with importance maps, "
        "<code>vkb-fill</code> the same with unused slots handed to the most important pixels; "
-       "<code>+occupancy</code> adds occupancy-map culling.</dd>\n";
+       "<code>dkb</code> deep k-buffer (importance from the network), <code>dkb-fill</code> the "
+       "same with unused slots handed out; <code>optimal</code> the optimal k-buffer oracle "
+       "(exact A-buffer pre-pass; its allocation is the proven minimum of the summed squared "
+       "error, or its distance to a lower bound is shown), <code>optimal-greedy</code> DHOIT's "
+       "Algorithm 1 as published; <code>+occupancy</code> adds occupancy-map culling. Each run "
+       "names the compositing rule it used.</dd>\n";
   h += "</dl>\n";
   h += "<footer>Generated by " + escape(info.mfrVersion.empty() ? "mfr" : info.mfrVersion) +
        " <code>compare</code>. All images are files next to this page.</footer>\n";

@@ -161,6 +161,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
         // from high to low; exact because k never exceeds the last bin
         std::vector<uint64_t> histogram(kHistogramBins, 0);
         for (uint32_t c : n) ++histogram[std::min<uint64_t>(c, kHistogramBins - 1)];
+        a.scratchBytes += histogram.capacity() * sizeof(uint64_t);
         // never above the largest n(p): a larger k buys nothing
         uint64_t maxN = 1;
         for (uint32_t c : n) maxN = std::max<uint64_t>(maxN, c);
@@ -208,6 +209,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
         }
         fillByImportance(n, importance, slotsInBudget, k);
       }
+      a.scratchBytes += k.capacity() * sizeof(uint64_t);
       a.reservedK.resize(pixels);
       for (size_t p = 0; p < pixels; ++p) {
         a.reservedSlots += k[p];

@@ -29,6 +29,12 @@ Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 ba
         out.curves[p] = errorCurve(local.data(), truth->counts[p], background, compositing);
       }
   });
+  out.bytesAllocated =
+      truth->stats.bytesAllocated + truth->nodes.capacity() * sizeof(FragmentNode) +
+      truth->offsets.capacity() * sizeof(uint64_t) + truth->counts.capacity() * sizeof(uint32_t) +
+      out.curves.capacity() * sizeof(std::vector<double>);
+  for (const std::vector<double>& c : out.curves)
+    out.bytesAllocated += c.capacity() * sizeof(double);
   out.n = std::move(truth->depthComplexity);
   for (uint32_t c : out.n) {
     out.coveredPixels += c > 0;

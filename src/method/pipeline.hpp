@@ -2,8 +2,10 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "mfr/capture/occupancy_map.hpp"
@@ -24,6 +26,31 @@ struct Allocation {
   // accounted for) but never filled, so the engine materialises only min(k(p), n(p)).
   std::vector<uint32_t> reservedK;  // k(p) as allocated (empty: same as capacity)
   uint64_t reservedSlots = 0;       // sum of k(p): the nodes the memory model charges
+  uint64_t scratchBytes = 0;        // temporary buffers of the policy (histogram, k before caps)
+};
+
+/// The CPU engine's measured memory: each buffer's bytes, added where it is allocated.
+class BufferLedger {
+ public:
+  template <class Vector>
+  void add(const char* category, const Vector& v) {
+    addBytes(category, v.capacity() * sizeof(typename Vector::value_type));
+  }
+  void addBytes(const char* category, uint64_t bytes) {
+    if (bytes) bytes_[category] += bytes;
+  }
+  void addAll(const std::map<std::string, uint64_t>& other) {
+    for (const auto& [category, bytes] : other) bytes_[category] += bytes;
+  }
+  const std::map<std::string, uint64_t>& byCategory() const { return bytes_; }
+  uint64_t total() const {
+    uint64_t t = 0;
+    for (const auto& [category, bytes] : bytes_) t += bytes;
+    return t;
+  }
+
+ private:
+  std::map<std::string, uint64_t> bytes_;
 };
 
 /// Turns the policy, the budget and (when a count pass ran) n(p) into k(p) and offsets.

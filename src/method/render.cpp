@@ -91,18 +91,39 @@ ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method,
   return image;
 }
 
-// The optimal k-buffer's pre-pass: n(p) and the k(p) of the allocator over hybrid error curves
-// (no k when the budget cannot give every covered pixel a slot: allocate() reports that).
-Result<std::pair<std::vector<uint32_t>, std::vector<uint32_t>>> optimalK(
-    const RasterFrame& frame, const MethodDesc& method, const RenderOptions& options,
-    uint64_t slots) {
+// The optimal k-buffer's pre-pass: n(p) and the oracle's k(p) with its bound over the error
+// curves of the method's compositing rule (no k when the budget cannot give every covered pixel
+// a slot: allocate() reports that).
+struct OracleChoice {
+  std::vector<uint32_t> n, k;
+  std::optional<OracleReport> report;
+  uint64_t bytesAllocated = 0;  // the pre-pass (A-buffer, error curves)
+};
+
+Result<OracleChoice> optimalK(const RasterFrame& frame, const MethodDesc& method,
+                              const RenderOptions& options, uint64_t slots) {
   auto oracle = frameErrorCurves(frame, options.background, method.compositing);
   if (!oracle) return oracle.error();
-  if (slots < oracle->coveredPixels)
-    return std::make_pair(std::move(oracle->n), std::vector<uint32_t>());
-  std::vector<uint32_t> k = method.publishedGreedy ? allocateOptimalGreedy(oracle->curves, slots)
-                                                   : allocateOptimalHull(oracle->curves, slots);
-  return std::make_pair(std::move(oracle->n), std::move(k));
+  OracleChoice out;
+  out.bytesAllocated = oracle->bytesAllocated;
+  if (slots < oracle->coveredPixels) {
+    out.n = std::move(oracle->n);
+    return out;
+  }
+  OracleOptions oo;
+  oo.publishedGreedy = method.publishedGreedy;
+  OracleAllocation a = allocateOptimal(oracle->curves, slots, oo);
+  OracleReport& r = out.report.emplace();
+  r.error = a.error;
+  r.lowerBound = a.lowerBound;
+  r.lagrangianBound = a.lagrangianBound;
+  r.exact = a.exact;
+  r.solver = a.solver;
+  r.nonconvexPixels = a.nonconvexPixels;
+  r.corePixels = a.corePixels;
+  out.n = std::move(oracle->n);
+  out.k = std::move(a.k);
+  return out;
 }
 
 }  // namespace
@@ -152,6 +173,7 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   stats.method = method.name;
   stats.budgetBytes = options.budgetBytes;
   PassTimer timer(stats.passes);
+  detail::BufferLedger ledger;
   const size_t pixels = frame.pixelCount();
   const MemoryModel memory =
       MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
@@ -168,6 +190,7 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   else if (method.allocation != AllocationPolicy::FixedK &&
            !(method.allocation == AllocationPolicy::Optimal && options.budgetBytes))
     out.depthComplexity = timer.run("count", [&] { return countFragments(frame); });
+  ledger.add("depth_complexity", out.depthComplexity);
 
   // importance (variable k-buffer): the previous frame's nearest |n.v| (a preceding frame from
   // the same camera unless the caller hands one over), then the map
@@ -193,6 +216,7 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
     const double cpu = featureCpu + inferenceCpu;
     stats.passes.push_back({"features", cpu > 0.0 ? wall * featureCpu / cpu : wall});
     stats.passes.push_back({"inference", cpu > 0.0 ? wall * inferenceCpu / cpu : 0.0});
+    ledger.add("importance", out.importance.importance);
   } else if (method.allocation == AllocationPolicy::Importance) {
     out.nearestCosine = timer.run("nearest_normal", [&] { return nearestCosine(frame); });
     const std::vector<float>& previous =
@@ -203,6 +227,11 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
       return computeImportance(frame.width(), frame.height(), out.depthComplexity, previous,
                                method.importance);
     });
+    ledger.add("nearest_normal", out.nearestCosine);
+    for (const std::vector<float>* map :
+         {&out.importance.importance, &out.importance.depth, &out.importance.periphery,
+          &out.importance.fresnel, &out.importance.noise})
+      ledger.add("importance", *map);
   }
 
   // optimal k-buffer (offline oracle): exact A-buffer, per-pixel hybrid error curves, allocation
@@ -211,8 +240,12 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
     const uint64_t slots = memory.fragmentSlots(*options.budgetBytes, pixels);
     auto chosen = timer.run("oracle", [&] { return optimalK(frame, method, options, slots); });
     if (!chosen) return chosen.error();
-    out.depthComplexity = std::move(chosen->first);
-    oracleK = std::move(chosen->second);
+    out.depthComplexity = std::move(chosen->n);
+    oracleK = std::move(chosen->k);
+    stats.oracle = std::move(chosen->report);
+    ledger.add("depth_complexity", out.depthComplexity);
+    ledger.add("oracle_k", oracleK);
+    ledger.addBytes("oracle_prepass", chosen->bytesAllocated);
   }
 
   // allocate
@@ -222,6 +255,11 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   });
   if (!allocated) return allocated.error();
   detail::Allocation& alloc = allocated.value();
+  ledger.add("k", alloc.capacity);
+  ledger.add("k", alloc.reservedK);
+  ledger.add("offsets", alloc.offsets);
+  ledger.add("store_kind", alloc.kind);
+  ledger.addBytes("allocation_scratch", alloc.scratchBytes);
 
   // buffers
   detail::Stores stores;
@@ -233,12 +271,17 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
     if (options.capture == CaptureMode::FragmentParallel) stores.locks.assign(pixels, 0);
     if (method.compositing == Compositing::Hybrid) stores.tails.assign(pixels, HybridTail{});
   });
+  ledger.addBytes("nodes", stores.nodes.size() * sizeof(FragmentNode));
+  ledger.add("counters", stores.counts);
+  ledger.add("locks", stores.locks);
+  ledger.add("tail", stores.tails);
 
   // occupancy culling passes
   OccupancyMap occupancy;
   if (method.occupancyWords > 0) {
     occupancy = OccupancyMap(pixels, method.occupancyWords);
     buildOccupancy(frame, alloc, occupancy, timer);
+    ledger.addBytes("occupancy", occupancy.allocatedBytes());
   }
 
   // capture
@@ -256,6 +299,8 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   stats.bytesByCategory = memory.breakdown(pixels, alloc.reservedSlots);
   for (const auto& [category, bytes] : stats.bytesByCategory) stats.bytesUsed += bytes;
   if (options.budgetBytes) MFR_CHECK(stats.bytesUsed <= *options.budgetBytes);
+  stats.bytesAllocatedByCategory = ledger.byCategory();
+  stats.bytesAllocated = ledger.total();
   stats.fragmentsGenerated = counters.generated;
   stats.culledOccupancy = counters.culledOccupancy;
   stats.culledKPlus = counters.culledKPlus;

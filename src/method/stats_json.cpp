@@ -8,6 +8,8 @@ nlohmann::json statsToJson(const RenderStats& s) {
   j["budget_bytes"] = s.budgetBytes ? nlohmann::json(*s.budgetBytes) : nlohmann::json(nullptr);
   j["bytes_used"] = s.bytesUsed;
   j["bytes_by_category"] = s.bytesByCategory;
+  j["bytes_allocated"] = s.bytesAllocated;
+  j["bytes_allocated_by_category"] = s.bytesAllocatedByCategory;
   j["fragment_slots"] = s.fragmentSlots;
   j["fragments_generated"] = s.fragmentsGenerated;
   j["fragments_captured"] = s.captured;
@@ -29,6 +31,17 @@ nlohmann::json statsToJson(const RenderStats& s) {
   for (const PassTime& p : s.passes) times[p.name] = p.ms;
   j["time_ms"] = times;
   j["total_ms"] = s.totalMs();
+  if (s.oracle) {
+    const OracleReport& o = *s.oracle;
+    j["oracle_error"] = o.error;
+    j["oracle_lower_bound"] = o.lowerBound;
+    j["oracle_gap"] = o.gap();
+    j["oracle_lagrangian_bound"] = o.lagrangianBound;
+    j["oracle_exact"] = o.exact;
+    j["oracle_solver"] = o.solver;
+    j["oracle_nonconvex_pixels"] = o.nonconvexPixels;
+    j["oracle_core_pixels"] = o.corePixels;
+  }
   return j;
 }
 

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <string>
 #include <thread>
 
@@ -18,8 +19,18 @@ int resolveThreads(int threads) {
   return hw > 0 ? static_cast<int>(hw) : 1;
 }
 
+int maxTileWorkers() {
+  // MFR_MAX_WORKERS raises the cap above the hardware threads (tests: 8 workers on 2 cores)
+  static const int cap = [] {
+    const char* env = std::getenv("MFR_MAX_WORKERS");
+    const int requested = env ? std::atoi(env) : 0;
+    return std::max(resolveThreads(0), std::min(requested, 1024));
+  }();
+  return cap;
+}
+
 int RasterFrame::arenaThreads() const {
-  return std::min(threads_, resolveThreads(0));
+  return std::min(threads_, maxTileWorkers());
 }
 
 namespace {
@@ -196,6 +207,7 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   frame.rayScaleY_ = -2.0f * tanHalf / static_cast<float>(options.height);
   frame.rayBiasY_ = (1.0f - 1.0f / static_cast<float>(options.height)) * tanHalf;
 
+  const WorkerLimit workers(frame.arenaThreads());
   tbb::task_arena arena(frame.arenaThreads());
   // vertex transform
   const size_t vertexCount = scene.positions.size();

@@ -84,6 +84,12 @@ class OccupancyMap {
     return t != kNoCulling && bucket(pixel, z) > t;
   }
 
+  /// Bytes this map's buffers hold (the CPU engine's measured memory).
+  uint64_t allocatedBytes() const {
+    return zNear_.capacity() * sizeof(float) + zFar_.capacity() * sizeof(float) +
+           threshold_.capacity() * sizeof(uint32_t) + bits_.capacity() * sizeof(uint32_t);
+  }
+
  private:
   int words_ = 1;
   std::vector<float> zNear_, zFar_;

@@ -28,7 +28,9 @@ namespace mfr {
 struct CompareOptions {
   std::vector<std::string> methods;  // preset names (methodPreset), at least one, no duplicates
   std::vector<uint64_t> budgets;  // bytes, at least one, no duplicates; budgets[0] is "the" budget
-  Compositing compositing = Compositing::KBuffer;  // of the bounded methods (ground truth: exact)
+  /// Compositing of every method (ground truth: exact); none: each preset's own rule (hybrid for
+  /// dkb*, optimal*; kbuffer for the others).
+  std::optional<Compositing> compositing;
   CaptureMode capture = CaptureMode::TileOwned;
   glm::vec3 background{1.0f};  // linear RGB
   std::string scene;           // the scene's name or source, for the results
@@ -52,9 +54,10 @@ struct CompareMetrics {
 
 /// One method at one budget (or the ground truth).
 struct CompareRun {
-  std::string method;                   // preset name
-  std::optional<uint64_t> budgetBytes;  // none for the ground truth
-  std::optional<std::string> error;     // the render failed (e.g. budget too small): no data below
+  std::string method;                              // preset name
+  std::optional<uint64_t> budgetBytes;             // none for the ground truth
+  Compositing compositing = Compositing::KBuffer;  // the rule this run composited with
+  std::optional<std::string> error;  // the render failed (e.g. budget too small): no data below
   RenderStats stats;
   uint64_t budgetSlots = 0;  // F(M) of the method's memory model (0 without a budget)
   CompareMetrics metrics;
@@ -76,7 +79,7 @@ struct CompareBudget {
 struct CompareResult {
   std::string scene;
   int width = 0, height = 0;
-  Compositing compositing = Compositing::KBuffer;
+  std::optional<Compositing> compositing;  // CompareOptions::compositing (none: per preset)
   CaptureMode capture = CaptureMode::TileOwned;
   double flipPixelsPerDegree = kFlipDefaultPixelsPerDegree;
   CompareRun groundTruth;     // abuffer, no budget, metrics against itself (all 0, PSNR infinite)

@@ -10,7 +10,18 @@
 //   - allocateOptimalHull: each curve's lower convex hull gives segments of decreasing error drop
 //     per slot; from k = 1 everywhere the steepest segments are bought first, and the last one
 //     partially at its best affordable k. Exact on convex curves, and never worse than the greedy
-//     on the counterexamples of tests/test_optimal_allocation.cpp.
+//     when every curve is convex, but not in general: real hybrid curves need not be convex
+//     (moving a fragment from the tail to the core can raise the error).
+//   - allocateOptimal: the oracle of the `optimal` preset. The hull solution at the critical
+//     multiplier lambda gives the Lagrangian lower bound
+//         LB = sum_p min_k (err_p(k) + lambda k) - lambda F  <=  minimum total error,
+//     and every allocation can be written as LB + lambda (F - sum k) + sum_p r_p(k_p) with reduced
+//     costs r_p(k) = err_p(k) + lambda k - min_j (err_p(j) + lambda j) >= 0. An allocation better
+//     than the hull's (error A) therefore only uses values with r_p(k) < A - LB (the gap): pixels
+//     with a single such value are fixed, and an exact dynamic programme over the others (the
+//     "core", a few pixels near the multiplier, where non-convex curves matter) finds the true
+//     minimum. When the core is too large for the programme's cell limit, the better of the hull
+//     and the published greedy is returned and the bound with its gap is reported.
 // Presets optimal / optimal-greedy run them on an exact A-buffer pre-pass (optimal_oracle.hpp).
 #pragma once
 
@@ -41,5 +52,35 @@ std::vector<uint32_t> allocateOptimalGreedy(const std::vector<std::vector<double
                                             uint64_t slots);
 std::vector<uint32_t> allocateOptimalHull(const std::vector<std::vector<double>>& curves,
                                           uint64_t slots);
+
+/// A pixel's curve is convex when its drops err(k) - err(k + 1) never increase (beyond rounding).
+bool errorCurveIsConvex(const std::vector<double>& curve);
+
+struct OracleOptions {
+  /// Cells (core pixels' options x slot range) the exact step may visit; above, no exact step.
+  uint64_t maxDpCells = uint64_t{1} << 28;
+  /// Published greedy (DHOIT Algorithm 1) instead of the exact oracle; the bound is still given.
+  bool publishedGreedy = false;
+};
+
+/// An allocation with what is known of its distance to the true minimum.
+struct OracleAllocation {
+  std::vector<uint32_t> k;  // per pixel; 0 for empty curves
+  double error = 0.0;       // sum_p err_p(k_p)
+  /// Proven lower bound on the minimum total error: the minimum itself when `exact`, else the
+  /// Lagrangian (hull) bound. error - lowerBound is the reported gap (0 when exact).
+  double lowerBound = 0.0;
+  double lagrangianBound = 0.0;  // the hull relaxation's bound, always computed
+  bool exact = false;            // error is the minimum (proven)
+  uint64_t nonconvexPixels = 0;  // pixels whose curve is not convex
+  uint64_t corePixels = 0;       // pixels left free for the exact step
+  const char* solver = "";       // "all-fit", "hull", "hull+dp", "greedy"
+  double gap() const { return error - lowerBound; }
+};
+
+/// The optimal k-buffer's allocation with its bound (see the comment at the top). Requires
+/// slots >= the number of non-empty curves (one fragment per covered pixel).
+OracleAllocation allocateOptimal(const std::vector<std::vector<double>>& curves, uint64_t slots,
+                                 const OracleOptions& options = {});
 
 }  // namespace mfr

@@ -19,6 +19,8 @@ struct FrameErrorCurves {
   std::vector<uint32_t> n;                  // n(p)
   uint64_t coveredPixels = 0;
   uint64_t fragments = 0;  // sum n(p)
+  /// Bytes the pre-pass allocated: the A-buffer's buffers, its kept nodes and the curves.
+  uint64_t bytesAllocated = 0;
 };
 
 /// `compositing`: the rule whose error the curves measure (the optimal k-buffer of DHOIT: hybrid).

@@ -40,11 +40,31 @@ struct PassTime {
   double ms = 0.0;
 };
 
+/// What the optimal k-buffer's oracle knows of its allocation (optimal_allocation.hpp). Errors
+/// are sums over pixels of the squared linear-RGB distance to the exact A-buffer colour, for the
+/// method's compositing rule.
+struct OracleReport {
+  double error = 0.0;       // of the returned allocation
+  double lowerBound = 0.0;  // proven: the minimum when exact, else the Lagrangian bound
+  double lagrangianBound = 0.0;
+  bool exact = false;
+  std::string solver;            // all-fit, hull, hull+dp, greedy
+  uint64_t nonconvexPixels = 0;  // covered pixels whose error curve is not convex
+  uint64_t corePixels = 0;       // pixels the exact step searched
+  double gap() const { return error - lowerBound; }
+};
+
 struct RenderStats {
   std::string method;
   std::optional<uint64_t> budgetBytes;
+  /// The method's memory as the papers (and a GPU) lay it out: MemoryModel, never above the
+  /// budget.
   uint64_t bytesUsed = 0;
   std::map<std::string, uint64_t> bytesByCategory;
+  /// What this CPU engine actually allocated for the method's buffers (summed over the frame,
+  /// measured at the allocation sites; see README "Memory accounting"). Not bounded by the budget.
+  uint64_t bytesAllocated = 0;
+  std::map<std::string, uint64_t> bytesAllocatedByCategory;
   uint64_t fragmentSlots = 0;  // nodes allocated
   uint64_t fragmentsGenerated = 0;
   uint64_t culledOccupancy = 0;  // rejected by the occupancy threshold
@@ -60,6 +80,7 @@ struct RenderStats {
   std::optional<uint32_t> maxDepthComplexity;  // when a count pass ran
   std::optional<double> meanDepthComplexity;   // over covered pixels
   std::vector<PassTime> passes;
+  std::optional<OracleReport> oracle;  // optimal / optimal-greedy
   double lostPercent() const {
     return fragmentsGenerated ? 100.0 * static_cast<double>(lost) / fragmentsGenerated : 0.0;
   }

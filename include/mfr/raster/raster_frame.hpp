@@ -154,6 +154,10 @@ CoverageAll(F) -> CoverageAll<F>;
 /// Resolves a number of threads: 0 means all hardware threads.
 int resolveThreads(int threads);
 
+/// Most workers a tile pass runs: the hardware threads, or MFR_MAX_WORKERS when larger (so that
+/// tests can run 8 real workers on a 2-core machine).
+int maxTileWorkers();
+
 }  // namespace mfr
 
 #include "mfr/raster/raster_frame_impl.hpp"

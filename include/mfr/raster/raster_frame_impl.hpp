@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -19,8 +21,21 @@ inline TileRect RasterFrame::tileRect(int tile) const {
           std::min(height_, (ty + 1) * tileSize_) - 1};
 }
 
+/// While alive, lets oneTBB run `workers` threads even above the hardware's (a no-op below it).
+class WorkerLimit {
+ public:
+  explicit WorkerLimit(int workers) {
+    if (workers > resolveThreads(0))
+      control_.emplace(tbb::global_control::max_allowed_parallelism, static_cast<size_t>(workers));
+  }
+
+ private:
+  std::optional<tbb::global_control> control_;
+};
+
 template <class Fn>
 void RasterFrame::forEachTile(Fn&& fn) const {
+  const WorkerLimit workers(arenaThreads());
   tbb::task_arena arena(arenaThreads());
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, tileCount(), 1),

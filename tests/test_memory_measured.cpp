@@ -1,0 +1,134 @@
+// bytes_used is the papers' accounting (MemoryModel: what a GPU would lay out); bytes_allocated
+// is what the CPU engine really allocated for the method's buffers, measured where they are
+// allocated. Both are checked here against the documented layouts (README, "Memory accounting"),
+// recomputed from the run's k(p) and n(p).
+#include <gtest/gtest.h>
+
+#include <map>
+#include <string>
+
+#include "mfr/method/memory_model.hpp"
+#include "mfr/method/render.hpp"
+#include "mfr/scene/load.hpp"
+
+namespace mfr {
+namespace {
+
+struct Frame {
+  Scene scene;
+  RasterFrame frame;
+};
+
+const RasterFrame& hairball() {
+  static const Frame f = [] {
+    Scene s = loadScene("procedural:hairball?strands=200").value();
+    RasterFrame fr = RasterFrame::build(s, *s.defaultCamera, RasterOptions{72, 64, 16, 2}).value();
+    return Frame{std::move(s), std::move(fr)};
+  }();
+  return f.frame;
+}
+
+// The CPU engine's documented buffers of one run (README, "Memory accounting").
+std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const RenderOutput& out,
+                                                     uint64_t pixels, bool parallel,
+                                                     uint64_t abufferFragments) {
+  std::map<std::string, uint64_t> b;
+  const bool importance = m.allocation == AllocationPolicy::Importance;
+  uint64_t materialised = 0;  // nodes: min(k(p), n(p)) for importance allocation, else k(p)
+  for (size_t p = 0; p < pixels; ++p)
+    materialised += importance ? std::min(out.kMap[p], out.depthComplexity[p]) : out.kMap[p];
+  b["nodes"] = 8 * materialised;
+  b["counters"] = 4 * pixels;
+  b["k"] = 4 * pixels * (importance ? 2 : 1);  // k(p) [+ the reserved k(p) of importance]
+  b["offsets"] = 8 * pixels;                   // 64-bit offsets
+  b["store_kind"] = pixels;
+  if (m.allocation != AllocationPolicy::FixedK) b["depth_complexity"] = 4 * pixels;
+  if (parallel) b["locks"] = 4 * pixels;
+  if (m.compositing == Compositing::Hybrid) b["tail"] = 20 * pixels;
+  if (m.occupancyWords)
+    b["occupancy"] = (12 + 4 * static_cast<uint64_t>(m.occupancyWords)) * pixels;
+  if (m.allocation == AllocationPolicy::DynamicK) b["allocation_scratch"] = 1024 * 8;
+  if (importance) b["allocation_scratch"] = 8 * pixels;
+  if (importance && m.importanceSource == ImportanceSource::Heuristic) {
+    b["importance"] = 5 * 4 * pixels;  // I, I_d, I_per, I_f, noise
+    b["nearest_normal"] = 4 * pixels;
+  }
+  if (importance && m.importanceSource == ImportanceSource::Network) b["importance"] = 4 * pixels;
+  if (m.allocation == AllocationPolicy::Optimal) {
+    b["oracle_k"] = 4 * pixels;
+    // exact A-buffer (its own buffers), its nodes, offsets and counts kept, error curves
+    const uint64_t abuffer = 8 * abufferFragments + (4 + 4 + 8 + 1 + 4) * pixels;
+    const uint64_t kept = 8 * abufferFragments + (8 + 4) * pixels;
+    const uint64_t curves = 8 * abufferFragments + sizeof(std::vector<double>) * pixels;
+    b["oracle_prepass"] = abuffer + kept + curves;
+  }
+  return b;
+}
+
+TEST(MemoryMeasured, BytesAllocatedFollowTheDocumentedCpuLayoutForEveryPreset) {
+  const RasterFrame& frame = hairball();
+  const uint64_t pixels = frame.pixelCount();
+  const RenderOutput truth = render(frame, methodPreset("abuffer").value(), {}).value();
+  const uint64_t fragments = truth.stats.fragmentsGenerated;
+  int checked = 0;
+  for (std::string name : presetNames())
+    for (const char* suffix : {"", "+occupancy"})
+      for (bool parallel : {false, true})
+        for (Compositing rule : {Compositing::KBuffer, Compositing::Hybrid}) {
+          if (name == "abuffer" && *suffix) continue;
+          MethodDesc m = methodPreset(name + suffix).value();
+          m.compositing = rule;
+          RenderOptions o;
+          if (name != "abuffer") o.budgetBytes = 600000;
+          o.capture = parallel ? CaptureMode::FragmentParallel : CaptureMode::TileOwned;
+          auto out = render(frame, m, o);
+          ASSERT_TRUE(out.ok()) << m.name << ": " << out.error().message;
+          const std::string what = m.name + (parallel ? " parallel " : " tile ") + toString(rule);
+          EXPECT_EQ(out->stats.bytesAllocatedByCategory,
+                    documentedCpuBuffers(m, out.value(), pixels, parallel, fragments))
+              << what;
+          uint64_t sum = 0;
+          for (const auto& [category, bytes] : out->stats.bytesAllocatedByCategory) sum += bytes;
+          EXPECT_EQ(out->stats.bytesAllocated, sum) << what;
+          // the papers' accounting stays within the budget
+          if (o.budgetBytes) {
+            EXPECT_LE(out->stats.bytesUsed, *o.budgetBytes) << what;
+          }
+          ++checked;
+        }
+  EXPECT_EQ(checked, 4 * (1 + 2 * (static_cast<int>(presetNames().size()) - 1)));
+}
+
+TEST(MemoryMeasured, FragmentParallelModeChargesItsLockWordWithinTheBudget) {
+  // fkb has no lock word of its own; fragment-parallel capture needs one per pixel, charged
+  const RasterFrame& frame = hairball();
+  const uint64_t pixels = frame.pixelCount();
+  const MethodDesc fkb = methodPreset("fkb").value();
+  // exactly one slot per pixel plus the counter: enough for tile-owned capture only
+  const uint64_t budget = pixels * 4 + pixels * kNodeBytes;
+  RenderOptions tile;
+  tile.budgetBytes = budget;
+  auto owned = render(frame, fkb, tile);
+  ASSERT_TRUE(owned.ok()) << owned.error().message;
+  EXPECT_EQ(owned->stats.globalK, 1u);
+  EXPECT_FALSE(owned->stats.bytesByCategory.contains("locks"));
+  EXPECT_EQ(owned->stats.bytesUsed, budget);
+
+  RenderOptions parallel = tile;
+  parallel.capture = CaptureMode::FragmentParallel;
+  auto refused = render(frame, fkb, parallel);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_NE(refused.error().message.find("too small"), std::string::npos)
+      << refused.error().message;
+
+  parallel.budgetBytes = budget + pixels * 4;  // room for the lock words
+  auto locked = render(frame, fkb, parallel);
+  ASSERT_TRUE(locked.ok()) << locked.error().message;
+  EXPECT_EQ(locked->stats.bytesByCategory.at("locks"), 4 * pixels);
+  EXPECT_EQ(locked->stats.globalK, 1u);
+  EXPECT_EQ(locked->stats.bytesUsed, *parallel.budgetBytes);
+  EXPECT_EQ(locked->stats.bytesAllocatedByCategory.at("locks"), 4 * pixels);
+}
+
+}  // namespace
+}  // namespace mfr
