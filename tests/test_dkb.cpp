@@ -146,11 +146,14 @@ TEST(DeepKBuffer, SumOfKNeverExceedsTheBudgetAndFillKeepsOnePerCoveredPixel) {
       const RenderOutput out = renderDkb(h.frame, preset, budget);
       const MemoryModel model = MemoryModel::of(methodPreset(preset).value());
       const uint64_t slots = model.fragmentSlots(budget, 96 * 96);
+      ASSERT_EQ(out.kMap.size(), 96u * 96u);
+      ASSERT_EQ(out.depthComplexity.size(), 96u * 96u);
       uint64_t sumK = 0, demand = 0;
       for (size_t p = 0; p < out.kMap.size(); ++p) {
         sumK += out.kMap[p];
         demand += out.depthComplexity[p];
       }
+      ASSERT_GT(demand, 0u) << preset << " " << budget << ": an empty frame tests nothing";
       EXPECT_LE(sumK, slots) << preset << " " << budget;
       // counter, offset, lock, hybrid tail (20 B): no previous-frame normal
       EXPECT_EQ(out.stats.bytesUsed, 96u * 96u * 32u + sumK * 8u) << preset;
@@ -173,8 +176,11 @@ TEST(DeepKBuffer, PaperRuleFollowsEquation3) {
   const RenderOutput out = renderDkb(h.frame, "dkb", budget);
   const uint64_t slots =
       MemoryModel::of(methodPreset("dkb").value()).fragmentSlots(budget, 96 * 96);
+  ASSERT_EQ(out.kMap.size(), 96u * 96u);
+  ASSERT_EQ(out.importance.importance.size(), 96u * 96u);
   double sum = 0.0;
   for (float i : out.importance.importance) sum += i;
+  ASSERT_GT(sum, 0.0);
   for (size_t p = 0; p < out.kMap.size(); p += 5) {
     const double k = std::floor(out.importance.importance[p] / sum * static_cast<double>(slots));
     EXPECT_NEAR(out.kMap[p], k, 1.0) << p;  // floor of a float sum: off by one at most
@@ -238,8 +244,10 @@ TEST(DkbDataset, TargetsAreTheOptimalAllocationOverItsMaximum) {
   ASSERT_TRUE(samples);
   auto oracle = frameErrorCurves(h.frame, o.background);
   ASSERT_TRUE(oracle);
+  ASSERT_GT(oracle->coveredPixels, 0u);
   ASSERT_EQ(samples->size(), 5 * oracle->coveredPixels);  // every covered pixel, 5 budgets
   for (uint32_t step = 0; step < 5; ++step) {
+    uint64_t checked = 0;
     const uint64_t slots =
         learn::budgetStepSlots(oracle->coveredPixels, oracle->fragments, step, 5);
     const auto k = allocateOptimalHull(oracle->curves, slots);
@@ -256,7 +264,9 @@ TEST(DkbDataset, TargetsAreTheOptimalAllocationOverItsMaximum) {
       if (step == 4) {
         ASSERT_EQ(k[s.pixel], oracle->n[s.pixel]);  // every fragment
       }
+      ++checked;
     }
+    EXPECT_EQ(checked, oracle->coveredPixels) << "step " << step << ": every covered pixel";
   }
 }
 

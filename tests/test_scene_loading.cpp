@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <ostream>
 #include <random>
 #include <string>
 #include <vector>
@@ -20,6 +21,7 @@
 
 #include "mfr/scene/load.hpp"
 #include "mfr/scene/procedural.hpp"
+#include "shared_scenes.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -972,13 +974,15 @@ const RealScene kRealScenes[] = {
     {"StanfordDragon", "stanford/dragon/dragon_100k.ply", 100000},
 };
 
+// gtest prints a failing parameter with this (not as raw bytes)
+void PrintTo(const RealScene& scene, std::ostream* os) {
+  *os << scene.name << " (" << scene.file << ")";
+}
+
 class ReadmeScene : public ::testing::TestWithParam<RealScene> {};
 
 TEST_P(ReadmeScene, LoadsWithTheReadmeTriangleCount) {
-  const fs::path root = MFR_SCENES_DIR;
-  if (!fs::is_directory(root)) GTEST_SKIP() << "scenes folder absent: " << root.string();
-  const fs::path file = root / GetParam().file;
-  if (!fs::exists(file)) GTEST_SKIP() << "scene absent: " << file.string();
+  MFR_SHARED_SCENE(file, GetParam().file);
   auto scene = mfr::loadScene(file.string());
   ASSERT_LOADED(scene);
   EXPECT_EQ(scene->triangleCount(), GetParam().triangles);
@@ -992,12 +996,15 @@ INSTANTIATE_TEST_SUITE_P(SceneLoadingReal, ReadmeScene, ::testing::ValuesIn(kRea
 class SceneLoadingRealDetails : public ::testing::Test {
  protected:
   void SetUp() override {
-    if (!fs::is_directory(root)) GTEST_SKIP() << "scenes folder absent: " << root.string();
+    if (!mfr::test::sharedScenesPresent())
+      GTEST_SKIP() << "shared scenes folder absent: " << root.string();
   }
+  // the folder is there: a missing file is a failure naming it (not a skip)
   mfr::Result<mfr::Scene> load(const std::string& file) {
+    EXPECT_TRUE(mfr::test::sharedSceneExists(file));
     return mfr::loadScene((root / file).string());
   }
-  fs::path root = MFR_SCENES_DIR;
+  fs::path root = mfr::test::sharedScenesRoot();
 };
 
 TEST_F(SceneLoadingRealDetails, StainedGlassLampHasDecodedTexturesAndBlendAndMaskLayers) {
@@ -1041,11 +1048,14 @@ TEST_F(SceneLoadingRealDetails, TransmissionScenesFoldTransmissionIntoAlphaAndKe
 
 TEST_F(SceneLoadingRealDetails, AllRealScenesLoadWithinAFewSeconds) {
   const auto start = std::chrono::steady_clock::now();
-  for (const RealScene& real : kRealScenes)
-    if (fs::exists(root / real.file)) {
-      auto scene = load(real.file);
-      ASSERT_LOADED(scene);
-    }
+  size_t loaded = 0;
+  for (const RealScene& real : kRealScenes) {
+    ASSERT_TRUE(mfr::test::sharedSceneExists(real.file));
+    auto scene = load(real.file);
+    ASSERT_LOADED(scene);
+    ++loaded;
+  }
+  EXPECT_EQ(loaded, std::size(kRealScenes));
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 #ifdef NDEBUG

@@ -58,7 +58,7 @@ TEST(Importance, FresnelTermFollowsEquation5) {
   EXPECT_NEAR(m.importance[2], 0.5, 1e-6);
 }
 
-TEST(Importance, NoiseIsBoundedSeededAndThreadIndependent) {
+TEST(Importance, NoiseIsBoundedAndSeeded) {
   const std::vector<uint32_t> n(64 * 64, 1);
   ImportanceParams p = onlyFactor(false, false, false, true);
   const ImportanceMaps a = computeImportance(64, 64, n, {}, p);
@@ -87,10 +87,11 @@ TEST(Importance, ProductOfFactorsPlusNoiseClampedAtZero) {
 }
 
 RenderOutput renderVkb(const std::string& preset, uint64_t budget, int size = 96,
-                       const std::string& scene = "procedural:hairball?strands=300") {
+                       const std::string& scene = "procedural:hairball?strands=300",
+                       int threads = 2) {
   auto s = loadScene(scene);
   EXPECT_TRUE(s.ok());
-  RasterOptions ro{size, size, 32, 2};
+  RasterOptions ro{size, size, 32, threads};
   auto frame = RasterFrame::build(*s, *s->defaultCamera, ro);
   RenderOptions o;
   o.budgetBytes = budget;
@@ -105,8 +106,11 @@ TEST(VariableKBuffer, SumOfKNeverExceedsTheSlotsTheBudgetBuys) {
       const RenderOutput out = renderVkb(preset, budget);
       const MemoryModel model = MemoryModel::of(methodPreset(preset).value());
       const uint64_t slots = model.fragmentSlots(budget, 96 * 96);
+      ASSERT_EQ(out.kMap.size(), 96u * 96u);
+      ASSERT_EQ(out.depthComplexity.size(), 96u * 96u);
       uint64_t sumK = 0;
       for (uint32_t k : out.kMap) sumK += k;
+      EXPECT_GT(sumK, 0u) << preset << " " << budget;
       EXPECT_LE(sumK, slots) << preset << " " << budget;
       EXPECT_LE(out.stats.bytesUsed, budget);
       EXPECT_EQ(out.stats.bytesUsed, 96u * 96u * 13u + sumK * 8u) << "counter, offset, lock, n.v";
@@ -135,18 +139,47 @@ TEST(VariableKBuffer, FillCapturesAtLeastAsManyFragmentsAsThePaperRule) {
 TEST(VariableKBuffer, MoreImportantPixelsGetMoreSlots) {
   const RenderOutput out = renderVkb("vkb", 1000000);
   // among pixels with the same n(p), k(p) must not decrease with importance
+  int compared = 0;
   for (size_t a = 0; a < out.kMap.size(); a += 7)
     for (size_t b = a + 1; b < out.kMap.size(); b += 331)
       if (out.depthComplexity[a] == out.depthComplexity[b] &&
           out.importance.importance[a] > out.importance.importance[b]) {
         EXPECT_GE(out.kMap[a], out.kMap[b]);
+        ++compared;
       }
+  EXPECT_GT(compared, 100) << "too few pixel pairs with equal n(p) to test anything";
 }
 
 TEST(VariableKBuffer, DeterministicForAFixedSeed) {
   const RenderOutput a = renderVkb("vkb", 400000), b = renderVkb("vkb", 400000);
   EXPECT_EQ(a.kMap, b.kMap);
   EXPECT_EQ(encodeSrgb(a.image).rgba, encodeSrgb(b.image).rgba);
+}
+
+TEST(VariableKBuffer, IdenticalForAnyThreadCount) {
+  // the importance map (noise included), the allocation and the image do not depend on how many
+  // workers rasterize and capture: 1 thread against 2 and 7
+  int compared = 0;
+  for (const char* preset : {"vkb", "vkb-fill"}) {
+    const RenderOutput one =
+        renderVkb(preset, 400000, 96, "procedural:hairball?strands=300", /*threads=*/1);
+    ASSERT_FALSE(one.kMap.empty());
+    ASSERT_FALSE(one.importance.importance.empty());
+    ASSERT_GT(one.stats.lost, 0u) << preset << ": the budget must bind for k(p) to matter";
+    for (const int threads : {2, 7}) {
+      const RenderOutput many =
+          renderVkb(preset, 400000, 96, "procedural:hairball?strands=300", threads);
+      EXPECT_EQ(many.importance.importance, one.importance.importance) << preset << " " << threads;
+      EXPECT_EQ(many.importance.noise, one.importance.noise) << preset << " " << threads;
+      EXPECT_EQ(many.nearestCosine, one.nearestCosine) << preset << " " << threads;
+      EXPECT_EQ(many.kMap, one.kMap) << preset << " " << threads;
+      EXPECT_EQ(many.stats.captured, one.stats.captured) << preset << " " << threads;
+      EXPECT_EQ(encodeSrgb(many.image).rgba, encodeSrgb(one.image).rgba)
+          << preset << " " << threads;
+      ++compared;
+    }
+  }
+  EXPECT_EQ(compared, 4);
 }
 
 TEST(VariableKBuffer, UnlimitedBudgetEqualsTheABuffer) {

@@ -147,6 +147,16 @@ int run(const RenderArgs& a) {
   const int views = static_cast<int>(prepared->cameras.size());
   nlohmann::json allStats = nlohmann::json::array();
   std::vector<float> previousCosine;  // importance methods: nearest |n.v| of the previous view
+  if (prepared->previousCamera && method->allocation == AllocationPolicy::Importance &&
+      method->importanceSource == ImportanceSource::Heuristic) {
+    RasterOptions ro;  // --orbit-view I: view I - 1 precedes it, as in the full orbit
+    ro.width = a.scene.width;
+    ro.height = a.scene.height;
+    ro.threads = a.scene.threads;
+    auto frame = RasterFrame::build(scene, *prepared->previousCamera, ro);
+    if (!frame) return fail(a.scene.source + ": " + frame.error().message);
+    previousCosine = nearestCosine(frame.value());
+  }
   for (int v = 0; v < views; ++v) {
     progress.set("rendering " + method->name, v, views);
     RasterOptions ro;

@@ -80,7 +80,7 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
   load.transmissionAlphaFloor = static_cast<float>(o.transmissionFloor);
   auto loaded = loadScene(o.source, load);
   if (!loaded) return loaded.error();
-  PreparedScene prepared{std::move(loaded.value()), {}};
+  PreparedScene prepared{std::move(loaded.value()), {}, {}};
   Scene& scene = prepared.scene;
   if (o.alpha) scene.alphaOverride = static_cast<float>(*o.alpha);
   if (o.background.size() == 3)
@@ -104,6 +104,7 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
   }
   camera.eye = camera.target + (camera.eye - camera.target) / static_cast<float>(o.zoom);
   prepared.cameras = o.orbit > 0 ? orbit(camera, o.orbit) : std::vector<Camera>{camera};
+  if (o.orbitView > 0) prepared.previousCamera = prepared.cameras[o.orbitView - 1];
   if (o.orbitView >= 0) prepared.cameras = {prepared.cameras[o.orbitView]};
   return prepared;
 }

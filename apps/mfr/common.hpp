@@ -44,6 +44,9 @@ struct SceneOptions {
 struct PreparedScene {
   Scene scene;
   std::vector<Camera> cameras;  // one per view to render
+  /// With --orbit-view I > 0: view I - 1 of the orbit, the frame before the rendered one (its
+  /// nearest |n.v| feeds the variable k-buffer's Fresnel term as in a full orbit).
+  std::optional<Camera> previousCamera;
 };
 
 /// Loads the scene, applies overrides and resolves the cameras. Errors name the input.

@@ -161,6 +161,8 @@ Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptio
   RenderOptions renderOptions;
   renderOptions.capture = options.capture;
   renderOptions.background = options.background;
+  if (!options.previousNearestCosine.empty())
+    renderOptions.previousNearestCosine = &options.previousNearestCosine;
 
   // ground truth: the exact A-buffer, every fragment, sorted and composited
   progress("rendering the ground truth (abuffer)");

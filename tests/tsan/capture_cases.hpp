@@ -131,6 +131,7 @@ inline void expectFragmentParallelMatchesTileOwned(const RasterFrame& frame,
                                                    const std::string& what, int& reordered) {
   const auto owned = runMethod(frame, method, CaptureMode::TileOwned);
   ASSERT_TRUE(owned) << what;
+  ASSERT_GT(owned->stats.captured, 0u) << what << ": nothing captured, nothing to compare";
   const auto ownedSets = capturedSets(*owned);
   const std::vector<uint8_t> ownedBytes = encodeSrgb(owned->image).rgba;
   for (int r = 0; r < repeats; ++r) {

@@ -37,6 +37,9 @@ struct CompareOptions {
   double flipPixelsPerDegree = kFlipDefaultPixelsPerDegree;
   /// Importance methods (vkb, vkb-fill): seed of the noise term (Eq. 6).
   uint64_t seed = 1;
+  /// Variable k-buffer methods: the previous frame's nearest |n.v| (nearestCosine()); empty: this
+  /// frame's own.
+  std::vector<float> previousNearestCosine;
   /// Deep k-buffer methods (dkb, dkb-fill): the network (null: the built-in model).
   std::shared_ptr<const learn::Model> model;
   /// Called before each step: (what, steps done, steps in all). May be empty.

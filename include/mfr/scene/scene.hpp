@@ -51,8 +51,10 @@ struct Scene {
   std::optional<Camera> defaultCamera;  // procedural scenes frame themselves
 
   glm::vec3 background{1.0f, 1.0f, 1.0f};  // linear RGB behind everything
-  /// When set, every material's alpha becomes this value and its mode becomes Blend
-  /// (the papers render whole scenes as transparent).
+  /// When set, every material's alpha becomes this value and every surface blends with it (the
+  /// papers render whole scenes as transparent): Opaque and Blend materials, and the fragments of
+  /// Mask materials that pass their alpha test (a cutout keeps its shape; what it cuts away stays
+  /// away).
   std::optional<float> alphaOverride;
 
   size_t triangleCount() const { return indices.size() / 3; }
