@@ -62,8 +62,8 @@ int runDataset(DatasetArgs& a) {
   progress.clear();
   data.metadata = nlohmann::json{
       {"generator", "mfr dataset"},
-      {"features", "mfr-dkb-features-v1"},
-      {"target", "K_M(p) / max_q K_M(q), optimal k-buffer (hull)"},
+      {"features", kDkbFeatureSet},
+      {"target", learn::kDkbTargetScaling},
       {"width", a.scene.width},
       {"height", a.scene.height},
       {"orbit", a.scene.orbit},

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <set>
@@ -34,15 +35,22 @@ struct TrainArgs {
 struct Split {
   Eigen::MatrixXf trainX, trainY, validX, validY;
   std::vector<std::string> trainScenes, validScenes;
+  // per dataset, in order: its file name (not the folder, so the model's bytes do not depend on
+  // where it was trained) and the FNV-1a 64 of its bytes
+  nlohmann::json datasets = nlohmann::json::array();
 };
 
 // Loads every dataset and splits the samples by scene name.
 Result<Split> loadSplit(const TrainArgs& a) {
   std::vector<learn::Dataset> sets;
   std::vector<std::string> order;  // scene names in order of appearance
+  Split split;
   for (const std::string& path : a.datasets) {
     auto data = learn::readDataset(path);
     if (!data) return data.error();
+    if (auto ok = learn::checkDatasetDefinitions(data.value(), path); !ok) return ok.error();
+    split.datasets.push_back({{"file", std::filesystem::path(path).filename().string()},
+                              {"fnv1a64", learn::hashHex(data->fileHash)}});
     for (const std::string& s : data->scenes)
       if (std::find(order.begin(), order.end(), s) == order.end()) order.push_back(s);
     sets.push_back(std::move(data.value()));
@@ -55,7 +63,6 @@ Result<Split> loadSplit(const TrainArgs& a) {
   for (const std::string& v : valid)
     if (std::find(order.begin(), order.end(), v) == order.end())
       return makeError("--validation-scene '" + v + "': not in the datasets");
-  Split split;
   for (const std::string& s : order)
     (valid.count(s) ? split.validScenes : split.trainScenes).push_back(s);
   if (split.trainScenes.empty()) return makeError("--validation-scene: no scene left to train on");
@@ -136,29 +143,28 @@ int runTrain(TrainArgs& a) {
   if (logs.empty() || !std::isfinite(logs.back().trainLoss))
     return fail("training diverged (non-finite loss); lower --learning-rate or --momentum");
   const learn::EpochLog& last = logs.back();
-  nlohmann::json meta = {
-      {"features", kDkbFeatureSet},
-      {"feature_normalisation", "include/mfr/method/dkb_features.hpp"},
-      {"target", "K_M(p) / max_q K_M(q) per view and budget (include/mfr/learn/dataset.hpp)"},
-      {"layers", learn::kDkbLayers},
-      {"activations", "relu, relu, sigmoid"},
-      {"training",
-       {{"datasets", a.datasets},
-        {"train_scenes", split->trainScenes},
-        {"validation_scenes", split->validScenes},
-        {"train_samples", split->trainX.cols()},
-        {"validation_samples", split->validX.cols()},
-        {"epochs", o.epochs},
-        {"batch", o.batchSize},
-        {"learning_rate", o.learningRate},
-        {"momentum", o.momentum},
-        {"l1_first_hidden", o.regularization.l1FirstHidden},
-        {"l2_second_hidden", o.regularization.l2SecondHidden},
-        {"seed", o.seed},
-        {"final_train_mse", last.trainLoss},
-        {"final_validation_mse", std::isfinite(last.validationLoss)
-                                     ? nlohmann::json(last.validationLoss)
-                                     : nlohmann::json(nullptr)}}}};
+  nlohmann::json meta = {{"features", kDkbFeatureSet},
+                         {"feature_normalisation", "include/mfr/method/dkb_features.hpp"},
+                         {"target", learn::kDkbTargetScaling},
+                         {"layers", learn::kDkbLayers},
+                         {"activations", "relu, relu, sigmoid"},
+                         {"training",
+                          {{"datasets", split->datasets},
+                           {"train_scenes", split->trainScenes},
+                           {"validation_scenes", split->validScenes},
+                           {"train_samples", split->trainX.cols()},
+                           {"validation_samples", split->validX.cols()},
+                           {"epochs", o.epochs},
+                           {"batch", o.batchSize},
+                           {"learning_rate", o.learningRate},
+                           {"momentum", o.momentum},
+                           {"l1_first_hidden", o.regularization.l1FirstHidden},
+                           {"l2_second_hidden", o.regularization.l2SecondHidden},
+                           {"seed", o.seed},
+                           {"final_train_mse", last.trainLoss},
+                           {"final_validation_mse", std::isfinite(last.validationLoss)
+                                                        ? nlohmann::json(last.validationLoss)
+                                                        : nlohmann::json(nullptr)}}}};
   auto written = learn::writeModel(a.out, learn::Model{net, meta.dump(2)});
   if (!written) return fail(written.error().message);
   if (auto curve = writeLossCurve(a.lossCurve, logs); !curve) return fail(curve.error().message);

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <iterator>
 
+#include <nlohmann/json.hpp>
+
 #include "mfr/method/optimal_allocation.hpp"
 #include "mfr/method/optimal_oracle.hpp"
 
@@ -70,6 +72,18 @@ class Reader {
 };
 
 }  // namespace
+
+uint64_t fnv1a64(std::string_view bytes) {
+  uint64_t h = 0xcbf29ce484222325ull;
+  for (const char c : bytes) h = (h ^ static_cast<uint8_t>(c)) * 0x100000001b3ull;
+  return h;
+}
+
+std::string hashHex(uint64_t hash) {
+  std::string s(16, '0');
+  for (int i = 15; i >= 0; --i, hash >>= 4) s[i] = "0123456789abcdef"[hash & 15];
+  return s;
+}
 
 uint64_t budgetStepSlots(uint64_t coveredPixels, uint64_t fragments, int step, int steps) {
   if (steps <= 1) return fragments;
@@ -155,6 +169,7 @@ Result<Dataset> readDataset(const std::string& path) {
     return in.error(std::to_string(features) + " features per sample, expected 12");
   if (sceneCount == 0 || sceneCount > kMaxScenes) return in.error("bad scene count");
   Dataset data;
+  data.fileHash = fnv1a64(bytes);
   for (uint32_t i = 0; i < sceneCount; ++i) {
     uint32_t length = 0;
     std::string name;
@@ -185,6 +200,21 @@ Result<Dataset> readDataset(const std::string& path) {
       return in.error("sample " + std::to_string(i) + ": non-finite or out-of-range value");
   }
   return data;
+}
+
+Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& path) {
+  const auto meta = nlohmann::json::parse(data.metadata, nullptr, false);
+  if (!meta.is_object()) return {};
+  const std::pair<const char*, const char*> expected[] = {{"features", kDkbFeatureSet},
+                                                          {"target", kDkbTargetScaling}};
+  for (const auto& [key, value] : expected) {
+    const auto it = meta.find(key);
+    if (it == meta.end()) continue;
+    if (!it->is_string() || it->get<std::string>() != value)
+      return makeError("dataset " + path + ": its metadata declares " + key + " " + it->dump() +
+                       ", this build computes \"" + value + "\" (regenerate it with mfr dataset)");
+  }
+  return {};
 }
 
 }  // namespace mfr::learn

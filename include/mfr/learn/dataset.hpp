@@ -4,7 +4,8 @@
 // Target scaling: the paper's target is K_M(p) / F(M), numbers near 1 / |P| that a sigmoid output
 // and a mean-squared loss barely see. The runtime only uses I(p) / sum I, so any per-image factor
 // is free; we use t(p) = K_M(p) / max_q K_M(q) over the covered pixels of the same view and budget,
-// which spans [0, 1] (the sigmoid's range) and keeps k(p) proportional to t(p).
+// which spans [0, 1] (the sigmoid's range) and keeps k(p) proportional to t(p). kDkbTargetScaling
+// names this definition; datasets and models record it, and mfr train and dkb check it.
 //
 // File format (.mfrds), little-endian:
 //   offset  size   field
@@ -23,6 +24,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "mfr/core/result.hpp"
@@ -31,6 +33,12 @@
 namespace mfr::learn {
 
 inline constexpr uint32_t kDatasetVersion = 1;
+
+/// The target definition (scaling) of sampleView: the one constant `mfr dataset` records in
+/// datasets, `mfr train` in models, and checkDkbModel compares ("target"). Change it whenever the
+/// target changes, and retrain (scripts/train-model.sh).
+inline constexpr const char* kDkbTargetScaling =
+    "K_M(p) / max_q K_M(q) per view and budget (include/mfr/learn/dataset.hpp)";
 
 struct DatasetSample {
   uint32_t scene = 0;       // index into Dataset::scenes
@@ -45,11 +53,25 @@ struct Dataset {
   std::vector<std::string> scenes;
   std::string metadata;  // JSON
   std::vector<DatasetSample> samples;
+  uint64_t fileHash = 0;  // fnv1a64 of the file's bytes: set by readDataset, ignored when writing
 };
+
+/// 64-bit FNV-1a (offset basis 0xcbf29ce484222325, prime 0x100000001b3) of `bytes`: the content
+/// hash a model records of each dataset it was trained on.
+uint64_t fnv1a64(std::string_view bytes);
+
+/// fnv1a64 as 16 lower-case hex digits.
+std::string hashHex(uint64_t hash);
 
 Result<void> writeDataset(const std::string& path, const Dataset& data);
 /// Checks magic, version, feature count, lengths, scene indices, finite values; errors name path.
+/// Sets Dataset::fileHash.
 Result<Dataset> readDataset(const std::string& path);
+
+/// Checks that a dataset's metadata, where it declares a feature set ("features") or a target
+/// ("target"), declares kDkbFeatureSet and kDkbTargetScaling: a dataset written by an older
+/// `mfr dataset` is refused rather than trained on. `path` names it in the message.
+Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& path);
 
 /// F(M) of budget step s of `steps`: from one slot per covered pixel to every fragment, evenly.
 uint64_t budgetStepSlots(uint64_t coveredPixels, uint64_t fragments, int step, int steps);

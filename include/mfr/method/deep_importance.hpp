@@ -28,9 +28,6 @@ namespace learn {
 struct Model;
 }
 
-/// Feature-set identifier a model must declare in its metadata ("features") to be used by dkb.
-inline constexpr const char* kDkbFeatureSet = "mfr-dkb-features-v1";
-
 /// The count pass of the deep k-buffer: n(p), and the image statistics (sum n, covered pixels,
 /// depth range) in `image`.
 std::vector<uint32_t> countWithDepthRange(const RasterFrame& frame, ImageFeatureStats& image);
@@ -41,11 +38,14 @@ std::vector<float> predictImportance(const RasterFrame& frame, const learn::Mode
                                      const ImageFeatureStats& image, uint64_t slots,
                                      double* featureMs = nullptr, double* inferenceMs = nullptr);
 
-/// Checks that a model fits the deep k-buffer (12 inputs, 1 output, feature set); `name` names it.
+/// Checks that a model fits the deep k-buffer: 12 inputs, 1 output, metadata declaring the feature
+/// set kDkbFeatureSet ("features") and, if it declares a target ("target"), the target definition
+/// learn::kDkbTargetScaling. `name` names the model in the message.
 Result<void> checkDkbModel(const learn::Model& model, const std::string& name);
 
 /// The model shipped in the repository (models/dkb-default.mfrnn, compiled into the library),
-/// decoded once. An error when the build had no model file.
+/// decoded once. An error when the build had no model file, or when the model does not declare
+/// both kDkbFeatureSet and learn::kDkbTargetScaling (stale against the code: retrain it).
 Result<std::shared_ptr<const learn::Model>> builtinDkbModel();
 
 }  // namespace mfr

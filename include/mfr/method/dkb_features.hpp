@@ -31,6 +31,11 @@
 namespace mfr {
 
 inline constexpr int kDkbFeatureCount = 12;
+
+/// Identifier of the feature set above (order, normalisation): the one constant `mfr dataset`
+/// records in datasets, `mfr train` in models, and checkDkbModel requires of a model ("features").
+/// Change it whenever pixelFeatures changes, and retrain (scripts/train-model.sh).
+inline constexpr const char* kDkbFeatureSet = "mfr-dkb-features-v1";
 using PixelFeatures = std::array<float, kDkbFeatureCount>;
 
 /// What the feature pass accumulates for one pixel (order-independent: min, max, sums; ties of the
