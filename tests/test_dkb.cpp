@@ -209,7 +209,8 @@ TEST(DeepKBuffer, ReportsFeatureAndInferencePasses) {
 }
 
 TEST(DeepKBuffer, RejectsModelsThatDoNotFit) {
-  learn::Model wrongShape{learn::makeMlp({12, 8, 2}, 1), R"({"features":"mfr-dkb-features-v1"})"};
+  learn::Model wrongShape{learn::makeMlp({12, 8, 2}, 1),
+                          std::string(R"({"features":")") + kDkbFeatureSet + "\"}"};
   auto e = checkDkbModel(wrongShape, "m.mfrnn");
   ASSERT_FALSE(e);
   EXPECT_NE(e.error().message.find("m.mfrnn"), std::string::npos);
