@@ -18,6 +18,8 @@ packages=(
   libbenchmark-dev
   gnuplot-nox           # benchmark plots (scripts/bench.sh)
   python3               # evaluation tables (scripts/eval_tables.py)
+  pybind11-dev python3-pybind11 python3-dev python3-numpy  # the Python module mfr (python/)
+  python3-pytest        # its tests (python/tests, run by ctest)
   chromium              # the mfr compare report in headless Chromium (tests/report_chromium_test.sh)
 )
 

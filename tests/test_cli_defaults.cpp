@@ -150,7 +150,7 @@ TEST(CliDefaults, HelpListsTheTablesPresetsForEachOption) {
         << methodOptionRule(option).flags << "\n"
         << squeezed;
   EXPECT_EQ(presetsAccepting(MethodOption::K),
-            "zbuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic");
+            "zbuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, mlab");
   EXPECT_EQ(presetsAccepting(MethodOption::Model), "dkb, dkb-fill");
   for (const std::string& preset : presetNames())
     EXPECT_NE(squeezed.find(preset), std::string::npos) << preset;

@@ -302,6 +302,9 @@ TEST_F(CompareLibrary, HtmlReportIsSelfContainedAndShowsEverything) {
   EXPECT_NE(html.find("Mean FLIP vs budget"), std::string::npos);
   EXPECT_NE(html.find("MSE (linear) vs budget"), std::string::npos);
   EXPECT_NE(html.find("memory budget M"), std::string::npos);
+  // and every method's error against the bytes per pixel it was charged
+  EXPECT_NE(html.find("Mean FLIP vs bytes per pixel"), std::string::npos);
+  EXPECT_NE(html.find("bytes per pixel charged"), std::string::npos);
   // the failure is on the page
   EXPECT_NE(html.find("abuffer needs"), std::string::npos);
 }

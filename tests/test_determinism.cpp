@@ -1,6 +1,7 @@
 // "The output is byte-identical for any thread count": every preset, both compositing rules, on
 // the PNG bytes the CLI writes, for 1, 2, 3 and 8 workers (MFR_MAX_WORKERS lifts the cap of the
-// hardware threads so that 8 really means 8 workers on a 2-core machine).
+// hardware threads so that 8 really means 8 workers on a 2-core machine). The peer methods (wboit,
+// mboit, mlab) have one rule of their own, which --composite does not change: they run it once.
 #include <gtest/gtest.h>
 
 #include <cctype>
@@ -30,8 +31,13 @@ std::string readBytes(const fs::path& path) {
 // and the tail all matter.
 constexpr const char* kScene = "'procedural:hairball?strands=250' --width 80 --height 72";
 
+bool peerMethod(const std::string& preset) {
+  return !kBufferFamilyRule(methodPreset(preset).value().compositing);
+}
+
 void expectThreadIndependent(const std::string& preset, const std::string& composite,
                              const std::string& capture) {
+  const bool peer = peerMethod(preset);  // its own rule, no --composite
   ::setenv("MFR_MAX_WORKERS", "8", 1);
   const fs::path dir = test::processTempDir("mfr_determinism");
   std::string reference;
@@ -39,17 +45,21 @@ void expectThreadIndependent(const std::string& preset, const std::string& compo
     const fs::path png = dir / ("out_" + std::to_string(threads) + ".png");
     const fs::path stats = dir / ("stats_" + std::to_string(threads) + ".json");
     std::string args = std::string("render ") + kScene + " --quiet --method " + preset +
-                       " --composite " + composite + " --capture " + capture + " --threads " +
-                       std::to_string(threads) + " -o " + png.string() + " --stats-json " +
-                       stats.string();
-    if (preset != "abuffer") args += composite == "hybrid" ? " --budget 310KB" : " --budget 200KB";
+                       (peer ? std::string() : " --composite " + composite) + " --capture " +
+                       capture + " --threads " + std::to_string(threads) + " -o " + png.string() +
+                       " --stats-json " + stats.string();
+    if (preset != "abuffer")
+      args += composite == "hybrid" || peer ? " --budget 310KB" : " --budget 200KB";
     const test::CliRun run = test::runCli(args, dir);
     ASSERT_EQ(run.exitCode, 0) << preset << " " << composite << " threads " << threads << ": "
                                << run.err;
     const nlohmann::json j = nlohmann::json::parse(readBytes(stats));
     EXPECT_EQ(j["tile_workers"], threads) << "the cap was not lifted";
-    EXPECT_EQ(j["compositing"], composite);
-    if (preset != "abuffer") {
+    if (!peer) {
+      EXPECT_EQ(j["compositing"], composite);
+    }
+    // wboit and mboit lose no fragment (all are accumulated); mlab merges
+    if (preset != "abuffer" && preset != "wboit" && preset != "mboit") {
       EXPECT_GT(j["fragments_lost"].get<uint64_t>(), 0u) << preset << ": nothing overflows";
     }
     const std::string bytes = readBytes(png);
@@ -62,30 +72,45 @@ void expectThreadIndependent(const std::string& preset, const std::string& compo
   }
 }
 
-class EveryPreset : public ::testing::TestWithParam<std::string> {};
+class KBufferPreset : public ::testing::TestWithParam<std::string> {};
 
-TEST_P(EveryPreset, PngBytesIdenticalFor1238WorkersKBuffer) {
+TEST_P(KBufferPreset, PngBytesIdenticalFor1238WorkersKBuffer) {
   expectThreadIndependent(GetParam(), "kbuffer", "tile");
 }
 
-TEST_P(EveryPreset, PngBytesIdenticalFor1238WorkersHybrid) {
+TEST_P(KBufferPreset, PngBytesIdenticalFor1238WorkersHybrid) {
   expectThreadIndependent(GetParam(), "hybrid", "tile");
 }
 
-std::vector<std::string> presetsUnderTest() {
-  std::vector<std::string> names = presetNames();
-  names.push_back("kplus-heap+occupancy");
-  names.push_back("vkb+occupancy");
+// wboit, mboit, mlab: one compositing rule of their own
+class PeerPreset : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(PeerPreset, PngBytesIdenticalFor1238WorkersOwnRule) {
+  expectThreadIndependent(GetParam(), "kbuffer", "tile");
+}
+
+std::vector<std::string> presetsUnderTest(bool peers) {
+  std::vector<std::string> names;
+  for (const std::string& name : presetNames())
+    if (peerMethod(name) == peers) names.push_back(name);
+  if (!peers) {
+    names.push_back("kplus-heap+occupancy");
+    names.push_back("vkb+occupancy");
+  }
   return names;
 }
 
-INSTANTIATE_TEST_SUITE_P(Determinism, EveryPreset, ::testing::ValuesIn(presetsUnderTest()),
-                         [](const ::testing::TestParamInfo<std::string>& info) {
-                           std::string s = info.param;
-                           for (char& c : s)
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           return s;
-                         });
+std::string testName(const ::testing::TestParamInfo<std::string>& info) {
+  std::string s = info.param;
+  for (char& c : s)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return s;
+}
+
+INSTANTIATE_TEST_SUITE_P(Determinism, KBufferPreset, ::testing::ValuesIn(presetsUnderTest(false)),
+                         testName);
+INSTANTIATE_TEST_SUITE_P(Determinism, PeerPreset, ::testing::ValuesIn(presetsUnderTest(true)),
+                         testName);
 
 // The papers' fragment-parallel capture: the captured sets are identical for any thread count,
 // so the k-buffer resolve (no float tail sums) is byte-identical too.

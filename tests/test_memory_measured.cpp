@@ -33,11 +33,20 @@ std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const 
                                                      uint64_t pixels, bool parallel,
                                                      uint64_t abufferFragments) {
   std::map<std::string, uint64_t> b;
+  if (m.allocation == AllocationPolicy::NoNodes) {  // wboit / mboit: accumulators, no nodes
+    b["accumulators"] = (m.compositing == Compositing::WeightedBlended ? 20 : 36) * pixels;
+    b["counters"] = 4 * pixels;  // the CPU engine's count of accumulated fragments
+    b["k"] = 4 * pixels;
+    b["offsets"] = 8 * pixels;
+    b["store_kind"] = pixels;
+    if (parallel) b["locks"] = 4 * pixels;
+    return b;
+  }
   const bool importance = m.allocation == AllocationPolicy::Importance;
   uint64_t materialised = 0;  // nodes: min(k(p), n(p)) for importance allocation, else k(p)
   for (size_t p = 0; p < pixels; ++p)
     materialised += importance ? std::min(out.kMap[p], out.depthComplexity[p]) : out.kMap[p];
-  b["nodes"] = 8 * materialised;
+  b["nodes"] = (m.store == StoreChoice::MultiLayer ? 20 : 8) * materialised;  // mlab: 20 B
   b["counters"] = 4 * pixels;
   b["k"] = 4 * pixels * (importance ? 2 : 1);  // k(p) [+ the reserved k(p) of importance]
   b["offsets"] = 8 * pixels;                   // 64-bit offsets
@@ -76,8 +85,11 @@ TEST(MemoryMeasured, BytesAllocatedFollowTheDocumentedCpuLayoutForEveryPreset) {
       for (bool parallel : {false, true})
         for (Compositing rule : {Compositing::KBuffer, Compositing::Hybrid}) {
           if (name == "abuffer" && *suffix) continue;
+          // the peer methods: no +occupancy, their own rule only (--composite does not apply)
+          const bool peer = !kBufferFamilyRule(methodPreset(name).value().compositing);
+          if (peer && (*suffix || rule == Compositing::Hybrid)) continue;
           MethodDesc m = methodPreset(name + suffix).value();
-          m.compositing = rule;
+          if (!peer) m.compositing = rule;
           RenderOptions o;
           if (name != "abuffer") o.budgetBytes = 600000;
           o.capture = parallel ? CaptureMode::FragmentParallel : CaptureMode::TileOwned;
@@ -96,7 +108,9 @@ TEST(MemoryMeasured, BytesAllocatedFollowTheDocumentedCpuLayoutForEveryPreset) {
           }
           ++checked;
         }
-  EXPECT_EQ(checked, 4 * (1 + 2 * (static_cast<int>(presetNames().size()) - 1)));
+  constexpr int kPeers = 3;  // wboit, mboit, mlab: one rule, no +occupancy, both capture modes
+  EXPECT_EQ(checked,
+            4 * (1 + 2 * (static_cast<int>(presetNames().size()) - 1 - kPeers)) + 2 * kPeers);
 }
 
 TEST(MemoryMeasured, FragmentParallelModeChargesItsLockWordWithinTheBudget) {

@@ -754,7 +754,11 @@ TEST_F(SceneLoading, JsonSceneLoadsItsMeshRelativeToItselfAndAppliesOverrides) {
     "alpha": 0.4,
     "transmission_alpha_floor": 0.2
   })");
-  auto scene = mfr::loadScene(path);
+  // "../meshes" leaves the JSON file's folder: refused unless references outside are allowed
+  EXPECT_TRUE(isErrorNaming(mfr::loadScene(path), path, "'mesh' ../meshes/quad.gltf"));
+  mfr::LoadOptions options;
+  options.allowOutsideReferences = true;
+  auto scene = mfr::loadScene(path, options);
   ASSERT_LOADED(scene);
   EXPECT_EQ(scene->name, path);
   EXPECT_EQ(scene->triangleCount(), 2u);

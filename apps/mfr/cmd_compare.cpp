@@ -3,7 +3,6 @@
 // mfr/compare/compare.hpp).
 #include <cmath>
 #include <cstdio>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -13,6 +12,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "mfr/compare/compare.hpp"
+#include "mfr/compare/compare_output.hpp"
 #include "mfr/core/units.hpp"
 
 namespace mfr::cli {
@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 struct CompareArgs {
   SceneOptions scene;
   std::string budgets;
-  std::string methods = "fkb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,optimal";
+  std::string methods = "fkb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,optimal,wboit,mboit,mlab";
   std::string model;
   std::string out;
   std::string composite;  // empty: each preset's own rule
@@ -71,24 +71,6 @@ std::string commandLine() {
     }
   }
   return line.empty() ? std::string("mfr compare") : line;
-}
-
-std::string utcNow() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buffer[64];
-  std::strftime(buffer, sizeof buffer, "%Y-%m-%d %H:%M:%S UTC", &tm);
-  return buffer;
-}
-
-Result<void> writeText(const fs::path& path, const std::string& text) {
-  std::ofstream f(path, std::ios::binary);
-  if (!f) return makeError(path.string() + ": cannot write");
-  f << text;
-  f.close();
-  if (!f) return makeError(path.string() + ": write failed");
-  return {};
 }
 
 std::string psnrCell(double psnr) {
@@ -176,22 +158,14 @@ int run(const CompareArgs& a, const std::string& version) {
     return fail("--capture '" + a.capture + "': expected tile or parallel");
 
   // output folder: created and probed before any work
+  if (auto ready = prepareOutputFolder(a.out); !ready) return fail(ready.error().message);
   const fs::path dir(a.out);
-  {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    if (ec || !fs::is_directory(dir))
-      return fail(a.out + ": cannot create the output folder" +
-                  (ec ? " (" + ec.message() + ")" : std::string(" (not a directory)")));
-    const fs::path probe = dir / ".mfr_compare_write_test";
-    if (!std::ofstream(probe)) return fail(a.out + ": output folder is not writable");
-    fs::remove(probe, ec);
-  }
 
   Progress progress(!a.scene.quiet);
   progress.set("loading " + a.scene.source);
   auto prepared = prepareScene(a.scene);
   if (!prepared) return fail(prepared.error().message);
+  options.memoryLimitBytes = a.scene.memoryLimitBytes().value();  // checked by prepareScene
   options.background = prepared->scene.background;
   RasterOptions ro;
   ro.width = a.scene.width;
@@ -200,6 +174,11 @@ int run(const CompareArgs& a, const std::string& version) {
   progress.set("setting up " + a.scene.source);
   auto frame = RasterFrame::build(prepared->scene, prepared->cameras.front(), ro);
   if (!frame) return fail(a.scene.source + ": " + frame.error().message);
+  if (prepared->previousCamera) {  // --orbit-view I: view I - 1 precedes it (vkb's Fresnel term)
+    auto previous = RasterFrame::build(prepared->scene, *prepared->previousCamera, ro);
+    if (!previous) return fail(a.scene.source + ": " + previous.error().message);
+    options.previousNearestCosine = nearestCosine(previous.value());
+  }
   options.progress = [&progress](const std::string& stage, int done, int total) {
     progress.set(stage, done, total);
   };
@@ -209,34 +188,15 @@ int run(const CompareArgs& a, const std::string& version) {
 
   // files
   progress.set("writing " + a.out);
-  const auto png = [&](const std::string& file, const Image8& image) -> Result<void> {
-    if (file.empty()) return {};
-    return writePng((dir / file).string(), image);
-  };
-  std::vector<Result<void>> written;
-  written.push_back(png(r.groundTruth.imageFile, r.groundTruth.image));
-  written.push_back(png(r.depthComplexityFile, r.depthComplexityMap));
-  for (const CompareBudget& cb : r.budgets)
-    for (const CompareRun& run : cb.runs) {
-      if (!run.ok()) continue;
-      written.push_back(png(run.imageFile, run.image));
-      written.push_back(png(run.flipFile, run.flipMap));
-      written.push_back(png(run.kMapFile, run.kMap));
-      written.push_back(png(run.importanceFile, run.importanceMap));
-    }
   std::string versionNumber = version;
   if (versionNumber.rfind("mfr ", 0) == 0) versionNumber.erase(0, 4);
-  const nlohmann::json json = compareToJson(r, versionNumber);
-  const std::string jsonText = json.dump(2) + "\n";
-  written.push_back(writeText(dir / "results.json", jsonText));
-  written.push_back(writeText(dir / "results.csv", compareToCsv(r)));
   ReportInfo info;
   info.mfrVersion = version.empty() ? "mfr" : version;
   info.commandLine = commandLine();
-  info.generated = utcNow();
-  written.push_back(writeText(dir / "report.html", compareReportHtml(r, info)));
-  for (const Result<void>& w : written)
-    if (!w) return fail(w.error().message);
+  info.generated = utcTimestamp();
+  auto written = writeComparison(r, a.out, versionNumber, info);
+  if (!written) return fail(written.error().message);
+  const std::string& jsonText = written.value();
   progress.clear();
 
   if (!a.scene.quiet) {

@@ -39,6 +39,7 @@ int runDataset(DatasetArgs& a) {
     auto prepared = prepareScene(options);
     if (!prepared) return fail(prepared.error().message);
     sampling.background = prepared->scene.background;
+    sampling.memoryLimitBytes = options.memoryLimitBytes().value();  // checked by prepareScene
     const uint32_t sceneIndex = static_cast<uint32_t>(data.scenes.size());
     data.scenes.push_back(source);
     const size_t before = data.samples.size();

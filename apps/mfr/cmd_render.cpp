@@ -2,13 +2,13 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <memory>
 
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "mfr/core/atomic_file.hpp"
 #include "mfr/core/colormap.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/method_options.hpp"
@@ -57,7 +57,8 @@ Result<void> checkApplicable(const RenderArgs& a, const MethodDesc& m) {
       {"--no-depth-term", MethodOption::ImportanceParams},
       {"--no-periphery-term", MethodOption::ImportanceParams},
       {"--no-fresnel-term", MethodOption::ImportanceParams},
-      {"--no-noise", MethodOption::ImportanceParams}};
+      {"--no-noise", MethodOption::ImportanceParams},
+      {"--composite", MethodOption::Composite}};
   for (const auto& [flag, option] : flags)
     if (a.given(flag))
       if (auto ok = checkMethodOption(option, m, flag); !ok) return ok.error();
@@ -142,6 +143,7 @@ int run(const RenderArgs& a) {
   progress.set("loading " + a.scene.source);
   auto prepared = prepareScene(a.scene);
   if (!prepared) return fail(prepared.error().message);
+  options.memoryLimitBytes = a.scene.memoryLimitBytes().value();  // checked by prepareScene
   const Scene& scene = prepared->scene;
   options.background = scene.background;
   const int views = static_cast<int>(prepared->cameras.size());
@@ -230,10 +232,9 @@ int run(const RenderArgs& a) {
     }
   }
   const nlohmann::json statsOut = views == 1 ? allStats[0] : allStats;
-  if (!a.statsJson.empty()) {
-    std::ofstream f(a.statsJson);
-    if (!f) return fail(a.statsJson + ": cannot write");
-    f << statsOut.dump(2) << "\n";
+  if (!a.statsJson.empty()) {  // written atomically: never a truncated JSON file
+    auto written = writeFileAtomically(a.statsJson, statsOut.dump(2) + "\n");
+    if (!written) return fail(written.error().message);
   }
   if (a.scene.json) std::printf("%s\n", statsOut.dump(2).c_str());
   return 0;
@@ -256,7 +257,8 @@ Runner addRenderCommand(CLI::App& app) {
                   "Explicit k (otherwise derived from the budget)" + appliesTo(MethodOption::K));
   cmd->add_option("--composite", args->composite,
                   "kbuffer or hybrid (default: the preset's own rule, hybrid for dkb* and "
-                  "optimal*, else kbuffer)");
+                  "optimal*, else kbuffer)" +
+                      appliesTo(MethodOption::Composite));
   cmd->add_option("--occupancy-d", args->occupancyD,
                   "Occupancy map: 32*d buckets (default 1)" + appliesTo(MethodOption::OccupancyD));
   cmd->add_option("--capture", args->capture,

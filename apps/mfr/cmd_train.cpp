@@ -5,14 +5,16 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
+#include <sstream>
+#include <system_error>
 
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "mfr/core/atomic_file.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/plot.hpp"
 #include "mfr/learn/dataset.hpp"
@@ -125,21 +127,26 @@ int runTrain(TrainArgs& a) {
   auto split = loadSplit(a);
   if (!split) return fail(split.error().message);
   learn::Mlp net = learn::makeMlp(learn::kDkbLayers, o.seed);
-  std::ofstream log(a.log);
-  if (!log) return fail("--log " + a.log + ": cannot open for writing");
+  // the log is written (atomically, like every output) when training ends; its folder is checked
+  // now so that a bad --log fails before the training, not after it
+  const std::filesystem::path logFolder = std::filesystem::path(a.log).parent_path();
+  if (std::error_code ec; !std::filesystem::is_directory(logFolder.empty() ? "." : logFolder, ec))
+    return fail("--log " + a.log + ": cannot open for writing (no such folder)");
+  std::ostringstream log;
   log << "epoch,train_mse,validation_mse,seconds\n";
   Progress progress(!a.quiet);
   const auto logs = learn::train(
       net, split->trainX, split->trainY, split->validX, split->validY, o,
       [&](const learn::EpochLog& e) {
         log << e.epoch << ',' << e.trainLoss << ',' << e.validationLoss << ',' << e.seconds << '\n';
-        log.flush();
         char text[128];
         std::snprintf(text, sizeof text, "training: train %.4g, validation %.4g", e.trainLoss,
                       e.validationLoss);
         progress.set(text, e.epoch, o.epochs);
       });
   progress.clear();
+  if (auto written = writeFileAtomically(a.log, log.str()); !written)
+    return fail("--log " + written.error().message);
   if (logs.empty() || !std::isfinite(logs.back().trainLoss))
     return fail("training diverged (non-finite loss); lower --learning-rate or --momentum");
   const learn::EpochLog& last = logs.back();

@@ -7,8 +7,12 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "mfr/core/memory_limit.hpp"
+#include "mfr/core/units.hpp"
 #include "mfr/method/deep_importance.hpp"
 #include "mfr/raster/raster_frame.hpp"
+#include "mfr/scene/camera_spec.hpp"
+#include "mfr/scene/draw_order.hpp"
 
 namespace mfr::cli {
 
@@ -20,9 +24,7 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument) {
   app.add_option("--width", width, "Image width in pixels (1-16384)");
   app.add_option("--height", height, "Image height in pixels (1-16384)");
   app.add_option("--camera", camera,
-                 "EX,EY,EZ,TX,TY,TZ[,UX,UY,UZ[,FOV]]: eye, target, up, fov (deg)")
-      ->delimiter(',')
-      ->expected(6, 10);
+                 "EX,EY,EZ,TX,TY,TZ[,UX,UY,UZ[,FOV]]: eye, target, up, fov (deg)");
   app.add_option("--view", view, "Use the scene file's camera number N (0-based)");
   app.add_option("--orbit", orbit, "Render N views on a circle around the scene");
   app.add_option("--orbit-view", orbitView, "With --orbit N: only view I of the N (0-based)");
@@ -30,6 +32,8 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument) {
                  "Move the camera Z times closer to its target (default 1; 2 = half the distance)");
   app.add_option("--threads", threads, "Worker threads (default: all cores)");
   app.add_option("--seed", seed, "Seed for procedural scenes and noise (default 1)");
+  app.add_option("--shuffle-draw-order", shuffleDrawOrder,
+                 "Submit the scene's triangles in the random order of this seed");
   app.add_option("--alpha", alpha,
                  "Override every material's alpha (render the whole scene transparent)");
   app.add_option("--background", background, "Background R,G,B (linear, 0-1)")
@@ -40,6 +44,22 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument) {
       "Alpha floor for KHR_materials_transmission glass (alpha = max(floor, 1 - transmission))");
   app.add_flag("--quiet,-q", quiet, "No progress or summary on the terminal");
   app.add_flag("--json", json, "Print machine-readable JSON on stdout");
+  app.add_flag("--allow-outside-references", allowOutsideReferences,
+               "Let files named inside a scene file (glTF buffers and images, OBJ mtllib and "
+               "map_Kd, a JSON scene's mesh) lie outside its folder (never FIFOs or devices)");
+  app.add_option("--memory-limit", memoryLimit,
+                 "Refuse to allocate buffers larger than this, e.g. 8GB (default: " +
+                     std::to_string(static_cast<int>(kDefaultMemoryShare * 100)) +
+                     "% of the physical memory, " + formatBytes(defaultMemoryLimit()) + ")");
+}
+
+Result<uint64_t> SceneOptions::memoryLimitBytes() const {
+  if (memoryLimit.empty()) return defaultMemoryLimit();
+  auto bytes = parseByteSize(memoryLimit);
+  if (!bytes)
+    return makeError("--memory-limit '" + memoryLimit +
+                     "': expected a size such as 8GB, 512MB or 1048576 (at most 1 TiB)");
+  return bytes.value();
 }
 
 Result<PreparedScene> prepareScene(const SceneOptions& o) {
@@ -63,35 +83,41 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
   if (o.orbitView < -1) return makeError("--orbit-view: must be a view index (0-based)");
   if (o.alpha && !(*o.alpha >= 0.0 && *o.alpha <= 1.0))
     return makeError("--alpha: must be in [0, 1]");
-  if (!finiteAll(o.background) || !finiteAll(o.camera))
-    return makeError("--camera/--background: values must be finite numbers");
+  if (!finiteAll(o.background)) return makeError("--background: values must be finite numbers");
   if (!(o.transmissionFloor >= 0.0 && o.transmissionFloor <= 1.0))
     return makeError("--transmission-floor: must be in [0, 1]");
   for (double b : o.background)
     if (b < 0.0 || b > 1.0) return makeError("--background: components must be in [0, 1]");
-  if (o.camera.size() != 0 && o.camera.size() != 6 && o.camera.size() != 9 && o.camera.size() != 10)
-    return makeError("--camera: expected 6, 9 or 10 numbers");
+  std::optional<Camera> explicitCamera;
+  if (!o.camera.empty()) {
+    auto parsed = parseCameraSpec(o.camera, "--camera");
+    if (!parsed) return parsed.error();
+    explicitCamera = parsed.value();
+  }
   if (o.view < -1) return makeError("--view: must be a camera index (0-based)");
   if (!o.camera.empty() && o.view >= 0)
     return makeError("--view and --camera: give one camera, not both");
 
+  auto memoryLimit = o.memoryLimitBytes();
+  if (!memoryLimit) return memoryLimit.error();
+
   LoadOptions load;
   load.seed = o.seed;
   load.transmissionAlphaFloor = static_cast<float>(o.transmissionFloor);
+  load.allowOutsideReferences = o.allowOutsideReferences;
+  load.memoryLimitBytes = memoryLimit.value();
   auto loaded = loadScene(o.source, load);
   if (!loaded) return loaded.error();
   PreparedScene prepared{std::move(loaded.value()), {}, {}};
   Scene& scene = prepared.scene;
+  if (o.shuffleDrawOrder) shuffleDrawOrder(scene, *o.shuffleDrawOrder);
   if (o.alpha) scene.alphaOverride = static_cast<float>(*o.alpha);
   if (o.background.size() == 3)
     scene.background = glm::vec3(o.background[0], o.background[1], o.background[2]);
 
   Camera camera;
-  if (!o.camera.empty()) {
-    camera.eye = glm::vec3(o.camera[0], o.camera[1], o.camera[2]);
-    camera.target = glm::vec3(o.camera[3], o.camera[4], o.camera[5]);
-    if (o.camera.size() >= 9) camera.up = glm::vec3(o.camera[6], o.camera[7], o.camera[8]);
-    if (o.camera.size() == 10) camera.fovYDegrees = static_cast<float>(o.camera[9]);
+  if (explicitCamera) {
+    camera = *explicitCamera;
   } else if (o.view >= 0) {
     if (o.view >= static_cast<int>(scene.cameras.size()))
       return makeError(o.source + ": --view " + std::to_string(o.view) + " but the scene has " +

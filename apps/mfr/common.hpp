@@ -24,21 +24,26 @@ struct SceneOptions {
   std::string source;
   int width = 1024;
   int height = 1024;
-  std::vector<double> camera;  // eye(3) target(3) [up(3) [fov]]
-  int view = -1;               // camera of the file, by index
-  int orbit = 0;               // N views around the scene
-  int orbitView = -1;          // with orbit: only this one of the N views
-  double zoom = 1.0;           // camera distance to its target divided by this
+  std::string camera;  // "EX,EY,EZ,TX,TY,TZ[,UX,UY,UZ[,FOV]]" (parseCameraSpec)
+  int view = -1;       // camera of the file, by index
+  int orbit = 0;       // N views around the scene
+  int orbitView = -1;  // with orbit: only this one of the N views
+  double zoom = 1.0;   // camera distance to its target divided by this
   int threads = 0;
   uint64_t seed = 1;
+  std::optional<uint64_t> shuffleDrawOrder;  // submit the triangles in this seed's random order
   std::optional<double> alpha;
   std::vector<double> background;
   double transmissionFloor = 0.1;
   bool quiet = false;
   bool json = false;
+  bool allowOutsideReferences = false;  // files named in a scene may lie outside its folder
+  std::string memoryLimit;              // --memory-limit (empty: defaultMemoryLimit())
 
   /// Registers the options (and the positional scene unless the command takes several).
   void add(CLI::App& app, bool sceneArgument = true);
+  /// --memory-limit in bytes, or the default share of the physical memory.
+  Result<uint64_t> memoryLimitBytes() const;
 };
 
 struct PreparedScene {

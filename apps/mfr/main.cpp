@@ -2,6 +2,7 @@
 // reports; every failure is one line on stderr and a non-zero exit.
 #include <cstdio>
 #include <exception>
+#include <new>
 
 #include "commands.hpp"
 
@@ -27,6 +28,14 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("compare")) return compare();
     if (app.got_subcommand("dataset")) return dataset();
     if (app.got_subcommand("train")) return train();
+  } catch (const std::bad_alloc&) {
+    // the memory pre-flights let it through: named, never "std::bad_alloc"
+    const auto commands = app.get_subcommands();
+    std::fprintf(stderr,
+                 "mfr: error: out of memory in 'mfr %s' (smaller --width/--height or budgets, or "
+                 "a --memory-limit to refuse such runs before they allocate)\n",
+                 commands.empty() ? "" : commands.front()->get_name().c_str());
+    return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mfr: error: %s\n", e.what());
     return 1;

@@ -128,7 +128,10 @@ Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptio
     if (!preset) return preset.error();
     if (!seenMethods.insert(name).second) return makeError("method '" + name + "': listed twice");
     MethodDesc m = preset.value();
-    if (options.compositing) m.compositing = *options.compositing;
+    // --composite chooses between the k-buffer family's rules; the peer methods (wboit, mboit,
+    // mlab) keep their own (each run records the rule it used)
+    if (options.compositing && kBufferFamilyRule(m.compositing))
+      m.compositing = *options.compositing;
     m.importance.seed = options.seed;
     m.model = options.model;
     methods.push_back(m);
@@ -161,6 +164,7 @@ Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptio
   RenderOptions renderOptions;
   renderOptions.capture = options.capture;
   renderOptions.background = options.background;
+  renderOptions.memoryLimitBytes = options.memoryLimitBytes;
   if (!options.previousNearestCosine.empty())
     renderOptions.previousNearestCosine = &options.previousNearestCosine;
 

@@ -171,11 +171,13 @@ std::string markerSvg(int marker, double x, double y, const std::string& colour)
   }
 }
 
-/// A line plot of y vs budget (x in bytes, ticks at the budgets), one polyline per series.
+/// A line plot of y vs budget (x in bytes, ticks at the budgets), one polyline per series; or of
+/// y vs another x (`xName`) with the ticks given in `budgets`.
 std::string svgPlot(const std::string& title, const std::string& yLabel, bool allowLogY,
                     bool zeroBased, const std::vector<Series>& series,
                     const std::vector<uint64_t>& budgets,
-                    const std::vector<std::string>& budgetLabels) {
+                    const std::vector<std::string>& budgetLabels,
+                    const std::string& xName = "memory budget M") {
   size_t longest = 0;
   for (const Series& s : series)
     longest = std::max(longest, s.name.size() + (s.points.empty() ? 9 : 0));
@@ -268,7 +270,7 @@ std::string svgPlot(const std::string& title, const std::string& yLabel, bool al
       lastLabelX = x;
     }
   }
-  std::string xLabel = "memory budget M";
+  std::string xLabel = xName;
   if (ax.log) xLabel += " (log scale)";
   svg += format("<text x=\"%.1f\" y=\"%.1f\" text-anchor=\"middle\">%s</text>", (x0 + x1) / 2,
                 H - 12, escape(xLabel).c_str());
@@ -687,7 +689,47 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
                  labels) +
          "<figcaption>Share of the generated fragments not in the final per-pixel "
          "cores.</figcaption>"
-         "</figure>\n</div>\n";
+         "</figure>\n";
+    // every method's error against the bytes per pixel it was charged (bytes_used / pixels):
+    // methods that do not spend the whole budget (wboit, mboit, vkb) sit where they really are
+    const double pixels = static_cast<double>(r.width) * static_cast<double>(r.height);
+    double lo = INFINITY, hi = 0.0;
+    std::vector<Series> byBytes =
+        seriesOf([](const CompareRun& run) { return run.metrics.flipMean; });
+    for (size_t m = 0; m < byBytes.size(); ++m) {
+      size_t j = 0;
+      for (size_t i : order) {
+        const CompareRun& run = r.budgets[i].runs[m];
+        if (!run.ok()) continue;
+        const double bpp = static_cast<double>(run.stats.bytesUsed) / pixels;
+        byBytes[m].points[j++].first = bpp;
+        lo = std::min(lo, bpp);
+        hi = std::max(hi, bpp);
+      }
+      std::sort(byBytes[m].points.begin(), byBytes[m].points.end());
+    }
+    if (std::isfinite(lo)) {
+      std::vector<uint64_t> ticks;
+      std::vector<std::string> tickLabels;
+      // ticks: the data's range (whole bytes) and nice values between
+      const double a = std::max(1.0, std::floor(lo)), b = std::max(std::ceil(hi), a + 1.0);
+      ticks.push_back(static_cast<uint64_t>(a));
+      tickLabels.push_back(format("%g B", a));
+      for (double t : niceTicks(a, b, 4))
+        if (t > a + 0.5 && t < b - 0.5) {
+          ticks.push_back(static_cast<uint64_t>(std::llround(t)));
+          tickLabels.push_back(format("%g B", std::round(t)));
+        }
+      ticks.push_back(static_cast<uint64_t>(b));
+      tickLabels.push_back(format("%g B", b));
+      h += "<figure>" +
+           svgPlot("Mean FLIP vs bytes per pixel", "mean FLIP", false, true, byBytes, ticks,
+                   tickLabels, "bytes per pixel charged (bytes_used / pixels)") +
+           "<figcaption>Every method's error against the memory it was charged per pixel, "
+           "across all budgets: which method buys the most quality per byte.</figcaption>"
+           "</figure>\n";
+    }
+    h += "</div>\n";
   }
 
   // images

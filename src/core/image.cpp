@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <filesystem>
-#include <fstream>
+#include <limits>
+#include <string>
 
+#include "mfr/core/atomic_file.hpp"
 #include "mfr/core/color.hpp"
+#include "mfr/core/file_access.hpp"
+#include "mfr/core/quote.hpp"
 
 #include <stb_image.h>
 #include <stb_image_write.h>
@@ -35,28 +39,45 @@ ImageRGB decodeSrgb(const Image8& image) {
 
 Result<void> writePng(const std::string& path, const Image8& image) {
   if (image.width <= 0 || image.height <= 0) return makeError(path + ": empty image");
+  // encoded in memory, then written atomically: never a truncated PNG at `path`
+  std::string encoded;
+  const auto append = [](void* context, void* data, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data),
+                                               static_cast<size_t>(size));
+  };
+  if (!stbi_write_png_to_func(append, &encoded, image.width, image.height, 4, image.rgba.data(),
+                              image.width * 4))
+    return makeError(path + ": cannot encode PNG");
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   std::error_code ec;
   if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-  if (!stbi_write_png(path.c_str(), image.width, image.height, 4, image.rgba.data(),
-                      image.width * 4))
-    return makeError(path + ": cannot write PNG");
+  auto written = writeFileAtomically(path, encoded);
+  if (!written) {  // "PATH: cannot open for writing (...)" -> "PATH: cannot write PNG (...)"
+    std::string reason = written.error().message;
+    if (reason.rfind(path + ": ", 0) == 0) reason.erase(0, path.size() + 2);
+    return makeError(path + ": cannot write PNG: " + reason);
+  }
   return {};
 }
 
 Result<Image8> readPng(const std::string& path) {
-  if (!std::filesystem::exists(path)) return makeError(path + ": no such file");
-  {
-    static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
-    unsigned char head[8] = {};
-    std::ifstream file(path, std::ios::binary);
-    if (!file.read(reinterpret_cast<char*>(head), 8) || !std::equal(head, head + 8, kSignature))
-      return makeError(path + ": not a PNG file");
-  }
+  // a regular file (a FIFO is refused, not waited on) of less than 2 GiB
+  auto bytes = readRegularFileBytes(path, path, std::numeric_limits<int>::max());
+  if (!bytes) return bytes.error();
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (bytes->size() < 8 || !std::equal(bytes->begin(), bytes->begin() + 8, kSignature))
+    return makeError(path + ": not a PNG file");
+  const auto size = static_cast<int>(bytes->size());
   int w = 0, h = 0, n = 0;
-  if (!stbi_info(path.c_str(), &w, &h, &n)) return makeError(path + ": not a readable image");
-  unsigned char* data = stbi_load(path.c_str(), &w, &h, &n, 4);
-  if (!data) return makeError(path + ": " + stbi_failure_reason());
+  if (!stbi_info_from_memory(bytes->data(), size, &w, &h, &n)) {
+    const char* reason = stbi_failure_reason();
+    return makeError(path + ": not a readable image" +
+                     (reason ? " (" + oneLine(reason) + ")" : std::string()));
+  }
+  MFR_TRY(checkImageDimensions(w, h, path));  // from the header, before decoding
+  unsigned char* data = stbi_load_from_memory(bytes->data(), size, &w, &h, &n, 4);
+  // stb quotes the bytes of an unknown chunk type: keep the message on one line
+  if (!data) return makeError(path + ": " + oneLine(stbi_failure_reason()));
   Image8 image;
   image.width = w;
   image.height = h;

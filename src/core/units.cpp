@@ -5,11 +5,14 @@
 #include <cmath>
 #include <cstdio>
 
+#include "mfr/core/quote.hpp"
+
 namespace mfr {
 
 Result<uint64_t> parseByteSize(const std::string& text) {
   const auto bad = [&] {
-    return makeError("budget '" + text + "': expected a size such as 20MB, 512KB or 1048576");
+    return makeError("budget " + quoteInput(text) +
+                     ": expected a size such as 20MB, 512KB or 1048576");
   };
   size_t i = 0;
   while (i < text.size() && (std::isdigit(static_cast<unsigned char>(text[i])) || text[i] == '.'))
@@ -34,9 +37,9 @@ Result<uint64_t> parseByteSize(const std::string& text) {
   else
     return bad();
   const double bytes = std::floor(value * scale);
-  if (bytes < 1.0) return makeError("budget '" + text + "': must be at least 1 byte");
+  if (bytes < 1.0) return makeError("budget " + quoteInput(text) + ": must be at least 1 byte");
   if (bytes > 1024.0 * 1024.0 * 1024.0 * 1024.0)
-    return makeError("budget '" + text + "': above the 1 TiB limit");
+    return makeError("budget " + quoteInput(text) + ": above the 1 TiB limit");
   return static_cast<uint64_t>(bytes);
 }
 

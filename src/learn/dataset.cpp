@@ -6,11 +6,14 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 
 #include <nlohmann/json.hpp>
 
+#include "mfr/core/atomic_file.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/method/optimal_allocation.hpp"
 #include "mfr/method/optimal_oracle.hpp"
 
@@ -94,7 +97,8 @@ uint64_t budgetStepSlots(uint64_t coveredPixels, uint64_t fragments, int step, i
 
 Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t scene,
                                               uint32_t view, const ViewSamplingOptions& options) {
-  auto oracle = frameErrorCurves(frame, options.background);
+  auto oracle =
+      frameErrorCurves(frame, options.background, Compositing::Hybrid, options.memoryLimitBytes);
   if (!oracle) return oracle.error();
   const std::vector<FeatureAccumulator> pixels = accumulateFeatures(frame);
   const ImageFeatureStats image = imageFeatureStats(pixels);
@@ -144,14 +148,16 @@ Result<void> writeDataset(const std::string& path, const Dataset& data) {
     for (float f : s.features) put(out, f);
     put(out, s.target);
   }
-  std::ofstream file(path, std::ios::binary);
-  if (!file) return makeError("dataset " + path + ": cannot open for writing");
-  file.write(out.data(), static_cast<std::streamsize>(out.size()));
-  if (!file) return makeError("dataset " + path + ": write failed");
+  // a temporary file renamed into place: an interrupted write never leaves a truncated dataset
+  if (auto written = writeFileAtomically(path, out); !written)
+    return makeError("dataset " + written.error().message);
   return {};
 }
 
 Result<Dataset> readDataset(const std::string& path) {
+  std::error_code ec;  // a FIFO or device would block or never end: regular files only
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+    return makeError("dataset " + path + ": not a regular file");
   std::ifstream file(path, std::ios::binary);
   if (!file) return makeError("dataset " + path + ": cannot open (missing or unreadable)");
   const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
@@ -211,8 +217,9 @@ Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& pat
     const auto it = meta.find(key);
     if (it == meta.end()) continue;
     if (!it->is_string() || it->get<std::string>() != value)
-      return makeError("dataset " + path + ": its metadata declares " + key + " " + it->dump() +
-                       ", this build computes \"" + value + "\" (regenerate it with mfr dataset)");
+      return makeError("dataset " + path + ": its metadata declares " + key + " " +
+                       oneLine(it->dump(), 120) + ", this build computes \"" + value +
+                       "\" (regenerate it with mfr dataset)");
   }
   return {};
 }

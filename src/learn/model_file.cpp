@@ -16,6 +16,8 @@
 #include <string_view>
 #include <system_error>
 
+#include "mfr/core/atomic_file.hpp"
+
 namespace mfr::learn {
 namespace {
 
@@ -289,20 +291,18 @@ Result<void> writeModel(const std::string& path, const Model& model) {
     if (!problem.empty()) return fail(path, "cannot write the model: ", problem);
   }
   const std::vector<uint8_t> bytes = encodeModel(model);
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) return fail(path, "cannot open for writing (", errnoText(errno), ")");
-  int err = 0;
-  errno = 0;
-  if (std::fwrite(bytes.data(), 1, bytes.size(), file) != bytes.size()) err = errno ? errno : EIO;
-  if (std::fclose(file) != 0 && err == 0) err = errno ? errno : EIO;  // buffered writes fail here
-  if (err != 0) return fail(path, "write error (", errnoText(err), ")");
-  return {};
+  // a temporary file renamed into place: an interrupted write never leaves a truncated model
+  return writeFileAtomically(
+      path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 Result<Model> readModel(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     return fail(path, "cannot read a model file: is a directory");
+  }
+  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) {
+    return fail(path, "cannot read a model file: not a regular file");  // a FIFO would block
   }
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (!file) return fail(path, "cannot open model file (", errnoText(errno), ")");

@@ -11,7 +11,9 @@
 //                 at n(p), and hands freed and remainder slots to the pixels with the largest unmet
 //                 importance;
 //   optimal       k(p) from the offline oracle (optimal_allocation.hpp) over an A-buffer pre-pass;
-//   unbounded     k(p) = n(p) (A-buffer / S-buffer).
+//   unbounded     k(p) = n(p) (A-buffer / S-buffer);
+//   no nodes      k(p) = 0 (wboit, mboit: per-pixel accumulators only; the budget must cover them).
+// Node bytes are the memory model's S_f (8, or 20 for mlab's nodes).
 // Offsets are an exclusive prefix sum of k(p) in tile-major order (the S-buffer's clustering of
 // pixels by tiles, for locality).
 #include <algorithm>
@@ -40,9 +42,13 @@ StoreKind pickStore(StoreChoice choice, uint32_t n, uint32_t k) {
       return StoreKind::MaxArray;
     case StoreChoice::MaxHeap:
       return StoreKind::MaxHeap;
-    default:
+    case StoreChoice::PerPixel:
       return (n > k && k > 16) ? StoreKind::MaxHeap : StoreKind::MaxArray;
+    case StoreChoice::MultiLayer:  // MLAB's own store (peer_methods.cpp); the kind is unused
+    case StoreChoice::None:
+      return StoreKind::MaxArray;
   }
+  return StoreKind::MaxArray;
 }
 
 }  // namespace
@@ -91,8 +97,19 @@ void fillByImportance(const std::vector<uint32_t>& n, const std::vector<float>& 
 
 Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
                             const MemoryModel& memory, std::optional<uint64_t> budget,
-                            const std::vector<uint32_t>& n, const std::vector<float>& importance,
+                            const std::vector<uint32_t>& n, const std::vector<float>& importanceIn,
                             const std::vector<uint32_t>& oracleK) {
+  // I(p) comes from hand-set parameters or a model file (deep k-buffer): a NaN, infinite or
+  // negative value counts as 0, so that no float-to-integer conversion below ever sees it.
+  const auto usable = [](float i) { return std::isfinite(i) && i >= 0.0f; };
+  std::vector<float> sanitized;
+  const bool clean = std::all_of(importanceIn.begin(), importanceIn.end(), usable);
+  if (!clean) {
+    sanitized = importanceIn;
+    for (float& i : sanitized)
+      if (!usable(i)) i = 0.0f;
+  }
+  const std::vector<float>& importance = clean ? importanceIn : sanitized;
   const uint64_t pixels = frame.pixelCount();
   const uint64_t overhead = memory.overhead(pixels);
   const std::string& name = method.name;
@@ -100,7 +117,16 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
   a.capacity.assign(pixels, 0);
   a.kind.assign(pixels, StoreKind::MaxArray);
 
-  if (budget && *budget < overhead + kNodeBytes)
+  const uint64_t nodeBytes = memory.node;
+  if (method.allocation == AllocationPolicy::NoNodes) {  // wboit, mboit: accumulators only
+    if (budget && *budget < overhead)
+      return makeError("budget " + bytesText(*budget) + ": too small for " + name + " at " +
+                       sizeText(frame) + " (its per-pixel buffers take " + bytesText(overhead) +
+                       ")");
+    a.offsets.assign(pixels, 0);
+    return a;
+  }
+  if (budget && *budget < overhead + nodeBytes)
     return makeError("budget " + bytesText(*budget) + ": too small for " + name + " at " +
                      sizeText(frame) + " (its per-pixel buffers take " + bytesText(overhead) +
                      ", leaving no room for a fragment)");
@@ -117,7 +143,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
   auto tooSmall = [&](const char* which, uint64_t count) {
     return makeError("budget " + bytesText(*budget) + ": too small for one fragment per " + which +
                      " with " + name + " at " + sizeText(frame) + " (needs " +
-                     bytesText(overhead + count * kNodeBytes) + ")");
+                     bytesText(overhead + count * nodeBytes) + ")");
   };
 
   switch (method.allocation) {
@@ -125,7 +151,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
       a.slots = sumCapped(UINT32_MAX);
       if (a.slots > slotsInBudget)
         return makeError("budget " + bytesText(*budget) + ": " + name + " needs " +
-                         bytesText(overhead + a.slots * kNodeBytes) + " for all " +
+                         bytesText(overhead + a.slots * nodeBytes) + " for all " +
                          std::to_string(a.slots) + " fragments at " + sizeText(frame));
       for (size_t p = 0; p < pixels; ++p) a.capacity[p] = n[p];
       break;
@@ -141,7 +167,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
       if (k * pixels > slotsInBudget)
         return makeError("budget " + bytesText(*budget) + ": " + name +
                          " with k = " + std::to_string(k) + " needs " +
-                         bytesText(overhead + k * pixels * kNodeBytes) + " at " + sizeText(frame));
+                         bytesText(overhead + k * pixels * nodeBytes) + " at " + sizeText(frame));
       a.globalK = static_cast<uint32_t>(k);
       a.slots = k * pixels;
       std::fill(a.capacity.begin(), a.capacity.end(), static_cast<uint32_t>(k));
@@ -180,7 +206,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
       if (a.slots > slotsInBudget)
         return makeError("budget " + bytesText(*budget) + ": " + name +
                          " with k = " + std::to_string(k) + " needs " +
-                         bytesText(overhead + a.slots * kNodeBytes) + " at " + sizeText(frame));
+                         bytesText(overhead + a.slots * nodeBytes) + " at " + sizeText(frame));
       a.globalK = static_cast<uint32_t>(k);
       for (size_t p = 0; p < pixels; ++p)
         a.capacity[p] = static_cast<uint32_t>(std::min<uint64_t>(n[p], k));
@@ -220,6 +246,8 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
       MFR_CHECK(a.reservedSlots <= slotsInBudget);
       break;
     }
+    case AllocationPolicy::NoNodes:  // returned above
+      break;
     case AllocationPolicy::Optimal: {  // k(p) chosen by the oracle (render.cpp) within F(M)
       if (!budget) return makeError(name + ": needs a budget");
       if (slotsInBudget < covered) return tooSmall("covered pixel", covered);

@@ -165,6 +165,8 @@ CaptureCounters runCapture(const RasterFrame& frame, const Allocation& alloc,
 CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,
                         const Allocation& allocation, const OccupancyMap* occupancy,
                         CaptureMode mode, Stores& stores) {
+  if (isPeerRule(method.compositing))  // wboit, mboit, mlab: peer_methods.cpp
+    return capturePeer(frame, method, allocation, mode, stores);
   const bool hybrid = method.compositing == Compositing::Hybrid;
   const bool occ = occupancy != nullptr;
   const bool kplus = method.culling == CullingTest::KPlus;

@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 
 #include <nlohmann/json.hpp>
 
+#include "mfr/core/quote.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/learn/model_file.hpp"
 
@@ -79,7 +81,9 @@ std::vector<float> predictImportance(const RasterFrame& frame, const learn::Mode
     const Eigen::MatrixXf out = learn::predict(model.net, inputs);
     for (size_t j = 0; j < covered.size(); ++j) {
       const int x = r.x0 + covered[j] % w, y = r.y0 + covered[j] / w;
-      importance[static_cast<size_t>(y) * frame.width() + x] = out(0, static_cast<Eigen::Index>(j));
+      // a model whose activations overflow float predicts NaN: that pixel gets importance 0
+      const float v = out(0, static_cast<Eigen::Index>(j));
+      importance[static_cast<size_t>(y) * frame.width() + x] = std::isnan(v) ? 0.0f : v;
     }
     addNs(inferenceNs, start);
   });
@@ -107,13 +111,13 @@ Result<void> checkDkbModelFits(const learn::Model& model, const std::string& nam
     return makeError("model " + name + ": its metadata does not declare the feature set \"" +
                      std::string(kDkbFeatureSet) + "\" (was it written by mfr train?)");
   if (features != kDkbFeatureSet)
-    return makeError("model " + name + ": trained on the feature set \"" + features +
+    return makeError("model " + name + ": trained on the feature set \"" + oneLine(features, 80) +
                      "\", this build computes \"" + kDkbFeatureSet + "\" (retrain it)");
   if (target.empty() && requireTarget)
     return makeError("model " + name + ": its metadata does not declare the target \"" +
                      learn::kDkbTargetScaling + "\" (retrain it)");
   if (!target.empty() && target != learn::kDkbTargetScaling)
-    return makeError("model " + name + ": trained for the target \"" + target +
+    return makeError("model " + name + ": trained for the target \"" + oneLine(target, 120) +
                      "\", this build's target is \"" + learn::kDkbTargetScaling +
                      "\" (retrain it)");
   return {};

@@ -1,12 +1,17 @@
 #include "mfr/method/memory_model.hpp"
 
 #include "mfr/capture/occupancy_map.hpp"
+#include "mfr/method/mboit.hpp"
+#include "mfr/method/mlab.hpp"
+#include "mfr/method/wboit.hpp"
 
 namespace mfr {
 
 MemoryModel MemoryModel::of(const MethodDesc& method, bool fragmentParallel) {
   MemoryModel m;
-  const bool prefixSum = method.allocation != AllocationPolicy::FixedK;
+  const bool noNodes = method.allocation == AllocationPolicy::NoNodes;
+  const bool prefixSum = method.allocation != AllocationPolicy::FixedK && !noNodes;
+  m.counter = noNodes ? 0 : 4;
   m.offset = prefixSum ? 4 : 0;
   m.lock = method.perPixelLock || fragmentParallel ? 4 : 0;
   m.occupancy = method.occupancyWords > 0 ? OccupancyMap::bytesPerPixel(method.occupancyWords) : 0;
@@ -15,19 +20,34 @@ MemoryModel MemoryModel::of(const MethodDesc& method, bool fragmentParallel) {
                        method.importanceSource == ImportanceSource::Heuristic
                    ? 1
                    : 0;
+  switch (method.compositing) {
+    case Compositing::WeightedBlended:
+      m.accum = sizeof(WboitPixel);
+      break;
+    case Compositing::MomentBased:
+      m.accum = sizeof(MboitPixel);
+      break;
+    case Compositing::KBuffer:
+    case Compositing::Hybrid:
+    case Compositing::MultiLayerAlpha:
+      break;
+  }
+  if (method.store == StoreChoice::MultiLayer) m.node = kMlabNodeBytes;
+  if (noNodes) m.node = 0;
   m.image = method.allocation == AllocationPolicy::DynamicK ? kHistogramBins * 4 : 0;
   return m;
 }
 
 std::map<std::string, uint64_t> MemoryModel::breakdown(uint64_t pixels, uint64_t slots) const {
   std::map<std::string, uint64_t> bytes;
-  bytes["nodes"] = slots * kNodeBytes;
-  bytes["counters"] = pixels * counter;
+  if (slots || counter) bytes["nodes"] = slots * node;
+  if (counter) bytes["counters"] = pixels * counter;
   if (offset) bytes["offsets"] = pixels * offset;
   if (lock) bytes["locks"] = pixels * lock;
   if (occupancy) bytes["occupancy"] = pixels * occupancy;
   if (tail) bytes["tail"] = pixels * tail;
   if (previous) bytes["previous_frame"] = pixels * previous;
+  if (accum) bytes["accumulators"] = pixels * accum;
   if (image) bytes["histogram"] = image;
   return bytes;
 }

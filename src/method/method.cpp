@@ -1,11 +1,13 @@
 #include "mfr/method/method.hpp"
 
+#include "mfr/core/quote.hpp"
+
 namespace mfr {
 
 std::vector<std::string> presetNames() {
-  return {"zbuffer",  "abuffer",       "fkb",           "kplus-array", "kplus-heap",
-          "kplus-sb", "kplus-dynamic", "vkb",           "vkb-fill",    "dkb",
-          "dkb-fill", "optimal",       "optimal-greedy"};
+  return {"zbuffer",        "abuffer", "fkb",      "kplus-array", "kplus-heap", "kplus-sb",
+          "kplus-dynamic",  "vkb",     "vkb-fill", "dkb",         "dkb-fill",   "optimal",
+          "optimal-greedy", "wboit",   "mboit",    "mlab"};
 }
 
 Result<MethodDesc> methodPreset(const std::string& fullName) {
@@ -62,13 +64,26 @@ Result<MethodDesc> methodPreset(const std::string& fullName) {
     m.perPixelLock = true;
     m.compositing = Compositing::Hybrid;  // the oracle minimises the hybrid error
     m.publishedGreedy = name == "optimal-greedy";
+  } else if (name == "wboit" || name == "mboit") {
+    // the peer methods (README "Peer methods"): per-pixel accumulators, no fragment nodes
+    m.allocation = AllocationPolicy::NoNodes;
+    m.store = StoreChoice::None;
+    m.compositing = name == "wboit" ? Compositing::WeightedBlended : Compositing::MomentBased;
+  } else if (name == "mlab") {
+    // k nodes per pixel from the budget like fkb, MLAB's store, the k+ family's per-pixel lock
+    m.allocation = AllocationPolicy::FixedK;
+    m.store = StoreChoice::MultiLayer;
+    m.perPixelLock = true;
+    m.compositing = Compositing::MultiLayerAlpha;
   } else {
     std::string known;
     for (const std::string& n : presetNames()) known += (known.empty() ? "" : ", ") + n;
-    return makeError("method '" + fullName + "': unknown (known: " + known +
+    return makeError("method " + quoteInput(fullName) + ": unknown (known: " + known +
                      ", each optionally with +occupancy)");
   }
   if (occupancy) {
+    if (!kBufferFamilyRule(m.compositing))
+      return makeError("method '" + fullName + "': occupancy culling applies to k-buffers only");
     if (m.allocation == AllocationPolicy::Unbounded)
       return makeError("method '" + fullName + "': occupancy culling needs a bounded k");
     m.occupancyWords = 1;
@@ -88,9 +103,12 @@ const char* toString(AllocationPolicy a) {
       return "dynamic-k";
     case AllocationPolicy::Importance:
       return "importance";
-    default:
+    case AllocationPolicy::Optimal:
       return "optimal";
+    case AllocationPolicy::NoNodes:
+      return "no-nodes";
   }
+  return "?";
 }
 const char* toString(StoreChoice s) {
   switch (s) {
@@ -100,21 +118,51 @@ const char* toString(StoreChoice s) {
       return "max-array";
     case StoreChoice::MaxHeap:
       return "max-heap";
-    default:
+    case StoreChoice::PerPixel:
       return "per-pixel";
+    case StoreChoice::MultiLayer:
+      return "multi-layer";
+    case StoreChoice::None:
+      return "none";
   }
+  return "?";
 }
 const char* toString(CullingTest c) {
   return c == CullingTest::None ? "none" : "kplus";
 }
 const char* toString(Compositing c) {
-  return c == Compositing::KBuffer ? "kbuffer" : "hybrid";
+  switch (c) {
+    case Compositing::KBuffer:
+      return "kbuffer";
+    case Compositing::Hybrid:
+      return "hybrid";
+    case Compositing::WeightedBlended:
+      return "weighted-blended";
+    case Compositing::MomentBased:
+      return "moment-based";
+    case Compositing::MultiLayerAlpha:
+      return "multi-layer-alpha";
+  }
+  return "?";
+}
+
+bool kBufferFamilyRule(Compositing c) {
+  switch (c) {
+    case Compositing::KBuffer:
+    case Compositing::Hybrid:
+      return true;
+    case Compositing::WeightedBlended:
+    case Compositing::MomentBased:
+    case Compositing::MultiLayerAlpha:
+      return false;
+  }
+  return false;
 }
 
 Result<Compositing> parseCompositing(const std::string& text) {
   if (text == "kbuffer") return Compositing::KBuffer;
   if (text == "hybrid") return Compositing::Hybrid;
-  return makeError("compositing '" + text + "': expected kbuffer or hybrid");
+  return makeError("compositing " + quoteInput(text) + ": expected kbuffer or hybrid");
 }
 
 }  // namespace mfr

@@ -13,6 +13,7 @@ bool takesK(const MethodDesc& m) {
     case AllocationPolicy::Unbounded:
     case AllocationPolicy::Importance:
     case AllocationPolicy::Optimal:
+    case AllocationPolicy::NoNodes:
       return false;
   }
   return false;
@@ -36,6 +37,10 @@ bool occupancy(const MethodDesc& m) {
   return m.occupancyWords > 0;
 }
 
+bool kBufferFamily(const MethodDesc& m) {
+  return kBufferFamilyRule(m.compositing);
+}
+
 }  // namespace
 
 const std::vector<MethodOptionRule>& methodOptionRules() {
@@ -50,6 +55,8 @@ const std::vector<MethodOptionRule>& methodOptionRules() {
        "--importance-alpha/--n-limit/--periphery-d/--fovea/--noise/--no-*-term/"
        "--importance-factors",
        "the variable k-buffer's heuristic importance", heuristicImportance},
+      {MethodOption::Composite, "--composite", "the k-buffer family (kbuffer / hybrid rules)",
+       kBufferFamily},
   };
   return rules;
 }

@@ -2,19 +2,40 @@
 #include "mfr/method/optimal_oracle.hpp"
 
 #include <algorithm>
+#include <string>
 
+#include "mfr/core/memory_limit.hpp"
 #include "mfr/method/optimal_allocation.hpp"
 #include "mfr/method/render.hpp"
 
 namespace mfr {
 
 Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 background,
-                                          Compositing compositing) {
+                                          Compositing compositing,
+                                          std::optional<uint64_t> memoryLimitBytes) {
   RenderOptions exact;
   exact.keepStores = true;
   exact.background = background;
+  exact.memoryLimitBytes = memoryLimitBytes;  // the A-buffer checks its own buffers
   auto truth = render(frame, methodPreset("abuffer").value(), exact);
   if (!truth) return truth.error();
+  {  // memory pre-flight of the curves (8 bytes per fragment, a vector per pixel) on top of the
+     // A-buffer's output
+    uint64_t fragments = 0;
+    for (uint32_t c : truth->counts) fragments += c;
+    const uint64_t held =
+        truth->nodes.capacity() * sizeof(FragmentNode) +
+        truth->offsets.capacity() * sizeof(uint64_t) +
+        (truth->counts.capacity() + truth->kMap.capacity() + truth->depthComplexity.capacity()) *
+            sizeof(uint32_t) +
+        truth->image.pixels.capacity() * sizeof(glm::vec3);
+    const uint64_t curves = saturatingAdd(saturatingMul(fragments, sizeof(double)),
+                                          saturatingMul(frame.pixelCount(), 24 + 16));
+    MFR_TRY(checkMemory(
+        saturatingAdd(held, curves), memoryLimitBytes.value_or(defaultMemoryLimit()),
+        "the error curves of " + std::to_string(fragments) + " fragments at " +
+            std::to_string(frame.width()) + " x " + std::to_string(frame.height()) + " pixels"));
+  }
   FrameErrorCurves out;
   out.curves.resize(frame.pixelCount());
   frame.forEachTile([&](int tile) {

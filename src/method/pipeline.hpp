@@ -10,8 +10,11 @@
 
 #include "mfr/capture/occupancy_map.hpp"
 #include "mfr/method/compositing.hpp"
+#include "mfr/method/mboit.hpp"
 #include "mfr/method/memory_model.hpp"
+#include "mfr/method/mlab.hpp"
 #include "mfr/method/render.hpp"
+#include "mfr/method/wboit.hpp"
 
 namespace mfr::detail {
 
@@ -96,11 +99,27 @@ struct Stores {
   std::vector<uint32_t> counts;
   std::vector<uint32_t> locks;
   std::vector<HybridTail> tails;  // empty unless hybrid
+  // the peer methods' buffers (peer_methods.cpp), empty for the others
+  std::vector<WboitPixel> wboit;  // per pixel
+  std::vector<MboitPixel> mboit;  // per pixel
+  std::vector<MlabNode> mlab;     // k(p) per pixel at offsets[p] (the node pool of mlab)
 };
 
 /// The capture pass: every fragment through occupancy test, k+ test and store insertion.
 CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,
                         const Allocation& allocation, const OccupancyMap* occupancy,
                         CaptureMode mode, Stores& stores);
+
+/// The peer methods (wboit, mboit, mlab): their buffers, the MBOIT moments pass, the capture
+/// (accumulation / MLAB insertion; counts[p] is the fragments accumulated, or MLAB's nodes in use)
+/// and the resolve. Fragment-parallel mode takes the per-pixel spin-lock around each update.
+bool isPeerRule(Compositing c);
+void allocatePeerStores(const MethodDesc& method, const Allocation& allocation, size_t pixels,
+                        Stores& stores);
+void accumulateMoments(const RasterFrame& frame, CaptureMode mode, Stores& stores);
+CaptureCounters capturePeer(const RasterFrame& frame, const MethodDesc& method,
+                            const Allocation& allocation, CaptureMode mode, Stores& stores);
+ImageRGB resolvePeer(const RasterFrame& frame, const MethodDesc& method,
+                     const Allocation& allocation, const Stores& stores, glm::vec3 background);
 
 }  // namespace mfr::detail

@@ -6,10 +6,14 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <new>
+#include <string>
 
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "mfr/core/memory_limit.hpp"
+#include "mfr/core/units.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/deep_importance.hpp"
 #include "mfr/method/optimal_allocation.hpp"
@@ -19,11 +23,18 @@
 namespace mfr {
 namespace {
 
+/// The pass this thread is running (named in an out-of-memory error).
+const char*& currentPass() {
+  thread_local const char* pass = "set-up";
+  return pass;
+}
+
 class PassTimer {
  public:
   explicit PassTimer(std::vector<PassTime>& passes) : passes_(passes) {}
   template <class Fn>
   auto run(const char* name, Fn&& fn) {
+    currentPass() = name;
     const auto start = std::chrono::steady_clock::now();
     if constexpr (std::is_void_v<decltype(fn())>) {
       fn();
@@ -72,6 +83,8 @@ void buildOccupancy(const RasterFrame& frame, const detail::Allocation& alloc, O
 ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method,
                  const detail::Allocation& alloc, const detail::Stores& stores,
                  glm::vec3 background) {
+  if (detail::isPeerRule(method.compositing))
+    return detail::resolvePeer(frame, method, alloc, stores, background);
   ImageRGB image(frame.width(), frame.height());
   const bool hybrid = method.compositing == Compositing::Hybrid;
   frame.forEachTile([&](int tile) {
@@ -102,8 +115,9 @@ struct OracleChoice {
 
 Result<OracleChoice> optimalK(const RasterFrame& frame, const MethodDesc& method,
                               const RenderOptions& options, uint64_t slots) {
-  auto oracle = frameErrorCurves(frame, options.background, method.compositing);
-  if (!oracle) return oracle.error();
+  auto oracle =
+      frameErrorCurves(frame, options.background, method.compositing, options.memoryLimitBytes);
+  if (!oracle) return makeError(method.name + ": the oracle's pre-pass: " + oracle.error().message);
   OracleChoice out;
   out.bytesAllocated = oracle->bytesAllocated;
   if (slots < oracle->coveredPixels) {
@@ -160,14 +174,50 @@ std::vector<uint32_t> countFragments(const RasterFrame& frame) {
   return counts;
 }
 
-Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
-                            const RenderOptions& options) {
+namespace {
+
+/// "abuffer at 1024 x 768 pixels", for memory errors.
+std::string renderWhat(const RasterFrame& frame, const MethodDesc& method) {
+  return method.name + " at " + std::to_string(frame.width()) + " x " +
+         std::to_string(frame.height()) + " pixels";
+}
+
+/// What render() allocates per pixel before any node (README "Memory accounting"): counters, k,
+/// offsets, store kind, the output image, n(p), and the method's locks, occupancy, tail and
+/// accumulators; importance allocation adds its reserved k, scratch and map. A lower bound,
+/// checked before the first pass.
+uint64_t perPixelBytes(const MethodDesc& method, const MemoryModel& memory) {
+  uint64_t bytes = 4 + 4 + 8 + 1 + sizeof(glm::vec3);
+  if (method.allocation != AllocationPolicy::FixedK) bytes += 4;
+  bytes += memory.lock + memory.occupancy + memory.tail + memory.accum;
+  if (method.allocation == AllocationPolicy::Importance) bytes += 4 + 8 + 4;
+  return bytes;
+}
+
+}  // namespace
+
+static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodDesc& method,
+                                         const RenderOptions& options, uint64_t memoryLimit) {
   if (method.occupancyWords < 0 || method.occupancyWords > 64)
     return makeError(method.name + ": occupancy d must be in [1, 64]");
   if (method.allocation == AllocationPolicy::Unbounded && method.occupancyWords > 0)
     return makeError(method.name + ": occupancy culling needs a bounded k");
   if (method.store == StoreChoice::Append && method.allocation != AllocationPolicy::Unbounded)
     return makeError(method.name + ": the append store needs exact (unbounded) allocation");
+  // the peer methods' rules go with their own allocation and store (README "Peer methods")
+  const bool accumulates = method.compositing == Compositing::WeightedBlended ||
+                           method.compositing == Compositing::MomentBased;
+  if (accumulates != (method.allocation == AllocationPolicy::NoNodes) ||
+      accumulates != (method.store == StoreChoice::None))
+    return makeError(method.name + ": " + toString(method.compositing) +
+                     " compositing goes with no-nodes allocation and no store, and only it");
+  if ((method.compositing == Compositing::MultiLayerAlpha) !=
+          (method.store == StoreChoice::MultiLayer) ||
+      (method.store == StoreChoice::MultiLayer && method.allocation != AllocationPolicy::FixedK))
+    return makeError(method.name + ": the multi-layer store goes with fixed k and " +
+                     "multi-layer-alpha compositing, and only them");
+  if (detail::isPeerRule(method.compositing) && method.occupancyWords > 0)
+    return makeError(method.name + ": occupancy culling applies to k-buffers only");
   RenderOutput out;
   RenderStats& stats = out.stats;
   stats.method = method.name;
@@ -177,6 +227,9 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   const size_t pixels = frame.pixelCount();
   const MemoryModel memory =
       MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
+  // memory pre-flight: the per-pixel buffers here, the node pool after allocate
+  MFR_TRY(checkMemory(saturatingMul(pixels, perPixelBytes(method, memory)), memoryLimit,
+                      renderWhat(frame, method) + ": its per-pixel buffers"));
 
   // count pass
   // (the optimal oracle counts in its own A-buffer pre-pass)
@@ -188,6 +241,7 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
     out.depthComplexity =
         timer.run("count", [&] { return countWithDepthRange(frame, imageFeatures); });
   else if (method.allocation != AllocationPolicy::FixedK &&
+           method.allocation != AllocationPolicy::NoNodes &&
            !(method.allocation == AllocationPolicy::Optimal && options.budgetBytes))
     out.depthComplexity = timer.run("count", [&] { return countFragments(frame); });
   ledger.add("depth_complexity", out.depthComplexity);
@@ -260,12 +314,30 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   ledger.add("offsets", alloc.offsets);
   ledger.add("store_kind", alloc.kind);
   ledger.addBytes("allocation_scratch", alloc.scratchBytes);
+  {  // the node pool (a copy with keepStores), stores and image on top of what is allocated
+    const uint64_t nodeBytes = saturatingMul(
+        alloc.slots, method.store == StoreChoice::MultiLayer ? memory.node : sizeof(FragmentNode));
+    const uint64_t perPixel =
+        4 + sizeof(glm::vec3) + memory.lock + memory.occupancy + memory.tail + memory.accum;
+    uint64_t held = ledger.total();  // less what is freed by now (the oracle's, the scratch)
+    for (const char* freed : {"oracle_prepass", "allocation_scratch"})
+      if (auto it = ledger.byCategory().find(freed); it != ledger.byCategory().end())
+        held -= it->second;
+    const uint64_t needed =
+        saturatingAdd(saturatingAdd(held, saturatingMul(nodeBytes, options.keepStores ? 2 : 1)),
+                      saturatingMul(pixels, perPixel));
+    MFR_TRY(checkMemory(needed, memoryLimit,
+                        renderWhat(frame, method) + ": its " + std::to_string(alloc.slots) +
+                            " fragment slots and buffers"));
+  }
 
   // buffers
   detail::Stores stores;
   timer.run("clear", [&] {
-    stores.nodes.allocate(alloc.slots);
-    if (options.keepStores)  // unused slots are handed out: make them defined
+    const bool mlab = method.store == StoreChoice::MultiLayer;  // its nodes: stores.mlab
+    stores.nodes.allocate(mlab ? 0 : alloc.slots);
+    detail::allocatePeerStores(method, alloc, pixels, stores);
+    if (options.keepStores && !mlab)  // unused slots are handed out: make them defined
       std::fill(stores.nodes.data(), stores.nodes.data() + alloc.slots, FragmentNode{0});
     stores.counts.assign(pixels, 0);
     if (options.capture == CaptureMode::FragmentParallel) stores.locks.assign(pixels, 0);
@@ -275,6 +347,9 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
   ledger.add("counters", stores.counts);
   ledger.add("locks", stores.locks);
   ledger.add("tail", stores.tails);
+  ledger.add("nodes", stores.mlab);
+  ledger.add("accumulators", stores.wboit);
+  ledger.add("accumulators", stores.mboit);
 
   // occupancy culling passes
   OccupancyMap occupancy;
@@ -283,6 +358,10 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
     buildOccupancy(frame, alloc, occupancy, timer);
     ledger.addBytes("occupancy", occupancy.allocatedBytes());
   }
+
+  // moment-based OIT: the moments pass before the capture (its second geometry pass)
+  if (method.compositing == Compositing::MomentBased)
+    timer.run("moments", [&] { detail::accumulateMoments(frame, options.capture, stores); });
 
   // capture
   const detail::CaptureCounters counters = timer.run("capture", [&] {
@@ -340,6 +419,23 @@ Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
     out.counts = std::move(stores.counts);
   }
   return out;
+}
+
+Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
+                            const RenderOptions& options) {
+  const uint64_t limit = options.memoryLimitBytes.value_or(defaultMemoryLimit());
+  struct RestorePass {  // a nested render (the oracle's pre-pass) leaves the outer pass named
+    const char* outer = currentPass();
+    ~RestorePass() { currentPass() = outer; }
+  } restore;
+  currentPass() = "set-up";
+  try {
+    return renderPasses(frame, method, options, limit);
+  } catch (const std::bad_alloc&) {  // the pre-flight let it through, the allocation failed anyway
+    return makeError(renderWhat(frame, method) + ": out of memory allocating the buffers of the " +
+                     currentPass() + " pass (memory limit " + formatBytes(limit) +
+                     "; --memory-limit)");
+  }
 }
 
 }  // namespace mfr

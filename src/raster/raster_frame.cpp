@@ -93,12 +93,18 @@ struct SetupContext {
 bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVertex& v1,
                    const ClipVertex& v2, uint32_t prim, uint32_t material, TriangleSetup& t) {
   const ClipVertex* v[3] = {&v0, &v1, &v2};
+  // Clipping leaves |x/w|, |y/w| <= kGuardBand up to float rounding; under extreme projections
+  // (a field of view of 1e-20 degrees, coordinates near the float range) that rounding is large
+  // or NaN. Clamping to the guard band keeps the fixed-point set-up below in range.
+  constexpr double kMaxNdc = kGuardBand * 1.001;
   double sx[3], sy[3];
   for (int i = 0; i < 3; ++i) {
     const glm::vec4& c = v[i]->clip;
     const double invW = 1.0 / static_cast<double>(c.w);
-    sx[i] = (static_cast<double>(c.x) * invW * 0.5 + 0.5) * ctx.width;
-    sy[i] = (0.5 - static_cast<double>(c.y) * invW * 0.5) * ctx.height;
+    const double ndcX = static_cast<double>(c.x) * invW, ndcY = static_cast<double>(c.y) * invW;
+    if (!(std::isfinite(ndcX) && std::isfinite(ndcY) && std::isfinite(invW))) return false;
+    sx[i] = (std::clamp(ndcX, -kMaxNdc, kMaxNdc) * 0.5 + 0.5) * ctx.width;
+    sy[i] = (0.5 - std::clamp(ndcY, -kMaxNdc, kMaxNdc) * 0.5) * ctx.height;
     t.x[i] = static_cast<int32_t>(std::llround(sx[i] * 256.0));
     t.y[i] = static_cast<int32_t>(std::llround(sy[i] * 256.0));
     t.z[i] = static_cast<float>(static_cast<double>(c.z) * invW * 0.5 + 0.5);

@@ -6,12 +6,18 @@
 // Images are not decoded while tinygltf parses the file: a custom image callback keeps the encoded
 // bytes, and only images used as a base colour texture are decoded (in parallel) afterwards.
 // tinygltf trusts bufferView ranges, so every accessor and image range is bounds-checked here.
+//
+// Files: the glTF is read here and handed to tinygltf from memory; tinygltf reads external buffers
+// and images only through the file-system callbacks below, which confine them to the glTF's folder
+// (mfr/core/file_access.hpp). Before tinygltf runs, every external uri is resolved and checked
+// (regular file inside the folder, a buffer's byteLength equal to its file's size), so a refused
+// reference is an error naming it and nothing it names is ever opened. Image headers are checked
+// against the image size cap before decoding.
 #include <tiny_gltf.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <new>
@@ -24,8 +30,14 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
+#include <nlohmann/json.hpp>
 
+#include "mfr/core/file_access.hpp"
+#include "mfr/core/memory_limit.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
+
+#include <stb_image.h>  // Debian libstb (linked by the library): image headers
 
 namespace mfr {
 namespace {
@@ -71,10 +83,156 @@ std::string firstLine(const std::string& text) {
   return text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
 }
 
-bool startsWithGlbMagic(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  char magic[4] = {};
-  return in.read(magic, 4) && std::memcmp(magic, "glTF", 4) == 0;
+bool startsWithGlbMagic(const std::vector<unsigned char>& bytes) {
+  return bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// File access: external buffers and images, confined to the glTF's folder.
+
+/// tinygltf's base folder of a file path (GetBaseDir): everything before the last separator.
+std::string baseDirOf(const std::string& path) {
+  const size_t slash = path.find_last_of("/\\");
+  return slash == std::string::npos ? std::string() : path.substr(0, slash);
+}
+
+/// tinygltf's uri decoding (dlib::urldecode): '+' is a space, %XX a byte.
+std::string decodeUri(const std::string& uri) {
+  const auto hex = [](unsigned char c) -> unsigned char {
+    if (c >= '0' && c <= '9') return static_cast<unsigned char>(c - '0');
+    if (c >= 'a' && c <= 'f') return static_cast<unsigned char>(c - 'a' + 10);
+    if (c >= 'A' && c <= 'F') return static_cast<unsigned char>(c - 'A' + 10);
+    return 0;
+  };
+  std::string out;
+  for (size_t i = 0; i < uri.size(); ++i) {
+    if (uri[i] == '+') {
+      out += ' ';
+    } else if (uri[i] == '%' && uri.size() > i + 2) {
+      out += static_cast<char>((hex(static_cast<unsigned char>(uri[i + 1])) << 4) |
+                               hex(static_cast<unsigned char>(uri[i + 2])));
+      i += 2;
+    } else {
+      out += uri[i];
+    }
+  }
+  return out;
+}
+
+/// What the file-system callbacks know (their user data).
+struct GltfFiles {
+  std::string path;  // the glTF file
+  bool allowOutside = false;
+  uint64_t maxFileBytes = 0;                      // cap for any external file
+  std::map<std::string, uint64_t> expectedBytes;  // canonical path -> a buffer's byteLength
+  std::string refusal;  // the first reference refused inside tinygltf (fails the load)
+
+  /// The reference inside the glTF that tinygltf's candidate path `candidate` stands for; empty
+  /// for tinygltf's second guess, the working folder (never allowed).
+  std::string referenceOf(const std::string& candidate) const {
+    const std::string base = baseDirOf(path);
+    if (base.empty()) return candidate;
+    const std::string prefix = base.back() == '/' ? base : base + "/";
+    return candidate.rfind(prefix, 0) == 0 ? candidate.substr(prefix.size()) : std::string();
+  }
+  Result<std::filesystem::path> resolve(const std::string& candidate) {
+    const std::string reference = referenceOf(candidate);
+    if (reference.empty()) return makeError("");
+    auto resolved = resolveReference(path, reference, "uri " + quoteInput(reference), allowOutside);
+    if (!resolved && refusal.empty()) refusal = resolved.error().message;
+    return resolved;
+  }
+};
+
+bool gltfFileExists(const std::string& candidate, void* user) {
+  return static_cast<GltfFiles*>(user)->resolve(candidate).ok();
+}
+
+/// No expansion of `~` or variables: a uri is a relative path, nothing else.
+std::string gltfExpandFilePath(const std::string& path, void*) {
+  return path;
+}
+
+bool gltfReadWholeFile(std::vector<unsigned char>* out, std::string* err,
+                       const std::string& candidate, void* user) {
+  auto* files = static_cast<GltfFiles*>(user);
+  auto resolved = files->resolve(candidate);
+  if (!resolved) return false;
+  uint64_t maxBytes = files->maxFileBytes;
+  if (auto it = files->expectedBytes.find(resolved->string()); it != files->expectedBytes.end())
+    maxBytes = it->second;
+  auto bytes =
+      readRegularFileBytes(*resolved, "uri " + quoteInput(files->referenceOf(candidate)), maxBytes);
+  if (!bytes) {
+    if (files->refusal.empty()) files->refusal = bytes.error().message;
+    if (err) *err += bytes.error().message + "\n";
+    return false;
+  }
+  *out = std::move(*bytes);
+  return true;
+}
+
+bool gltfWriteWholeFile(std::string* err, const std::string&, const std::vector<unsigned char>&,
+                        void*) {
+  if (err) *err += "writing is not supported\n";
+  return false;
+}
+
+/// The JSON of a .gltf, or of a GLB's first (JSON) chunk; discarded when it does not parse
+/// (tinygltf then reports the problem).
+nlohmann::json gltfJson(const std::vector<unsigned char>& bytes) {
+  const unsigned char* begin = bytes.data();
+  size_t size = bytes.size();
+  if (startsWithGlbMagic(bytes)) {
+    uint32_t chunkLength = 0, chunkType = 0;
+    if (size < 20) return nlohmann::json::value_t::discarded;
+    std::memcpy(&chunkLength, begin + 12, 4);
+    std::memcpy(&chunkType, begin + 16, 4);
+    if (chunkType != 0x4E4F534Au || chunkLength > size - 20)
+      return nlohmann::json::value_t::discarded;
+    begin += 20;
+    size = chunkLength;
+  }
+  return nlohmann::json::parse(begin, begin + size, nullptr, false);
+}
+
+/// Every external uri of the glTF resolved and checked before tinygltf opens anything: regular
+/// files inside the folder (unless allowed outside), a buffer's file exactly its byteLength.
+/// Records the buffers' sizes for the read callback.
+Result<void> checkReferences(const nlohmann::json& doc, GltfFiles& files) {
+  if (!doc.is_object()) return {};
+  const auto external = [](const nlohmann::json& item) {
+    return item.is_object() && item.contains("uri") && item["uri"].is_string() &&
+           !tinygltf::IsDataURI(item["uri"].get<std::string>());
+  };
+  if (auto it = doc.find("buffers"); it != doc.end() && it->is_array())
+    for (size_t i = 0; i < it->size(); ++i) {
+      const nlohmann::json& buffer = (*it)[i];
+      if (!external(buffer)) continue;
+      const std::string uri = buffer["uri"].get<std::string>();
+      const std::string what = "buffer " + std::to_string(i) + " uri " + quoteInput(uri);
+      auto resolved = resolveReference(files.path, decodeUri(uri), what, files.allowOutside);
+      if (!resolved) return resolved.error();
+      const auto length = buffer.find("byteLength");
+      if (length == buffer.end() || !length->is_number_unsigned()) continue;  // tinygltf reports
+      const uint64_t declared = length->get<uint64_t>();
+      auto size = checkRegularFile(*resolved, what);
+      if (!size) return size.error();
+      if (*size != declared)
+        return makeError(what + ": byteLength " + std::to_string(declared) +
+                         " differs from the file's size, " + std::to_string(*size) + " bytes");
+      files.expectedBytes.emplace(resolved->string(), declared);
+    }
+  if (auto it = doc.find("images"); it != doc.end() && it->is_array())
+    for (size_t i = 0; i < it->size(); ++i) {
+      const nlohmann::json& image = (*it)[i];
+      if (!external(image)) continue;
+      const std::string uri = image["uri"].get<std::string>();
+      const std::string what = "image " + std::to_string(i) + " uri " + quoteInput(uri);
+      auto resolved = resolveReference(files.path, decodeUri(uri), what, files.allowOutside);
+      if (!resolved) return resolved.error();
+    }
+  return {};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -159,7 +317,11 @@ class GltfSceneBuilder {
  public:
   GltfSceneBuilder(const tinygltf::Model& model, const EncodedImages& images,
                    const std::string& path, const LoadOptions& options)
-      : model_(model), images_(images), path_(path), options_(options) {}
+      : model_(model),
+        images_(images),
+        path_(path),
+        options_(options),
+        memoryLimit_(options.memoryLimitBytes.value_or(defaultMemoryLimit())) {}
 
   Result<Scene> build();
 
@@ -184,6 +346,7 @@ class GltfSceneBuilder {
   const EncodedImages& images_;
   const std::string& path_;
   const LoadOptions& options_;
+  const uint64_t memoryLimit_;
 
   Scene scene_;
   bool anyUvs_ = false;
@@ -336,8 +499,8 @@ Result<void> GltfSceneBuilder::addMesh(int meshIndex, const glm::dmat4& world) {
     return fail("mesh " + std::to_string(meshIndex) + " does not exist");
   const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(meshIndex)];
   for (size_t p = 0; p < mesh.primitives.size(); ++p) {
-    const std::string what = "mesh " + std::to_string(meshIndex) + " ('" + mesh.name +
-                             "') primitive " + std::to_string(p);
+    const std::string what = "mesh " + std::to_string(meshIndex) + " (" +
+                             quoteInput(mesh.name, 60) + ") primitive " + std::to_string(p);
     MFR_TRY(addPrimitive(mesh.primitives[p], world, what));
   }
   return {};
@@ -560,12 +723,36 @@ Result<Texture> toRgba8(const tinygltf::Image& image) {
 Result<void> GltfSceneBuilder::decodeTextures() {
   std::vector<int> images(imageMap_.size());
   for (const auto& [image, slot] : imageMap_) images[static_cast<size_t>(slot)] = image;
+  const auto nameOf = [&](size_t imageIndex) {
+    const tinygltf::Image& source = model_.images[imageIndex];
+    return "image " + std::to_string(imageIndex) +
+           (source.uri.empty() ? "" : " (" + quoteInput(source.uri, 80) + ")");
+  };
+  // Headers first: every image's size against the cap, all of them against the memory limit
+  // (decoded 8 or 16 bits per channel, then the RGBA8 copy), before anything is decoded.
+  uint64_t decodeBytes = 0;
+  for (const int image : images) {
+    const auto imageIndex = static_cast<size_t>(image);
+    if (imageIndex >= images_.bytes.size() || images_.bytes[imageIndex].empty()) continue;
+    const std::vector<unsigned char>& bytes = images_.bytes[imageIndex];
+    int width = 0, height = 0, channels = 0;
+    if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max()) ||
+        !stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &width, &height,
+                               &channels))
+      continue;  // the decoder reports it
+    if (auto fits = checkImageDimensions(width, height, nameOf(imageIndex)); !fits)
+      return fail(fits.error().message);
+    decodeBytes = saturatingAdd(
+        decodeBytes, saturatingMul(static_cast<uint64_t>(width) * static_cast<uint64_t>(height),
+                                   4 + 2 * static_cast<uint64_t>(std::max(channels, 1))));
+  }
+  if (auto fits = checkMemory(decodeBytes, memoryLimit_, "its decoded textures"); !fits)
+    return fail(fits.error().message);
+
   std::vector<Result<Texture>> decoded(images.size(), makeError(""));
   tbb::parallel_for(size_t{0}, images.size(), [&](size_t i) {
     const auto imageIndex = static_cast<size_t>(images[i]);
-    const tinygltf::Image& source = model_.images[imageIndex];
-    const std::string name = "image " + std::to_string(imageIndex) +
-                             (source.uri.empty() ? "" : " ('" + source.uri + "')");
+    const std::string name = nameOf(imageIndex);
     if (imageIndex >= images_.bytes.size() || images_.bytes[imageIndex].empty()) {
       decoded[i] = fail(name + " could not be read");
       return;
@@ -636,14 +823,34 @@ Result<Scene> GltfSceneBuilder::build() {
 
 Result<Scene> loadGltf(const std::string& path, const LoadOptions& options) {
   try {
+    GltfFiles files;
+    files.path = path;
+    files.allowOutside = options.allowOutsideReferences;
+    const uint64_t limit = options.memoryLimitBytes.value_or(defaultMemoryLimit());
+    // tinygltf takes the file's length and image sizes as 32-bit integers
+    files.maxFileBytes = std::min<uint64_t>(limit, std::numeric_limits<int>::max());
+    auto bytes = readRegularFileBytes(path, path, std::min<uint64_t>(limit, UINT32_MAX));
+    if (!bytes) return bytes.error();
+    if (bytes->empty()) return makeError(path + ": empty file");
+    if (auto checked = checkReferences(gltfJson(*bytes), files); !checked)
+      return makeError(path + ": " + checked.error().message);
+
     tinygltf::Model model;
     EncodedImages images;
     images.model = &model;
     tinygltf::TinyGLTF loader;
     loader.SetImageLoader(&keepEncodedImage, &images);
+    loader.SetFsCallbacks(tinygltf::FsCallbacks{&gltfFileExists, &gltfExpandFilePath,
+                                                &gltfReadWholeFile, &gltfWriteWholeFile, &files});
     std::string err, warn;
-    const bool ok = startsWithGlbMagic(path) ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
-                                             : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    const std::string baseDir = baseDirOf(path);
+    const auto size = static_cast<unsigned int>(bytes->size());
+    const bool ok =
+        startsWithGlbMagic(*bytes)
+            ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes->data(), size, baseDir)
+            : loader.LoadASCIIFromString(
+                  &model, &err, &warn, reinterpret_cast<const char*>(bytes->data()), size, baseDir);
+    if (!files.refusal.empty()) return makeError(path + ": " + files.refusal);
     if (!ok) {
       const std::string reason = firstLine(err);
       return makeError(path + ": " + (reason.empty() ? "invalid glTF file" : reason));

@@ -11,12 +11,13 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
+#include "mfr/core/file_access.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr {
@@ -28,7 +29,7 @@ using nlohmann::json;
 struct Checker {
   const std::string& path;
   Error fail(const std::string& key, const std::string& problem) const {
-    return makeError(path + ": '" + key + "' " + problem);
+    return makeError(path + ": '" + oneLine(key, 80) + "' " + problem);  // keys may hold any text
   }
 
   Result<float> number(const json& value, const std::string& key, float min, float max) const {
@@ -100,11 +101,11 @@ Result<Camera> parseCamera(const Checker& check, const json& value, const std::s
 }  // namespace
 
 Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options) {
-  std::ifstream in(path);
-  if (!in) return makeError(path + ": cannot be read");
+  auto text = readRegularFile(path, path);
+  if (!text) return text.error();
   json root;
   try {
-    root = json::parse(in);
+    root = json::parse(*text);
   } catch (const json::exception& e) {
     std::string what = e.what();  // "[json.exception.parse_error.101] parse error at ..."
     if (what.rfind("[json.exception.", 0) == 0 && what.find("] ") != std::string::npos)
@@ -152,13 +153,17 @@ Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options)
   }
   if (mesh.empty()) return check.fail("mesh", "is required");
 
-  // Files resolve against this file's directory; JSON scene files do not nest.
+  // Files resolve against this file's directory and must lie inside it (unless allowed outside,
+  // file_access.hpp); JSON scene files do not nest.
   std::string source = mesh;
   if (mesh.rfind("procedural:", 0) != 0) {
     const std::filesystem::path meshPath(mesh);
     std::string extension = meshPath.extension().string();
     for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (extension == ".json") return check.fail("mesh", "must not be another JSON scene file");
+    auto resolved =
+        resolveReference(path, mesh, "'mesh' " + oneLine(mesh), options.allowOutsideReferences);
+    if (!resolved) return makeError(path + ": " + resolved.error().message);
     source =
         meshPath.is_absolute()
             ? mesh

@@ -3,12 +3,13 @@
 // has vertex normals, passes validateScene and is named after the source string.
 #include "mfr/scene/load.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
-#include <fstream>
-#include <system_error>
 
+#include "mfr/core/file_access.hpp"
 #include "mfr/scene/procedural.hpp"
 
 namespace mfr {
@@ -25,11 +26,9 @@ std::string lowercaseExtension(const std::string& path) {
 }
 
 Result<Scene> loadFile(const std::string& path, const LoadOptions& options) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(status)) return makeError(path + ": no such file");
-  if (std::filesystem::is_directory(status)) return makeError(path + ": is a directory");
-  if (!std::ifstream(path, std::ios::binary)) return makeError(path + ": cannot be read");
+  // stat, not open: a FIFO or device named as the scene is refused instead of blocking the open
+  if (auto regular = checkRegularFile(path, path); !regular) return regular.error();
+  if (::access(path.c_str(), R_OK) != 0) return makeError(path + ": cannot be read");
 
   const std::string extension = lowercaseExtension(path);
   if (extension == ".gltf" || extension == ".glb") return loadGltf(path, options);
@@ -46,7 +45,8 @@ Result<Scene> loadFile(const std::string& path, const LoadOptions& options) {
 Result<Scene> loadScene(const std::string& source, const LoadOptions& options) {
   const std::string prefix = kProceduralPrefix;
   Result<Scene> loaded = source.rfind(prefix, 0) == 0
-                             ? makeProceduralScene(source.substr(prefix.size()), options.seed)
+                             ? makeProceduralScene(source.substr(prefix.size()), options.seed,
+                                                   options.maxProceduralTriangles)
                              : loadFile(source, options);
   if (!loaded) {  // make sure the message names the source (procedural errors may not)
     const std::string& message = loaded.error().message;

@@ -6,6 +6,10 @@
 //  - Kd is the linear base colour; map_Kd is loaded with stb_image to RGBA8 (sRGB as stored),
 //    resolved relative to the directory of the MTL file that declared it. A missing or undecodable
 //    texture is an error naming it.
+//  - mtllib and map_Kd files must be regular files inside the folder of the file naming them
+//    (LoadOptions::allowOutsideReferences lifts the folder rule); a refused one is an error naming
+//    it, checked before it is opened. A missing MTL file only falls back to the default material.
+//    Texture headers are checked against the image size cap before decoding.
 //  - Alpha is tinyobjloader's `dissolve`: `d` when present, otherwise 1 - `Tr` (tinyobjloader
 //    already does this inversion, and ignores `Tr` when `d` is present). Alpha < 1 -> Blend, else
 //    Opaque. Faces without a (known) material use a default opaque white material.
@@ -21,12 +25,17 @@
 #include <filesystem>
 #include <fstream>
 #include <initializer_list>
+#include <limits>
 #include <map>
 #include <new>
+#include <sstream>
 #include <string>
 #include <unordered_map>
 #include <vector>
 
+#include "mfr/core/file_access.hpp"
+#include "mfr/core/memory_limit.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
 
 #include <stb_image.h>  // Debian libstb (linked by the library)
@@ -36,30 +45,39 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// Reads the MTL files an OBJ names (relative to the OBJ's directory) and remembers which
-/// directory each material came from, so texture paths resolve against their own MTL file.
+/// Reads the MTL files an OBJ names (inside the OBJ's folder) and remembers which file each
+/// material came from, so texture paths resolve against their own MTL file.
 class MtlReader : public tinyobj::MaterialReader {
  public:
-  explicit MtlReader(fs::path objDirectory) : objDirectory_(std::move(objDirectory)) {}
+  MtlReader(fs::path objFile, bool allowOutside)
+      : objFile_(std::move(objFile)), allowOutside_(allowOutside) {}
 
   bool operator()(const std::string& name, std::vector<tinyobj::material_t>* materials,
                   std::map<std::string, int>* materialMap, std::string* warn,
                   std::string* err) override {
-    const fs::path path = objDirectory_ / fs::path(name).lexically_normal();
-    std::ifstream stream(path);
-    if (!stream) {
-      if (warn) *warn += "material file '" + path.string() + "' not found\n";
+    const std::string what = "mtllib " + quoteInput(name);
+    auto path = resolveReference(objFile_, name, what, allowOutside_);
+    if (!path && !isNoSuchFileError(path.error())) {
+      if (refusal.empty()) refusal = path.error().message;  // refused, not missing
       return false;
     }
+    auto text = path ? readRegularFile(*path, what) : Result<std::string>(path.error());
+    if (!text) {
+      if (warn) *warn += "material file " + what + " not found\n";
+      return false;
+    }
+    std::istringstream stream(std::move(*text));
     tinyobj::LoadMtl(materialMap, materials, &stream, warn, err);
-    directories.resize(materials->size(), path.parent_path());
+    files.resize(materials->size(), *path);
     return true;
   }
 
-  std::vector<fs::path> directories;  // by material index
+  std::vector<fs::path> files;  // the MTL file of each material, by material index
+  std::string refusal;          // the first refused mtllib (fails the load)
 
  private:
-  fs::path objDirectory_;
+  fs::path objFile_;
+  bool allowOutside_;
 };
 
 std::string firstLine(const std::string& text) {
@@ -107,13 +125,26 @@ void restoreNonFiniteCoordinates(const std::string& path, std::vector<float>& ve
   }
 }
 
-Result<Texture> loadTexture(const fs::path& file) {
+/// A texture file (already resolved): header checked against the size cap and the memory limit
+/// before decoding. `decodedBytes` adds up the textures' bytes so far.
+Result<Texture> loadTexture(const fs::path& file, const std::string& what, uint64_t memoryLimit,
+                            uint64_t& decodedBytes) {
+  auto bytes = readRegularFileBytes(
+      file, what, std::min<uint64_t>(memoryLimit, std::numeric_limits<int>::max()));
+  if (!bytes) return bytes.error();
+  const auto size = static_cast<int>(bytes->size());
   int width = 0, height = 0, channels = 0;
-  stbi_uc* pixels = stbi_load(file.string().c_str(), &width, &height, &channels, 4);
+  if (stbi_info_from_memory(bytes->data(), size, &width, &height, &channels)) {
+    MFR_TRY(checkImageDimensions(width, height, what));
+    decodedBytes = saturatingAdd(decodedBytes,
+                                 static_cast<uint64_t>(width) * static_cast<uint64_t>(height) * 4);
+    MFR_TRY(checkMemory(decodedBytes, memoryLimit, "its decoded textures"));
+  }
+  stbi_uc* pixels = stbi_load_from_memory(bytes->data(), size, &width, &height, &channels, 4);
   if (!pixels) {
     const char* reason = stbi_failure_reason();
-    return makeError("cannot load texture '" + file.string() + "'" +
-                     (reason ? std::string(": ") + reason : std::string()));
+    return makeError("cannot load texture " + what + " (" + quoteInput(file.string(), 200) + ")" +
+                     (reason ? ": " + oneLine(reason) : std::string()));
   }
   Texture texture;
   texture.width = width;
@@ -137,17 +168,19 @@ struct CornerHash {
   }
 };
 
-Result<Scene> buildObjScene(const std::string& path) {
-  const fs::path objDirectory = fs::path(path).parent_path();
+Result<Scene> buildObjScene(const std::string& path, const LoadOptions& options) {
+  MFR_TRY(checkRegularFile(path, path));  // before the open: a FIFO would block it
   std::ifstream stream(path);
   if (!stream) return makeError(path + ": cannot be read");
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> objMaterials;
   std::string warn, err;
-  MtlReader mtlReader(objDirectory);
-  if (!tinyobj::LoadObj(&attrib, &shapes, &objMaterials, &warn, &err, &stream, &mtlReader,
-                        /*triangulate=*/true)) {
+  MtlReader mtlReader(path, options.allowOutsideReferences);
+  const bool loaded = tinyobj::LoadObj(&attrib, &shapes, &objMaterials, &warn, &err, &stream,
+                                       &mtlReader, /*triangulate=*/true);
+  if (!mtlReader.refusal.empty()) return makeError(path + ": " + mtlReader.refusal);
+  if (!loaded) {
     const std::string reason = firstLine(err);
     return makeError(path + ": " + (reason.empty() ? "invalid OBJ file" : reason));
   }
@@ -162,6 +195,8 @@ Result<Scene> buildObjScene(const std::string& path) {
 
   // Materials (plus a default one, appended when some face needs it).
   std::map<std::string, int> textureByPath;
+  const uint64_t memoryLimit = options.memoryLimitBytes.value_or(defaultMemoryLimit());
+  uint64_t textureBytes = 0;
   for (size_t m = 0; m < objMaterials.size(); ++m) {
     const tinyobj::material_t& src = objMaterials[m];
     Material material;
@@ -172,14 +207,15 @@ Result<Scene> buildObjScene(const std::string& path) {
     if (!src.diffuse_texname.empty()) {
       std::string name = src.diffuse_texname;
       std::replace(name.begin(), name.end(), '\\', '/');  // paths written on Windows
-      const fs::path directory =
-          m < mtlReader.directories.size() ? mtlReader.directories[m] : objDirectory;
-      const fs::path file = (directory / name).lexically_normal();
-      auto it = textureByPath.find(file.string());
+      const fs::path mtlFile = m < mtlReader.files.size() ? mtlReader.files[m] : fs::path(path);
+      const std::string what = "map_Kd " + quoteInput(name);
+      auto file = resolveReference(mtlFile, name, what, options.allowOutsideReferences);
+      if (!file) return makeError(path + ": " + file.error().message);
+      auto it = textureByPath.find(file->string());
       if (it == textureByPath.end()) {
-        auto texture = loadTexture(file);
+        auto texture = loadTexture(*file, what, memoryLimit, textureBytes);
         if (!texture) return makeError(path + ": " + texture.error().message);
-        it = textureByPath.emplace(file.string(), static_cast<int>(scene.textures.size())).first;
+        it = textureByPath.emplace(file->string(), static_cast<int>(scene.textures.size())).first;
         scene.textures.push_back(std::move(*texture));
       }
       material.baseColorTexture = it->second;
@@ -270,9 +306,9 @@ Result<Scene> buildObjScene(const std::string& path) {
 
 }  // namespace
 
-Result<Scene> loadObj(const std::string& path, const LoadOptions& /*options*/) {
+Result<Scene> loadObj(const std::string& path, const LoadOptions& options) {
   try {
-    return buildObjScene(path);
+    return buildObjScene(path, options);
   } catch (const std::bad_alloc&) {
     return makeError(path + ": out of memory");
   } catch (const std::exception& e) {

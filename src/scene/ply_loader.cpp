@@ -29,6 +29,8 @@
 
 #include <glm/gtc/type_ptr.hpp>
 
+#include "mfr/core/file_access.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr {
@@ -121,6 +123,11 @@ class PlyChecker {
     bool haveFormat = false;
     while (true) {
       if (!nextLine(line)) return "PLY header has no end_header line";
+      // assimp's tokenizer stops at a NUL and splits words differently on other control
+      // characters: a header it would read otherwise than this check is refused
+      for (char c : line)
+        if ((static_cast<unsigned char>(c) < 0x20 && c != '\t') || c == 0x7f)
+          return "PLY header line " + quoteInput(line, 40) + " has a control character";
       const std::vector<std::string> w = words(line);
       if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
       if (w[0] == "end_header") break;
@@ -157,7 +164,7 @@ class PlyChecker {
         }
         elements_.back().properties.push_back(property);
       } else {
-        return "unknown PLY header line '" + std::string(line.substr(0, 40)) + "'";
+        return "unknown PLY header line " + quoteInput(line, 40);
       }
     }
     if (!haveFormat) return "PLY header has no format line";
@@ -329,6 +336,7 @@ struct PlyBuilder {
 
 Result<Scene> loadPly(const std::string& path, const LoadOptions& /*options*/) {
   try {
+    MFR_TRY(checkRegularFile(path, path));  // before the open: a FIFO would block it
     std::ifstream in(path, std::ios::binary);
     if (!in) return makeError(path + ": cannot be read");
     const std::vector<char> bytes((std::istreambuf_iterator<char>(in)),

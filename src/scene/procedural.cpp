@@ -100,9 +100,9 @@ float ParamReader::real(std::string_view key, double fallback, double lo, double
 }
 
 Result<void> checkTriangleBudget(const ParamReader& params, double triangles) {
-  if (triangles > kMaxTriangles)
+  if (!(triangles <= params.maxTriangles()))
     return params.fail("parameters produce " + formatNumber(std::round(triangles)) +
-                       " triangles (limit " + formatNumber(kMaxTriangles) + ")");
+                       " triangles (limit " + formatNumber(params.maxTriangles()) + ")");
   return {};
 }
 
@@ -331,7 +331,7 @@ std::vector<std::string> proceduralSceneNames() {
   return names;
 }
 
-Result<Scene> makeProceduralScene(const std::string& spec, uint64_t seed) {
+Result<Scene> makeProceduralScene(const std::string& spec, uint64_t seed, double maxTriangles) {
   using namespace procedural;
   std::string_view text = spec;
   if (text.starts_with("procedural:")) text.remove_prefix(std::string_view("procedural:").size());
@@ -377,7 +377,7 @@ Result<Scene> makeProceduralScene(const std::string& spec, uint64_t seed) {
                        " (expected an integer in [0, 18446744073709551615])");
   }
 
-  ParamReader reader(prefix, params);
+  ParamReader reader(prefix, params, maxTriangles);
   Result<Scene> scene = def->build(reader, seed);
   if (!scene) return scene.error();
   scene->name = "procedural:" + std::string(text);

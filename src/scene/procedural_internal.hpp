@@ -21,8 +21,8 @@
 
 namespace mfr::procedural {
 
-/// No parameter combination may produce more triangles than this (about 2.4 GB of mesh data).
-inline constexpr double kMaxTriangles = 50'000'000.0;
+/// No parameter combination may produce more triangles than this by default.
+inline constexpr double kMaxTriangles = kMaxProceduralTriangles;
 
 // ---------------------------------------------------------------------------------------------
 // Random numbers
@@ -97,8 +97,9 @@ class Rng {
 /// after reading all their parameters. Messages are prefixed with e.g. "procedural:layers".
 class ParamReader {
  public:
-  ParamReader(std::string prefix, const ProceduralParams& params)
-      : prefix_(std::move(prefix)), params_(params) {}
+  ParamReader(std::string prefix, const ProceduralParams& params,
+              double maxTriangles = kMaxTriangles)
+      : prefix_(std::move(prefix)), params_(params), maxTriangles_(maxTriangles) {}
 
   /// Integer in [lo, hi].
   int64_t integer(std::string_view key, int64_t fallback, int64_t lo, int64_t hi);
@@ -107,6 +108,8 @@ class ParamReader {
 
   const std::optional<Error>& error() const { return error_; }
   const std::string& prefix() const { return prefix_; }
+  /// The triangle cap checkTriangleBudget applies.
+  double maxTriangles() const { return maxTriangles_; }
   /// An error whose message is "<prefix>: <message>".
   Error fail(const std::string& message) const { return makeError(prefix_ + ": " + message); }
 
@@ -116,10 +119,12 @@ class ParamReader {
 
   std::string prefix_;
   const ProceduralParams& params_;
+  double maxTriangles_;
   std::optional<Error> error_;
 };
 
-/// Error unless `triangles` (computed in floating point so it cannot overflow) is within the cap.
+/// Error unless `triangles` (computed in floating point so it cannot overflow) is within the cap
+/// (params.maxTriangles()).
 Result<void> checkTriangleBudget(const ParamReader& params, double triangles);
 
 /// Shortest round-trip decimal form of a double ("0.5", "1e-06").

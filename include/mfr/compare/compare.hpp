@@ -44,6 +44,8 @@ struct CompareOptions {
   std::shared_ptr<const learn::Model> model;
   /// Called before each step: (what, steps done, steps in all). May be empty.
   std::function<void(const std::string& stage, int done, int total)> progress;
+  /// Memory pre-flight of every render (RenderOptions::memoryLimitBytes); none: the default.
+  std::optional<uint64_t> memoryLimitBytes;
 };
 
 /// Error of one image against the ground truth (both sRGB8 as written).
@@ -95,6 +97,8 @@ struct CompareResult {
 /// Renders the ground truth and every method at every budget. Errors: an empty method or budget
 /// list, an unknown or duplicated method, a duplicated or zero budget, or a failed ground truth.
 /// A method failing at a budget is not an error: its run carries the message.
+/// The result owns its images and statistics: the frame (and its scene) may go once it returns.
+/// compare_output.hpp writes the result as `mfr compare` does (writeComparison).
 Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptions& options);
 
 /// "20MB" for whole MiB, "400KB" for whole KiB, else "12345B" (file-name safe).

@@ -23,6 +23,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -63,6 +64,9 @@ uint64_t fnv1a64(std::string_view bytes);
 /// fnv1a64 as 16 lower-case hex digits.
 std::string hashHex(uint64_t hash);
 
+/// Writes the .mfrds file. Not validated here: the caller keeps scene indices below
+/// scenes.size(), 1..65536 scenes with names of 1..4096 bytes, metadata up to 1 MiB and finite
+/// values, or readDataset will refuse the file. Errors: the file cannot be written.
 Result<void> writeDataset(const std::string& path, const Dataset& data);
 /// Checks magic, version, feature count, lengths, scene indices, finite values; errors name path.
 /// Sets Dataset::fileHash.
@@ -81,6 +85,8 @@ struct ViewSamplingOptions {
   double sampleFraction = 0.2;  // of the covered pixels, per view and budget
   uint64_t seed = 1;
   glm::vec3 background{1.0f};
+  /// Memory pre-flight of the exact A-buffer and error curves (frameErrorCurves); none: default.
+  std::optional<uint64_t> memoryLimitBytes;
 };
 
 /// Features and optimal targets of one rendered view, for every budget step, sampled.

@@ -31,11 +31,20 @@ struct Model {
   std::string metadata;  // JSON text
 };
 
+/// The file's bytes for `model` (deterministic: the same model gives the same bytes). The model's
+/// shapes must agree with its sizes (checkShapes; a programmer error otherwise).
 std::vector<uint8_t> encodeModel(const Model& model);
-/// `name` names the source in error messages (a path, or "built-in model").
+/// Parses a model from memory. `name` names the source in error messages (a path, or "built-in
+/// model"). Errors: bad magic, unsupported version, layer count or sizes out of range, truncated
+/// or trailing bytes, non-finite parameters, metadata too long or not UTF-8.
 Result<Model> decodeModel(const uint8_t* bytes, size_t size, const std::string& name);
 
+/// Writes encodeModel's bytes. Errors (naming `path`): sizes out of range, non-finite
+/// parameters, bad metadata (nothing is written then), or the file cannot be written.
 Result<void> writeModel(const std::string& path, const Model& model);
+/// Reads and decodes a model file; errors as decodeModel's, or the file cannot be opened / read /
+/// is a directory. Whether the deep k-buffer can use the model is checkDkbModel's question
+/// (method/deep_importance.hpp).
 Result<Model> readModel(const std::string& path);
 
 }  // namespace mfr::learn

@@ -16,7 +16,13 @@
 //   occupancy  12+4d   zn, zf, k-th bucket, 32d-bit bitmap             +occupancy
 //   tail       20      sum(alpha rgb) 3 x f32, sum(alpha) f32, u32 t   hybrid
 //   previous   1       |n.v| of the previous frame's nearest, unorm8   vkb (Fresnel term)
+//   accum      20      sum(C w) 3 x f32, sum(a w) f32, revealage f32   wboit
+//              36      b0, b1..b4 5 x f32; sum(T a c) 3 x f32, sum(T a) mboit
 //   image      4096    depth-complexity histogram, 1024 x u32          kplus-dynamic (per image)
+// wboit and mboit keep no nodes and no counter (counter 0, no offset: F(M) is unused); mlab's
+// nodes are 20 B (depth, premultiplied r g b, transmittance: float32), so S_f = 20 for mlab, with
+// the counter (nodes in use) and the k+ family's lock word:
+//   wboit 20 B/pixel, mboit 36 B/pixel, mlab 8 B/pixel + 20 B per node (k = F(M) / |P|).
 // The variable k-buffer's importance map lives in the offset word (importance, then k(p), then the
 // prefix sum, computed in place), so it costs no extra bytes; the count pass's n(p) is the counter.
 // The deep k-buffer's features live in a per-worker 16x16-tile scratch (deep_importance.hpp), and
@@ -53,18 +59,22 @@ inline constexpr uint64_t kHistogramBins = 1024;
 
 struct MemoryModel {
   uint64_t counter = 4, offset = 0, lock = 0, occupancy = 0, tail = 0, previous = 0;  // per pixel
-  uint64_t image = 0;  // bytes per image
+  uint64_t accum = 0;          // per pixel: wboit / mboit accumulators
+  uint64_t image = 0;          // bytes per image
+  uint64_t node = kNodeBytes;  // S_f: bytes of one node (mlab: 20; wboit, mboit: 0, no nodes)
 
   /// `fragmentParallel`: methods without a lock word of their own (fkb, abuffer) need one per
   /// pixel when fragments of a pixel arrive from several threads (it stands in for the GPU's
   /// atomic insertion), and it is charged.
   static MemoryModel of(const MethodDesc& method, bool fragmentParallel = false);
-  uint64_t perPixel() const { return counter + offset + lock + occupancy + tail + previous; }
+  uint64_t perPixel() const {
+    return counter + offset + lock + occupancy + tail + previous + accum;
+  }
   uint64_t overhead(uint64_t pixels) const { return pixels * perPixel() + image; }
-  /// F(M): fragment slots a budget buys (0 when the overhead alone exceeds it).
+  /// F(M): fragment slots a budget buys (0 when the overhead alone exceeds it, or without nodes).
   uint64_t fragmentSlots(uint64_t budget, uint64_t pixels) const {
     const uint64_t fixed = overhead(pixels);
-    return budget > fixed ? (budget - fixed) / kNodeBytes : 0;
+    return budget > fixed && node ? (budget - fixed) / node : 0;
   }
   /// Bytes by category for `slots` allocated nodes.
   std::map<std::string, uint64_t> breakdown(uint64_t pixels, uint64_t slots) const;

@@ -27,6 +27,7 @@ enum class AllocationPolicy : uint8_t {
   DynamicK,    // largest global k whose exact memory fits the budget, from the histogram
   Importance,  // k(p) = floor(P(p) F(M)) from an importance map (variable / deep k-buffer)
   Optimal,     // offline oracle: k(p) minimising the hybrid error from an exact A-buffer pre-pass
+  NoNodes,     // no fragment nodes: per-pixel accumulators only (wboit, mboit)
 };
 
 /// Which store holds a pixel's fragments.
@@ -34,7 +35,9 @@ enum class StoreChoice : uint8_t {
   Append,  // exact-size arrays (only with Unbounded)
   MaxArray,
   MaxHeap,
-  PerPixel,  // K+B-SB rule: max-heap when n(p) > k(p) and k(p) > 16, else max-array
+  PerPixel,    // K+B-SB rule: max-heap when n(p) > k(p) and k(p) > 16, else max-array
+  MultiLayer,  // MLAB's blended nodes: depth-ordered insertion, two farthest merged when full
+  None,        // no nodes (NoNodes allocation)
 };
 
 enum class CullingTest : uint8_t {
@@ -51,7 +54,14 @@ enum class ImportanceSource : uint8_t {
 enum class Compositing : uint8_t {
   KBuffer,  // sort the captured fragments, composite front to back, drop the rest
   Hybrid,   // sorted core + order-independent tail (hybrid transparency)
+  // The peer methods' own rules (README "Peer methods"); --composite does not apply to them.
+  WeightedBlended,  // wboit: weighted sums and revealage (McGuire & Bavoil 2013), wboit.hpp
+  MomentBased,      // mboit: power moments, reconstructed transmittance (Muenstermann 2018)
+  MultiLayerAlpha,  // mlab: front-to-back over of the MultiLayer store's nodes (Salvi 2014)
 };
+
+/// True for kbuffer and hybrid, the rules `--composite` chooses between (the k-buffer family).
+bool kBufferFamilyRule(Compositing c);
 
 struct MethodDesc {
   std::string name;
@@ -76,10 +86,13 @@ struct MethodDesc {
 
 /// Preset names: zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, vkb,
 /// vkb-fill, dkb, dkb-fill, optimal, optimal-greedy, each bounded one optionally followed by
-/// "+occupancy".
+/// "+occupancy"; and the peer methods wboit, mboit, mlab (no +occupancy).
 std::vector<std::string> presetNames();
 
 /// Looks up a preset ("kplus-heap", "fkb+occupancy", ...). Errors list the known names.
+/// The description is a plain value: adjust it (k, compositing, occupancyWords, importance, model)
+/// before render(); which adjustments a preset accepts is method_options.hpp's table. `model` is
+/// shared (std::shared_ptr), not copied, so one network can serve many descriptions.
 Result<MethodDesc> methodPreset(const std::string& name);
 
 const char* toString(AllocationPolicy a);

@@ -18,6 +18,7 @@ enum class MethodOption : uint8_t {
   Model,             // --model: the deep k-buffer's network
   ImportanceMap,     // --importance-map: write I(p)
   ImportanceParams,  // vkb's Eq. 3-6 parameters and factor switches, --importance-factors
+  Composite,         // --composite kbuffer|hybrid: the k-buffer family (not wboit, mboit, mlab)
 };
 
 struct MethodOptionRule {

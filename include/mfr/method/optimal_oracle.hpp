@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -24,7 +25,10 @@ struct FrameErrorCurves {
 };
 
 /// `compositing`: the rule whose error the curves measure (the optimal k-buffer of DHOIT: hybrid).
+/// `memoryLimitBytes` (none: defaultMemoryLimit()): the A-buffer's and the curves' bytes are
+/// checked against it before they are allocated (RenderOptions::memoryLimitBytes).
 Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 background,
-                                          Compositing compositing = Compositing::Hybrid);
+                                          Compositing compositing = Compositing::Hybrid,
+                                          std::optional<uint64_t> memoryLimitBytes = std::nullopt);
 
 }  // namespace mfr

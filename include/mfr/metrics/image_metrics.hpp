@@ -32,7 +32,7 @@ struct ImageErrorStats {
   double psnrSrgb = 0.0;
 };
 
-/// MSE and PSNR on both linear and sRGB values in one pass.
+/// MSE and PSNR on both linear and sRGB values in one pass. Errors: as meanSquaredError's.
 Result<ImageErrorStats> compareImages(const Image8& reference, const Image8& test);
 
 /// Per-pixel squared error averaged over R, G, B.

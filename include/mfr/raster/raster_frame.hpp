@@ -69,10 +69,19 @@ struct TileRect {
   int x0, y0, x1, y1;  // inclusive
 };
 
-/// A frame refers to the scene's textures: the Scene must outlive the RasterFrame built from it.
+/// One view of a scene, set up for the tile passes: what render() (method/render.hpp) and
+/// runComparison (compare/compare.hpp) take.
+///
+/// Lifetime: a frame refers to the scene's textures: the Scene must outlive the RasterFrame built
+/// from it (and must not change meanwhile). A frame is immutable once built: any number of methods
+/// can render it one after the other (runComparison renders every method from one frame).
 class RasterFrame {
  public:
-  /// Validates the size, fits the clip planes to the scene, transforms, clips and bins.
+  /// Validates the size, fits the clip planes to the scene (the camera's zNear/zFar when non-zero),
+  /// transforms, clips and bins every triangle. Errors (one line): width or height outside
+  /// [1, kMaxImageSize], a tile size outside [8, 1024], a scene failing validateScene, a camera
+  /// with non-finite values, eye == target, up parallel to the view direction, a field of view
+  /// outside (0, 180) degrees, or explicit clip planes without 0 < near < far.
   static Result<RasterFrame> build(const Scene& scene, const Camera& camera,
                                    const RasterOptions& options);
 

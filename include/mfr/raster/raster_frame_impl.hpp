@@ -69,8 +69,14 @@ inline glm::vec4 sampleTexture(const Texture& tex, glm::vec2 uv) {
   const float flx = std::floor(fx), fly = std::floor(fy);
   const float ax = fx - flx, ay = fy - fly;
   auto wrap = [](long v, int n) { return static_cast<int>(((v % n) + n) % n); };
-  const long ix = std::isfinite(flx) ? static_cast<long>(flx) : 0;
-  const long iy = std::isfinite(fly) ? static_cast<long>(fly) : 0;
+  // uvs far outside [0, 1] (any finite float a file holds) wrap exactly with fmod before the
+  // conversion, which would overflow a long
+  auto texelIndex = [](float f, int n) -> long {
+    if (!std::isfinite(f)) return 0;
+    return static_cast<long>(std::abs(f) < 1e9f ? f : std::fmod(f, static_cast<float>(n)));
+  };
+  const long ix = texelIndex(flx, tex.width);
+  const long iy = texelIndex(fly, tex.height);
   const int x0 = wrap(ix, tex.width), x1 = wrap(ix + 1, tex.width);
   const int y0 = wrap(iy, tex.height), y1 = wrap(iy + 1, tex.height);
   auto texel = [&](int x, int y) {

@@ -1,0 +1,305 @@
+#!/usr/bin/env python3
+"""Writes the committed seed inputs of the fuzz targets into fuzz/seeds/TARGET/.
+
+Small, hand-made, valid (and a few deliberately broken) inputs that reach every feature of each
+parser: glTF with external / data-URI / buffer-view resources, sparse and normalized accessors,
+node hierarchies, transmission, cameras; GLB; OBJ with MTL and textures; PLY in all three formats;
+JSON scenes; procedural specs; byte sizes and method names; camera strings; model and dataset files.
+The glTF seeds refer to buffer.bin and texture.png, which the targets write next to the input
+(fuzz/gltf_helpers.hpp). Run from anywhere: python3 fuzz/make_seeds.py
+"""
+import base64
+import json
+import os
+import struct
+import zlib
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SEEDS = os.path.join(HERE, "seeds")
+
+FEATURE_SET = "mfr-dkb-features-v1"  # include/mfr/method/dkb_features.hpp kDkbFeatureSet
+TARGET_SCALING = ("K_M(p) / max_q K_M(q) per view and budget "
+                  "(include/mfr/learn/dataset.hpp)")  # include/mfr/learn/dataset.hpp
+
+
+def write(target, name, data):
+    folder = os.path.join(SEEDS, target)
+    os.makedirs(folder, exist_ok=True)
+    if isinstance(data, str):
+        data = data.encode()
+    with open(os.path.join(folder, name), "wb") as f:
+        f.write(data)
+
+
+def png(width, height, rgba_rows, color_type=6):
+    """A PNG (colour type 6 RGBA8 or 2 RGB8) from rows of bytes."""
+    def chunk(kind, body):
+        return (struct.pack(">I", len(body)) + kind + body +
+                struct.pack(">I", zlib.crc32(kind + body) & 0xffffffff))
+    raw = b"".join(b"\x00" + row for row in rgba_rows)
+    return (b"\x89PNG\r\n\x1a\n" +
+            chunk(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, color_type, 0, 0, 0)) +
+            chunk(b"IDAT", zlib.compress(raw)) + chunk(b"IEND", b""))
+
+
+TEXTURE = png(2, 2, [bytes([255, 0, 0, 128, 0, 255, 0, 255]), bytes([0, 0, 255, 64, 255, 255, 255, 0])])
+
+# buffer.bin as fuzz/gltf_helpers.hpp writes it
+POSITIONS = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+UVS = struct.pack("<6f", 0, 0, 1, 0, 0, 1)
+INDICES = struct.pack("<4H", 0, 1, 2, 0)
+BUFFER = POSITIONS + UVS + INDICES  # 68 bytes
+
+
+def triangle_gltf(buffer_uri, image, extra_material=None, extra=None):
+    """A textured triangle: accessors 0 positions, 1 uvs, 2 indices into buffer 0 (BUFFER)."""
+    material = {"pbrMetallicRoughness": {"baseColorFactor": [1, 0.5, 0.25, 0.6],
+                                         "baseColorTexture": {"index": 0}},
+                "alphaMode": "BLEND", "doubleSided": True}
+    if extra_material:
+        material.update(extra_material)
+    doc = {
+        "asset": {"version": "2.0"},
+        "scene": 0,
+        "scenes": [{"nodes": [0, 2]}],
+        "nodes": [{"mesh": 0, "translation": [0, 0, -1], "rotation": [0, 0, 0.3826834, 0.9238795],
+                   "scale": [1, 2, 1], "children": [1]},
+                  {"mesh": 0, "matrix": [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0.5, 0, -0.5, 1]},
+                  {"camera": 0, "translation": [0, 0, 3]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1},
+                                    "indices": 2, "material": 0, "mode": 4}]}],
+        "materials": [material],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"magFilter": 9729, "minFilter": 9987, "wrapS": 10497, "wrapT": 33071}],
+        "images": [image],
+        "cameras": [{"type": "perspective",
+                     "perspective": {"yfov": 0.8, "znear": 0.1, "zfar": 100, "aspectRatio": 1}}],
+        "buffers": [{"byteLength": len(BUFFER)} if buffer_uri is None else
+                    {"uri": buffer_uri, "byteLength": len(BUFFER)}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36, "target": 34962},
+                        {"buffer": 0, "byteOffset": 36, "byteLength": 24, "byteStride": 8},
+                        {"buffer": 0, "byteOffset": 60, "byteLength": 6, "target": 34963}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]},
+                      {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"},
+                      {"bufferView": 2, "componentType": 5123, "count": 3, "type": "SCALAR"}],
+    }
+    if extra:
+        extra(doc)
+    return doc
+
+
+def data_uri(mime, data):
+    return "data:%s;base64,%s" % (mime, base64.b64encode(data).decode())
+
+
+def gltf_seeds():
+    write("gltf", "external.gltf", json.dumps(triangle_gltf("buffer.bin", {"uri": "texture.png"}), indent=1))
+
+    def sparse_and_more(doc):
+        # sparse positions (vertex 2 moved), normalized ubyte uvs, a second primitive without
+        # indices, an orthographic camera, transmission, MASK
+        doc["buffers"].append({"uri": data_uri("application/octet-stream",
+                                               struct.pack("<H2x3f", 2, 0.2, 0.9, 0.1) +
+                                               bytes([0, 0, 255, 0, 0, 255, 0, 0]))})
+        doc["bufferViews"] += [{"buffer": 1, "byteOffset": 0, "byteLength": 2},
+                               {"buffer": 1, "byteOffset": 4, "byteLength": 12},
+                               {"buffer": 1, "byteOffset": 16, "byteLength": 6}]
+        doc["accessors"] += [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                              "sparse": {"count": 1,
+                                         "indices": {"bufferView": 3, "componentType": 5123},
+                                         "values": {"bufferView": 4}}},
+                             {"bufferView": 5, "componentType": 5121, "normalized": True,
+                              "count": 3, "type": "VEC2"}]
+        doc["meshes"].append({"primitives": [{"attributes": {"POSITION": 3, "TEXCOORD_0": 4},
+                                              "material": 1}]})
+        doc["materials"].append({"pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.9, 0.4, 1]},
+                                 "alphaMode": "MASK", "alphaCutoff": 0.3,
+                                 "extensions": {"KHR_materials_transmission":
+                                                {"transmissionFactor": 0.8}}})
+        doc["extensionsUsed"] = ["KHR_materials_transmission"]
+        doc["nodes"].append({"mesh": 1, "scale": [0.5, 0.5, 0.5]})
+        doc["scenes"][0]["nodes"].append(3)
+        doc["cameras"].append({"type": "orthographic",
+                               "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}})
+        doc["nodes"].append({"camera": 1, "translation": [0, 1, 4]})
+        doc["scenes"][0]["nodes"].append(4)
+
+    write("gltf", "datauri_sparse.gltf", json.dumps(triangle_gltf(
+        data_uri("application/octet-stream", BUFFER),
+        {"uri": data_uri("image/png", TEXTURE)}, extra=sparse_and_more), indent=1))
+    write("gltf", "minimal.gltf", '{"asset": {"version": "2.0"}}')
+    write("gltf", "draco_required.gltf", json.dumps(
+        {"asset": {"version": "2.0"}, "extensionsRequired": ["KHR_draco_mesh_compression"]}))
+
+    # GLB: BIN chunk = BUFFER + PNG, the image read through a buffer view
+    def glb_doc(doc):
+        doc["bufferViews"].append({"buffer": 0, "byteOffset": len(BUFFER), "byteLength": len(TEXTURE)})
+        doc["buffers"][0]["byteLength"] = len(BUFFER) + len(TEXTURE)
+
+    doc = triangle_gltf(None, {"bufferView": 3, "mimeType": "image/png"}, extra=glb_doc)
+    write("glb", "embedded.glb", glb(doc, BUFFER + TEXTURE))
+    doc = triangle_gltf("buffer.bin", {"uri": "texture.png"})
+    write("glb", "external.glb", glb(doc, b""))
+
+
+def glb(doc, binary):
+    js = json.dumps(doc, separators=(",", ":")).encode()
+    js += b" " * (-len(js) % 4)
+    out = struct.pack("<I", len(js)) + b"JSON" + js
+    if binary:
+        binary += b"\0" * (-len(binary) % 4)
+        out += struct.pack("<I", len(binary)) + b"BIN\0" + binary
+    return b"glTF" + struct.pack("<II", 2, 12 + len(out)) + out
+
+
+def obj_seeds():
+    write("obj", "textured_mtl.obj",
+          "# quad and a pentagon with a textured, transparent material\n"
+          "mtllib scene.mtl\n"
+          "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nv 0 0 -1\n"
+          "vt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+          "vn 0 0 1\n"
+          "g front\nusemtl glass\n"
+          "f 1/1/1 2/2/1 3/3/1 4/4/1\n"
+          "usemtl tinted\n"
+          "f -5/1 -4/2 -1/3\n"
+          "s off\no other\nusemtl missing\nf 1//1 3//1 5//1\n"
+          "#--mtl--\n"
+          "newmtl glass\nKd 0.8 0.9 1.0\nd 0.3\nmap_Kd texture.png\n"
+          "newmtl tinted\nKd 1 0.2 0.2\nTr 0.6\nillum 2\n")
+    write("obj", "plain.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n")
+    write("obj", "polygon_no_mtl.obj",
+          "mtllib absent.mtl\nv 0 0 0\nv 2 0 0\nv 3 1 0\nv 1 2 0\nv -1 1 0\nf 1 2 3 4 5\n")
+    write("obj", "bad_index.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n")
+    write("obj", "nan.obj", "v 0 0 0\nv nan 0 0\nv 0 1 0\nf 1 2 3\n")
+
+
+def ply_seeds():
+    header = ("ply\nformat {fmt} 1.0\ncomment made by fuzz/make_seeds.py\n"
+              "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+              "property float nx\nproperty float ny\nproperty float nz\n"
+              "element face 2\nproperty list uchar int vertex_indices\nend_header\n")
+    verts = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, -0.5)]
+    faces = [(0, 1, 2), (0, 2, 3)]
+    body = "".join("%g %g %g 0 0 1\n" % v for v in verts) + "".join(
+        "3 %d %d %d\n" % f for f in faces)
+    write("ply", "ascii.ply", header.format(fmt="ascii") + body)
+    for fmt, end in (("binary_little_endian", "<"), ("binary_big_endian", ">")):
+        data = b"".join(struct.pack(end + "6f", *v, 0, 0, 1) for v in verts)
+        data += b"".join(struct.pack(end + "B3i", 3, *f) for f in faces)
+        write("ply", fmt + ".ply", header.format(fmt=fmt).encode() + data)
+    # quads, extra properties and elements, ushort lists, uchar colours
+    write("ply", "quads_extra.ply",
+          "ply\nformat ascii 1.0\nobj_info generated\nelement vertex 5\n"
+          "property double x\nproperty double y\nproperty double z\n"
+          "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+          "element face 2\nproperty list uchar ushort vertex_indices\n"
+          "element edge 1\nproperty int vertex1\nproperty int vertex2\nend_header\n"
+          "0 0 0 255 0 0\n1 0 0 0 255 0\n1 1 0 0 0 255\n0 1 0 9 9 9\n0.5 0.5 1 1 2 3\n"
+          "4 0 1 2 3\n3 0 1 4\n0 1\n")
+    write("ply", "truncated.ply", "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n")
+
+
+def json_scene_seeds():
+    write("json_scene", "full.json", json.dumps(
+        {"mesh": "mesh.obj", "alpha": 0.5, "background": [1, 1, 1],
+         "cameras": [{"eye": [0, 1, 3], "target": [0, 0, 0], "up": [0, 1, 0], "fov": 45},
+                     {"eye": [2, 0, 2], "target": [0.5, 0.5, 0], "near": 0.5, "far": 20}],
+         "transmission_alpha_floor": 0.1}, indent=1))
+    write("json_scene", "procedural.json",
+          '{"mesh": "procedural:layers?k=3&r=1&pd=0.8", "background": [0, 0, 0.1]}')
+    write("json_scene", "spheres.json",
+          '{"mesh": "procedural:spheres?count=2&detail=4", "alpha": 1}')
+    write("json_scene", "bad_key.json", '{"mesh": "mesh.obj", "colour": 1}')
+    write("json_scene", "nested.json", '{"mesh": "other.json"}')
+
+
+def procedural_seeds():
+    specs = {
+        "layers": "layers?k=2&r=2&pd=0.5&alpha=0.3",
+        "hairball": "hairball?strands=5&segments=3&sides=3&radius=0.05&alpha=0.5&seed=7",
+        "smoke": "smoke?count=10&size=0.2&alpha=0.2",
+        "bottles": "bottles?count=1&segments=6&alpha=0.4",
+        "spheres": "spheres?count=3&scale=1&detail=4&alpha=0.3",
+        "out_of_range": "layers?k=0",
+        "unknown": "teapot?size=2",
+        "twice": "smoke?count=1&count=2",
+        "too_many": "hairball?strands=1000000",
+    }
+    for name, spec in specs.items():
+        write("procedural", name, spec)
+
+
+def units_seeds():
+    for i, text in enumerate(["20MB", "512KiB", "1.5GB", "4096", "1 k", "0.5mb", "2TB", ".5G",
+                              "fkb+occupancy", "kplus-dynamic", "hybrid", "kbuffer"]):
+        write("units", "seed%02d" % i, text)
+
+
+def camera_seeds():
+    for i, text in enumerate(["0,0,5,0,0,0", "0,1,3,0,0,0,0,1,0,45", "-1.5e2, +2,3,0,0,0,0,0,1,90",
+                              "0.5,0.5,0.2,0.5,0.5,-1,0,1,0,179.9", "1e30,0,0,0,0,0,0,1,0",
+                              "0,0,5,0,0,0,0,0,1", "nan,0,5,0,0,0", "1,2,3"]):
+        write("camera", "seed%02d" % i, text)
+
+
+def model_bytes(sizes, weights, metadata):
+    out = b"MFRMLP\0\0" + struct.pack("<II", 1, len(sizes) - 1)
+    out += b"".join(struct.pack("<I", s) for s in sizes)
+    k = 0
+    for l in range(len(sizes) - 1):
+        n = sizes[l + 1] * sizes[l] + sizes[l + 1]
+        out += struct.pack("<%df" % n, *weights[k:k + n])
+        k += n
+    meta = metadata.encode()
+    return out + struct.pack("<I", len(meta)) + meta
+
+
+def mfrnn_seeds():
+    meta = json.dumps({"features": FEATURE_SET, "target": TARGET_SCALING})
+    sizes = [12, 4, 1]
+    n = 12 * 4 + 4 + 4 + 1
+    weights = [((i * 37) % 11 - 5) / 10.0 for i in range(n)]
+    write("mfrnn", "dkb_12_4_1.mfrnn", model_bytes(sizes, weights, meta))
+    write("mfrnn", "huge_weights.mfrnn", model_bytes(sizes, [3e38 if i % 3 else -3e38 for i in range(n)], meta))
+    write("mfrnn", "linear_12_1.mfrnn", model_bytes([12, 1], [0.1] * 13, json.dumps({"features": FEATURE_SET})))
+    write("mfrnn", "no_metadata.mfrnn", model_bytes([2, 3, 1], [0.5] * 13, ""))
+    write("mfrnn", "wrong_features.mfrnn", model_bytes(sizes, weights, '{"features": "v0"}'))
+
+
+def mfrds_seeds():
+    meta = json.dumps({"features": FEATURE_SET, "target": TARGET_SCALING, "generator": "seed"})
+    scenes = [b"procedural:layers", b"procedural:smoke"]
+    out = b"MFRDS\0\0\0" + struct.pack("<III", 1, 12, len(scenes))
+    out += b"".join(struct.pack("<I", len(s)) + s for s in scenes)
+    out += struct.pack("<I", len(meta)) + meta.encode()
+    samples = [(0, 0, 0, 5), (0, 1, 2, 17), (1, 0, 4, 3)]
+    out += struct.pack("<Q", len(samples))
+    for i, (scene, view, step, pixel) in enumerate(samples):
+        out += struct.pack("<4I", scene, view, step, pixel)
+        out += struct.pack("<12f", *[(i + j) / 13.0 for j in range(12)])
+        out += struct.pack("<f", i / 2.0)
+    write("mfrds", "three_samples.mfrds", out)
+    old = out.replace(FEATURE_SET.encode(), b"mfr-dkb-features-v0")
+    write("mfrds", "old_features.mfrds", old)
+
+
+def png_seeds():
+    write("png", "rgba_2x2.png", TEXTURE)
+    write("png", "rgb_3x1.png", png(3, 1, [bytes([10, 20, 30, 40, 50, 60, 70, 80, 90])], color_type=2))
+    write("png", "not_png.png", b"GIF89a")
+
+
+if __name__ == "__main__":
+    gltf_seeds()
+    obj_seeds()
+    ply_seeds()
+    json_scene_seeds()
+    procedural_seeds()
+    units_seeds()
+    camera_seeds()
+    mfrnn_seeds()
+    mfrds_seeds()
+    png_seeds()
+    print("seeds written to", SEEDS)

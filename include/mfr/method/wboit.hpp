@@ -1,0 +1,62 @@
+// Weighted Blended Order-Independent Transparency.
+//   M. McGuire, L. Bavoil. "Weighted Blended Order-Independent Transparency". Journal of Computer
+//   Graphics Techniques (JCGT) 2(2), 2013, pp. 122-141.
+//
+// One accumulation pass, no fragment nodes. Per pixel (20 bytes, float32; the paper's targets are
+// RGBA16F + R8, mfr keeps float32 and charges what it stores):
+//   accum.rgb += C_i * w(z_i, a_i)       C_i = a_i c_i, the premultiplied linear colour
+//   accum.a   += a_i * w(z_i, a_i)
+//   revealage *= (1 - a_i)
+// and the composite (the paper's Eq. 6 with its resolve-shader clamp of the denominator):
+//   final = accum.rgb / clamp(accum.a, 1e-4, 5e4) * (1 - revealage) + revealage * background.
+// The depth weight is the paper's Eq. 10, the one written for window-space depth d = gl_FragCoord.z
+// (the fragments' depth here), with its lower clamp:
+//   w(z, a) = a * max(1e-2, 3e3 * (1 - d)^3)          (the upper clamp 3e3 is implied: d >= 0)
+// Sums are accumulated in the order fragments reach the pixel: primitive order in tile-owned
+// capture (the same for any thread count); in another submission order the float sums may differ
+// in the last bits (relative 1e-6 per fragment, see README "Peer methods").
+#pragma once
+
+#include <algorithm>
+
+#include <glm/glm.hpp>
+
+#include "mfr/core/color.hpp"
+
+namespace mfr {
+
+inline constexpr float kWboitMinWeight = 1e-2f;
+inline constexpr float kWboitMaxWeight = 3e3f;
+
+/// The paper's Eq. 10: w(z, alpha) = alpha * max(1e-2, 3e3 (1 - d)^3), d window-space depth.
+inline float wboitWeight(float depth, float alpha) {
+  const float t = 1.0f - std::clamp(depth, 0.0f, 1.0f);
+  return alpha * std::max(kWboitMinWeight, kWboitMaxWeight * t * t * t);
+}
+
+/// One pixel's accumulators: 20 bytes.
+struct WboitPixel {
+  float r = 0.0f, g = 0.0f, b = 0.0f;  // sum of C_i w_i (premultiplied colour times weight)
+  float a = 0.0f;                      // sum of a_i w_i
+  float revealage = 1.0f;              // product of (1 - a_i)
+
+  void add(float depth, glm::vec4 c) {  // c: linear colour, alpha
+    if (c.a <= 0.0f) return;
+    const float w = wboitWeight(depth, c.a);
+    r += c.r * c.a * w;
+    g += c.g * c.a * w;
+    b += c.b * c.a * w;
+    a += c.a * w;
+    revealage *= 1.0f - c.a;
+  }
+  void add(float depth, uint32_t rgba) { add(depth, unpackFragmentColor(rgba)); }
+
+  glm::vec3 composite(glm::vec3 background) const {
+    if (a <= 0.0f) return background;
+    const glm::vec3 average = glm::vec3(r, g, b) / std::clamp(a, 1e-4f, 5e4f);
+    return average * (1.0f - revealage) + revealage * background;
+  }
+};
+static_assert(sizeof(WboitPixel) == 20);
+
+}  // namespace mfr

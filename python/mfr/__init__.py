@@ -1,0 +1,262 @@
+"""mfr: bounded-memory multi-fragment rendering and order-independent transparency.
+
+The Python face of the C++ library (the extension module mfr._mfr):
+
+    import mfr
+    scene = mfr.load_scene("procedural:bottles")              # or a .gltf/.glb/.obj/.ply/.json
+    r = mfr.render(scene, method="kplus-dynamic", budget="4MB", width=256, height=256)
+    r.image, r.srgb, r.k_map, r.depth_complexity, r.importance  # numpy arrays
+    r.stats["bytes_used"]                                      # keys of `mfr render --stats-json`
+    mfr.write_png("out.png", r.srgb)
+    m = mfr.metrics(reference_png_or_array, test_png_or_array)  # MSE, PSNR, FLIP (+ map)
+    mfr.compare(scene, "out/compare", budgets=["2MB", "4MB"], methods=["fkb", "dkb"])
+    data = mfr.load_dataset("train.mfrds")                      # features (N, 12), targets (N,)
+    model = mfr.save_model("my.mfrnn", weights, biases)         # numpy weights -> dkb's model
+    mfr.render(scene, method="dkb", budget="4MB", model=model)
+
+Errors the library reports (missing files, unknown scenes or methods, budgets too small, options
+that do not apply to a method, ...) raise mfr.Error (a RuntimeError) with the library's one-line
+message, the same text `mfr` prints after "mfr: error: ". Arrays of the wrong shape raise
+ValueError. Rendering, loading and comparing release the GIL. Returned arrays own the library's
+buffers (no copies); arrays that view a Scene, Model or dataset are read-only.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+from typing import Any, Iterable, Sequence
+
+import numpy as np
+
+from . import _mfr
+from ._mfr import (  # noqa: F401  (re-exported)
+    DKB_LAYERS,
+    FEATURE_COUNT,
+    FEATURE_SET,
+    FLIP_DEFAULT_PPD,
+    TARGET_SCALING,
+    Error,
+    Model,
+    RenderResult,
+    Scene,
+    __version__,
+    builtin_model,
+    decode_srgb,
+    encode_srgb,
+    load_scene,
+    metrics,
+    parse_bytes,
+    preset_names,
+    read_png,
+    write_png,
+)
+
+__all__ = [
+    "DEFAULT_COMPARE_METHODS", "DKB_LAYERS", "FEATURE_COUNT", "FEATURE_SET", "FLIP_DEFAULT_PPD",
+    "TARGET_SCALING", "Dataset", "Error", "Model", "RenderResult", "Scene", "builtin_model",
+    "compare", "decode_srgb", "encode_srgb", "load_dataset", "load_model", "load_scene",
+    "make_model", "metrics", "parse_bytes", "preset_names", "read_png", "render",
+    "save_dataset", "save_model", "write_png",
+]
+
+#: The methods `mfr compare` runs when --methods is not given.
+DEFAULT_COMPARE_METHODS = ("fkb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "dkb-fill", "optimal",
+                           "wboit", "mboit", "mlab")
+
+
+def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1024, camera=None,
+           view=None, zoom=1.0, composite=None, capture="tile", threads=0, seed=1, model=None,
+           occupancy_d=None, importance=None, alpha=None, background=None, memory_limit=None,
+           depth_complexity=True) -> RenderResult:
+    """Renders one frame with one method, exactly as `mfr render` with the same options.
+
+    scene: an mfr.Scene, or a source string ("procedural:NAME[?k=v&...]" or a file), loaded with
+        `seed` (alpha and background then override its materials' alpha and its background;
+        with an mfr.Scene they apply to a copy).
+    method: a preset of mfr.preset_names() (optionally "NAME+occupancy").
+    budget: the memory budget M in bytes (int) or as text ("20MB", binary units); bounded
+        methods need it unless k is given.
+    k: explicit k (fixed, counted and dynamic-k presets). composite: "kbuffer" or "hybrid"
+        (default: the preset's own rule). capture: "tile" or "parallel". occupancy_d: buckets
+        32*d of a "+occupancy" method. model: a .mfrnn path or an mfr.Model (dkb*; default the
+        built-in model). importance: vkb's parameters as a dict (alpha, n_limit, periphery_d,
+        fovea, noise, depth_term, periphery_term, fresnel_term, noise_term).
+    camera: (eye xyz, target xyz[, up xyz[, fov degrees]]) as 6, 9 or 10 numbers; view: index of
+        a camera of the scene file; default: the scene's own camera, or one framing its bounds.
+        zoom: moves the camera zoom times closer to its target.
+    threads: worker threads (0: all cores; the output does not depend on it). seed: procedural
+        scenes and vkb's noise.
+    memory_limit: refuse runs whose buffers need more (bytes or "8GB"; default 75% of the
+        physical memory, as `mfr --memory-limit`).
+    depth_complexity: also count the fragments per pixel when the method does not.
+
+    Returns an mfr.RenderResult: image (float32 (h, w, 3) linear RGB), srgb (uint8 (h, w, 4), the
+    PNG's pixels), k_map (uint32 (h, w); None for methods without fragment slots, e.g. wboit),
+    depth_complexity (uint32 (h, w) or None), importance
+    (float32 (h, w) for vkb*/dkb*, else None) and stats (dict, the keys of --stats-json but
+    'image'). Raises mfr.Error with the library's message for bad input.
+    """
+    return _mfr.render(scene, method=method, budget=budget, k=k, width=width, height=height,
+                       camera=camera, view=view, zoom=zoom, composite=composite, capture=capture,
+                       threads=threads, seed=seed, model=model, occupancy_d=occupancy_d,
+                       importance=importance, alpha=alpha, background=background,
+                       memory_limit=memory_limit, depth_complexity=depth_complexity)
+
+
+def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_METHODS, width=1024,
+            height=1024, camera=None, view=None, zoom=1.0, composite=None, capture="tile",
+            threads=0, seed=1, model=None, ppd=FLIP_DEFAULT_PPD, alpha=None,
+            background=None, memory_limit=None) -> dict:
+    """Writes the folder `mfr compare --out OUT` writes for the same options and returns its
+    results.json as a dict.
+
+    The ground truth (exact A-buffer) once, then every method at every budget, measured against
+    it: OUT/ground_truth.png, ground_truth_depth_complexity.png, METHOD_BUDGET.png, _flip.png,
+    _kmap.png, (_importance.png), results.json, results.csv and report.html (its command line
+    is this call). budgets: one budget or a list (bytes or "20MB" strings); methods: presets;
+    composite: "kbuffer" / "hybrid" for every method (default each preset's own rule); model:
+    the dkb* network (path or mfr.Model); ppd: FLIP's pixels per degree. scene, camera, view,
+    zoom, width, height, threads, seed, alpha, background, memory_limit: as in mfr.render. A method that fails
+    at a budget is recorded with its error; bad input raises mfr.Error.
+    """
+    if isinstance(budgets, (str, int)):
+        budgets = [budgets]
+    if isinstance(methods, str):
+        methods = [m.strip() for m in methods.split(",")]
+    out = os.fspath(out)
+    call = [repr(scene.name if isinstance(scene, Scene) else scene), repr(out),
+            f"budgets={list(budgets)!r}", f"methods={list(methods)!r}",
+            f"width={width!r}", f"height={height!r}"]
+    for name, value, default in (("camera", camera, None), ("view", view, None),
+                                 ("zoom", zoom, 1.0), ("composite", composite, None),
+                                 ("capture", capture, "tile"), ("threads", threads, 0),
+                                 ("seed", seed, 1), ("ppd", ppd, FLIP_DEFAULT_PPD),
+                                 ("alpha", alpha, None), ("background", background, None),
+                                 ("memory_limit", memory_limit, None)):
+        if value != default:
+            call.append(f"{name}={value!r}")
+    if model is not None:
+        call.append(f"model={os.fspath(model)!r}" if not isinstance(model, Model) else
+                    "model=<mfr.Model>")
+    return _mfr._compare(scene, out, budgets=list(budgets), methods=list(methods), width=width,
+                         height=height, camera=camera, view=view, zoom=zoom,
+                         composite=composite, capture=capture, threads=threads, seed=seed,
+                         model=model, ppd=ppd, alpha=alpha, background=background,
+                         memory_limit=memory_limit, command_line="mfr.compare(" + ", ".join(call) + ")")
+
+
+# --- the deep k-buffer's models ----------------------------------------------------------------
+
+def _default_metadata(sizes: Sequence[int]) -> dict:
+    return {
+        "features": FEATURE_SET,
+        "feature_normalisation": "include/mfr/method/dkb_features.hpp",
+        "target": TARGET_SCALING,
+        "layers": list(sizes),
+        "activations": ", ".join(["relu"] * (len(sizes) - 2) + ["sigmoid"]),
+        "written_by": f"mfr {__version__} (Python)",
+    }
+
+
+def make_model(weights: Sequence[Any], biases: Sequence[Any], metadata=None) -> Model:
+    """An mfr.Model from numpy arrays: weights[l] of shape (outputs, inputs), biases[l] of shape
+    (outputs,), for y = relu(W x + b) on hidden layers and sigmoid(W x + b) at the output (the
+    network dkb runs; PyTorch's nn.Linear.weight has this layout). Values are stored as float32.
+
+    metadata: None (the deep k-buffer's declarations: features, target, layers, activations), a
+    dict (FEATURE_SET and TARGET_SCALING are added as "features" and "target" when missing, so
+    dkb accepts the model) or a str written verbatim (JSON text).
+    """
+    weights = [np.asarray(w) for w in weights]
+    biases = [np.asarray(b) for b in biases]
+    if metadata is None or isinstance(metadata, dict):
+        sizes = [int(weights[0].shape[-1])] + [int(w.shape[0]) for w in weights] if weights else []
+        meta = _default_metadata(sizes) if metadata is None else dict(metadata)
+        meta.setdefault("features", FEATURE_SET)
+        meta.setdefault("target", TARGET_SCALING)
+        metadata = json.dumps(meta, indent=2)
+    elif not isinstance(metadata, str):
+        raise TypeError("metadata: expected None, a dict or a JSON str")
+    return Model(weights, biases, metadata)
+
+
+def save_model(path, weights, biases=None, metadata=None) -> Model:
+    """Writes a .mfrnn model (include/mfr/learn/model_file.hpp) that `mfr render -m dkb --model`
+    and mfr.render(method="dkb", model=...) use unchanged. `weights` is a list of weight arrays
+    (see make_model) with `biases`, or an mfr.Model. Returns the mfr.Model written."""
+    model = weights if isinstance(weights, Model) else make_model(weights, biases, metadata)
+    model.save(os.fspath(path))
+    return model
+
+
+def load_model(path) -> Model:
+    """Reads a .mfrnn model; model.weights / model.biases are read-only float32 arrays
+    (np.array(w) copies them for training), model.metadata the JSON text. Raises mfr.Error
+    naming the file for a missing, truncated or malformed file."""
+    return Model.load(os.fspath(path))
+
+
+# --- datasets ----------------------------------------------------------------------------------
+
+@dataclasses.dataclass
+class Dataset:
+    """A .mfrds training set (include/mfr/learn/dataset.hpp) as numpy arrays, one row per sample.
+
+    features: float32 (N, 12), the deep k-buffer's inputs (include/mfr/method/dkb_features.hpp);
+    targets: float32 (N,), t(p) = K_M(p) / max K_M; scene, view, budget_step, pixel: uint32 (N,),
+    scene indexing `scenes`. Loaded arrays are read-only views of one buffer (np.array copies).
+    """
+
+    scenes: list
+    features: np.ndarray
+    targets: np.ndarray
+    scene: np.ndarray
+    view: np.ndarray
+    budget_step: np.ndarray
+    pixel: np.ndarray
+    metadata: Any = None  # dict when the file's metadata is JSON, else its text
+    file_hash: str = ""  # FNV-1a 64 of the file's bytes (what mfr train records)
+    metadata_text: str = ""  # the metadata exactly as in the file
+
+    def __len__(self) -> int:
+        return int(self.targets.shape[0])
+
+
+def load_dataset(path, *, check: bool = True) -> Dataset:
+    """Reads a .mfrds dataset written by `mfr dataset` (or save_dataset). check: refuse, as
+    `mfr train` does, a dataset whose metadata declares another feature set or target than this
+    build's (mfr.Error). Raises mfr.Error naming the file for a missing or malformed file."""
+    d = _mfr._load_dataset(os.fspath(path), check)
+    try:
+        metadata = json.loads(d["metadata"]) if d["metadata"] else None
+    except ValueError:
+        metadata = d["metadata"]
+    return Dataset(scenes=list(d["scenes"]), features=d["features"], targets=d["targets"],
+                   scene=d["scene"], view=d["view"], budget_step=d["budget_step"],
+                   pixel=d["pixel"], metadata=metadata, file_hash=d["file_hash"],
+                   metadata_text=d["metadata"])
+
+
+def save_dataset(path, features, targets=None, scenes: Iterable[str] = ("python",), *, scene=None,
+                 view=None, budget_step=None, pixel=None, metadata=None) -> None:
+    """Writes a .mfrds dataset: features (N, 12), targets (N,), scene names, and per-sample
+    scene / view / budget_step / pixel indices (default 0). metadata: None (this build's feature
+    set and target), a dict (JSON) or a str. A Dataset can be passed as `features` alone (its
+    metadata text is kept, so a loaded dataset is written back byte for byte)."""
+    if isinstance(features, Dataset):
+        data = features
+        features, targets, scenes = data.features, data.targets, data.scenes
+        scene, view, budget_step, pixel = data.scene, data.view, data.budget_step, data.pixel
+        if metadata is None:  # as read: the same bytes are written back
+            metadata = data.metadata_text if data.metadata_text else data.metadata
+    elif targets is None:
+        raise TypeError("save_dataset: targets are required with a features array")
+    if metadata is None:
+        metadata = {"features": FEATURE_SET, "target": TARGET_SCALING,
+                    "written_by": f"mfr {__version__} (Python)"}
+    if isinstance(metadata, dict):
+        metadata = json.dumps(metadata)
+    _mfr._save_dataset(os.fspath(path), np.asarray(features), np.asarray(targets), list(scenes),
+                       scene, view, budget_step, pixel, metadata)

@@ -1,0 +1,66 @@
+// Shared pieces of the Python module: library errors as mfr.Error, zero-copy numpy arrays over
+// moved std::vectors, JSON to Python.
+#pragma once
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mfr/core/result.hpp"
+
+namespace mfr::python {
+
+namespace py = pybind11;
+
+/// A library error (Result's message, one line naming the input): raised as mfr.Error.
+struct LibraryError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+template <class T>
+T unwrap(Result<T>&& result) {
+  if (!result) throw LibraryError(result.error().message);
+  return std::move(result.value());
+}
+
+inline void unwrap(Result<void>&& result) {
+  if (!result) throw LibraryError(result.error().message);
+}
+
+/// A numpy array over `values`' memory, which the array then owns (a capsule deletes it): no copy.
+/// `shape` must multiply to values.size() * componentsPerElement with elements of type `Scalar`.
+template <class Scalar, class T>
+py::array ownedArray(std::vector<T>&& values, std::vector<py::ssize_t> shape) {
+  static_assert(sizeof(T) % sizeof(Scalar) == 0);
+  auto* holder = new std::vector<T>(std::move(values));
+  py::capsule owner(holder, [](void* p) { delete static_cast<std::vector<T>*>(p); });
+  return py::array_t<Scalar>(shape, reinterpret_cast<const Scalar*>(holder->data()), owner);
+}
+
+/// A path argument: a str or an os.PathLike (pathlib.Path, ...). Else TypeError naming `what`.
+inline std::string pathText(const py::object& path, const char* what = "path") {
+  if (py::isinstance<py::str>(path)) return path.cast<std::string>();
+  if (py::hasattr(path, "__fspath__")) {
+    const py::object text = py::module_::import("os").attr("fspath")(path);
+    if (py::isinstance<py::str>(text)) return text.cast<std::string>();
+  }
+  throw py::type_error(std::string(what) + ": expected a str or os.PathLike path");
+}
+
+/// A JSON value as Python objects, exactly as json.loads would read its dump (non-finite numbers
+/// become None, as in the files the command line writes).
+py::object toPython(const nlohmann::json& value);
+
+void addSceneAndRender(py::module_& m);
+void addMetricsAndCompare(py::module_& m);
+void addLearn(py::module_& m);
+
+}  // namespace mfr::python

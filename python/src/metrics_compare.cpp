@@ -1,0 +1,156 @@
+// mfr.metrics (MSE, PSNR, FLIP with its map) and mfr.compare (the folder of `mfr compare`).
+#include <cmath>
+
+#include "common.hpp"
+#include "mfr/compare/compare.hpp"
+#include "mfr/compare/compare_output.hpp"
+#include "mfr/core/units.hpp"
+#include "mfr/method/method_options.hpp"
+#include "mfr/metrics/flip.hpp"
+#include "mfr/metrics/image_metrics.hpp"
+#include "scene_options.hpp"
+
+namespace mfr::python {
+namespace {
+
+/// A path (str or os.PathLike) read as PNG, or an image array (image8Argument).
+Image8 imageOrPath(const py::object& image, const char* what) {
+  if (py::isinstance<py::str>(image) || py::hasattr(image, "__fspath__")) {
+    const std::string path = pathText(image, what);
+    py::gil_scoped_release release;
+    return unwrap(readPng(path));
+  }
+  return image8Argument(py::array::ensure(image), what);
+}
+
+double pixelsPerDegree(double ppd) {
+  if (!(std::isfinite(ppd) && ppd > 0.0)) throw LibraryError("ppd: must be a positive number");
+  return ppd;
+}
+
+py::dict metrics(const py::object& referenceArg, const py::object& testArg, double ppd) {
+  const Image8 reference = imageOrPath(referenceArg, "reference");
+  const Image8 test = imageOrPath(testArg, "test");
+  pixelsPerDegree(ppd);
+  if (reference.width != test.width || reference.height != test.height)
+    throw LibraryError("reference is " + std::to_string(reference.width) + "x" +
+                       std::to_string(reference.height) + " but test is " +
+                       std::to_string(test.width) + "x" + std::to_string(test.height) +
+                       ": images must have the same size");
+  ImageErrorStats stats;
+  FlipResult flip;
+  double median = 0, p95 = 0, p99 = 0, maxFlip = 0;
+  {
+    py::gil_scoped_release release;
+    stats = unwrap(compareImages(reference, test));
+    flip = unwrap(computeFlip(reference, test, ppd));
+    median = flipPercentile(flip, 0.5);
+    p95 = flipPercentile(flip, 0.95);
+    p99 = flipPercentile(flip, 0.99);
+    maxFlip = flipPercentile(flip, 1.0);
+  }
+  py::dict d;
+  d["width"] = stats.width;
+  d["height"] = stats.height;
+  d["mse_linear"] = stats.mseLinear;
+  d["mse_srgb"] = stats.mseSrgb;
+  d["psnr_linear"] = stats.psnrLinear;  // inf for identical images
+  d["psnr_srgb"] = stats.psnrSrgb;
+  d["mse"] = stats.mseLinear;
+  d["psnr"] = stats.psnrLinear;
+  d["flip_mean"] = flip.mean;
+  d["flip_median"] = median;
+  d["flip_p95"] = p95;
+  d["flip_p99"] = p99;
+  d["flip_max"] = maxFlip;
+  d["pixels_per_degree"] = ppd;
+  const py::ssize_t h = flip.height, w = flip.width;
+  d["flip_map"] = ownedArray<float>(std::move(flip.errorMap), {h, w});
+  return d;
+}
+
+py::object compare(const py::object& sceneArg, const std::string& out,
+                   const std::vector<py::object>& budgets, const std::vector<std::string>& methods,
+                   int width, int height, const py::object& camera, const py::object& view,
+                   double zoom, const py::object& composite, const std::string& capture,
+                   int threads, uint64_t seed, const py::object& model, double ppd,
+                   const py::object& alpha, const py::object& background,
+                   const py::object& memoryLimitArg, const std::string& commandLine) {
+  if (out.empty()) throw LibraryError("out: an output folder is required");
+  CompareOptions options;
+  options.seed = seed;
+  options.flipPixelsPerDegree = pixelsPerDegree(ppd);
+  for (const std::string& name : methods) {
+    if (name.empty()) throw LibraryError("methods: empty method name in the list");
+    unwrap(methodPreset(name));
+    for (const std::string& seen : options.methods)
+      if (seen == name) throw LibraryError("methods: method '" + name + "' listed twice");
+    options.methods.push_back(name);
+  }
+  if (options.methods.empty()) throw LibraryError("methods: the method list is empty");
+  if (!model.is_none()) {  // the model must be used by some method, not silently ignored
+    bool used = false;
+    for (const std::string& name : options.methods)
+      used = used || checkMethodOption(MethodOption::Model, methodPreset(name).value());
+    if (!used)
+      throw LibraryError(std::string("model: none of the methods uses it (only ") +
+                         methodOptionRule(MethodOption::Model).appliesTo + ": " +
+                         presetsAccepting(MethodOption::Model) + ")");
+    options.model = modelArgument(model);
+  }
+  for (const py::object& budget : budgets) {
+    const uint64_t bytes = budgetArgument(budget);
+    for (uint64_t seen : options.budgets)
+      if (seen == bytes) throw LibraryError("budgets: " + budgetLabel(bytes) + " listed twice");
+    options.budgets.push_back(bytes);
+  }
+  if (options.budgets.empty())
+    throw LibraryError("budgets: no budget given (e.g. budgets=[\"20MB\", \"40MB\"])");
+  if (!composite.is_none())
+    options.compositing = unwrap(parseCompositing(composite.cast<std::string>()));
+  options.capture = captureArgument(capture);
+  const RasterOptions ro = rasterArgument(width, height, threads);
+  unwrap(prepareOutputFolder(out));
+
+  options.memoryLimitBytes = memoryLimitArgument(memoryLimitArg);
+  const SceneArgument scene =
+      sceneArgument(sceneArg, seed, alpha, background, options.memoryLimitBytes);
+  options.scene = scene.source;
+  options.background = scene.scene->background;
+  const Camera cam = cameraArgument(*scene.scene, camera, view, zoom);
+  std::string jsonText;
+  {
+    py::gil_scoped_release release;
+    auto frame = RasterFrame::build(*scene.scene, cam, ro);
+    if (!frame) throw LibraryError(scene.source + ": " + frame.error().message);
+    auto result = runComparison(frame.value(), options);
+    if (!result) throw LibraryError(scene.source + ": " + result.error().message);
+    ReportInfo info;
+    info.mfrVersion = std::string("mfr ") + MFR_VERSION;
+    info.commandLine = commandLine;
+    info.generated = utcTimestamp();
+    jsonText = unwrap(writeComparison(result.value(), out, MFR_VERSION, info));
+  }
+  return py::module_::import("json").attr("loads")(jsonText);
+}
+
+}  // namespace
+
+void addMetricsAndCompare(py::module_& m) {
+  m.attr("FLIP_DEFAULT_PPD") = kFlipDefaultPixelsPerDegree;
+  m.def("metrics", &metrics, py::arg("reference"), py::arg("test"),
+        py::arg("ppd") = kFlipDefaultPixelsPerDegree,
+        R"(Error of `test` against `reference`, as `mfr metrics --json` computes it: each a PNG path
+or an array (uint8 (h, w, 3|4) sRGB, or float (h, w, 3) linear, sRGB-encoded first). Returns a
+dict: width, height, mse_linear, mse_srgb, psnr_linear, psnr_srgb (inf when identical), mse and psnr
+(the linear ones), flip_mean, flip_median, flip_p95, flip_p99, flip_max, pixels_per_degree, and
+flip_map (LDR-FLIP per pixel, float32 (h, w) in [0, 1]).)");
+  m.def("_compare", &compare, py::arg("scene"), py::arg("out"), py::kw_only(), py::arg("budgets"),
+        py::arg("methods"), py::arg("width"), py::arg("height"), py::arg("camera"), py::arg("view"),
+        py::arg("zoom"), py::arg("composite"), py::arg("capture"), py::arg("threads"),
+        py::arg("seed"), py::arg("model"), py::arg("ppd"), py::arg("alpha"), py::arg("background"),
+        py::arg("memory_limit"), py::arg("command_line"),
+        "mfr.compare's work (see python/mfr/__init__.py).");
+}
+
+}  // namespace mfr::python

@@ -1,0 +1,251 @@
+// Python arguments -> library values (see scene_options.hpp).
+#include "scene_options.hpp"
+
+#include <cmath>
+#include <cstring>
+
+#include "mfr/core/units.hpp"
+#include "mfr/method/deep_importance.hpp"
+#include "mfr/scene/camera_spec.hpp"
+#include "mfr/scene/load.hpp"
+
+namespace mfr::python {
+namespace {
+
+std::vector<double> numbers(const py::object& value, const char* what) {
+  if (py::isinstance<py::str>(value)) throw LibraryError(std::string(what) + ": expected numbers");
+  std::vector<double> v;
+  for (const py::handle item : value) v.push_back(item.cast<double>());
+  for (double x : v)
+    if (!std::isfinite(x))
+      throw LibraryError(std::string(what) + ": values must be finite numbers");
+  return v;
+}
+
+}  // namespace
+
+std::optional<float> alphaArgument(const py::object& alpha) {
+  if (alpha.is_none()) return std::nullopt;
+  const double a = alpha.cast<double>();
+  if (!(a >= 0.0 && a <= 1.0)) throw LibraryError("alpha: must be in [0, 1]");
+  return static_cast<float>(a);
+}
+
+glm::vec3 backgroundArgument(const py::object& background) {
+  const std::vector<double> v = numbers(background, "background");
+  if (v.size() != 3) throw LibraryError("background: expected three numbers R, G, B");
+  for (double b : v)
+    if (b < 0.0 || b > 1.0) throw LibraryError("background: components must be in [0, 1]");
+  return glm::vec3(v[0], v[1], v[2]);
+}
+
+std::shared_ptr<Scene> loadSceneArgument(const std::string& source, uint64_t seed,
+                                         double transmissionFloor, const py::object& alpha,
+                                         const py::object& background,
+                                         std::optional<uint64_t> memoryLimit,
+                                         bool allowOutsideReferences) {
+  if (!(transmissionFloor >= 0.0 && transmissionFloor <= 1.0))
+    throw LibraryError("transmission_floor: must be in [0, 1]");
+  const std::optional<float> alphaOverride = alphaArgument(alpha);
+  std::optional<glm::vec3> backgroundColor;
+  if (!background.is_none()) backgroundColor = backgroundArgument(background);
+  LoadOptions load;
+  load.seed = seed;
+  load.transmissionAlphaFloor = static_cast<float>(transmissionFloor);
+  load.memoryLimitBytes = memoryLimit;
+  load.allowOutsideReferences = allowOutsideReferences;
+  auto scene = std::make_shared<Scene>();
+  {
+    py::gil_scoped_release release;
+    *scene = unwrap(loadScene(source, load));
+  }
+  if (alphaOverride) scene->alphaOverride = alphaOverride;
+  if (backgroundColor) scene->background = *backgroundColor;
+  return scene;
+}
+
+SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const py::object& alpha,
+                            const py::object& background, std::optional<uint64_t> memoryLimit) {
+  if (!py::isinstance<Scene>(scene)) {
+    if (!py::isinstance<py::str>(scene) && !py::hasattr(scene, "__fspath__"))
+      throw py::type_error("scene: expected an mfr.Scene or a source (str or os.PathLike)");
+    const std::string source = pathText(scene, "scene");
+    return {loadSceneArgument(source, seed, 0.1, alpha, background, memoryLimit), source};
+  }
+  auto loaded = scene.cast<std::shared_ptr<Scene>>();
+  if (alpha.is_none() && background.is_none()) return {loaded, loaded->name};
+  auto changed = std::make_shared<Scene>(*loaded);  // the caller's scene stays as it is
+  if (const auto a = alphaArgument(alpha)) changed->alphaOverride = a;
+  if (!background.is_none()) changed->background = backgroundArgument(background);
+  return {changed, loaded->name};
+}
+
+uint64_t budgetArgument(const py::object& budget) {
+  if (py::isinstance<py::str>(budget)) return unwrap(parseByteSize(budget.cast<std::string>()));
+  if (py::isinstance<py::bool_>(budget) || !py::isinstance<py::int_>(budget))
+    throw LibraryError("budget: expected bytes (an int) or a size such as \"20MB\"");
+  const long long bytes = budget.cast<long long>();
+  if (bytes <= 0) throw LibraryError("budget: must be a positive number of bytes");
+  return static_cast<uint64_t>(bytes);
+}
+
+std::optional<uint64_t> memoryLimitArgument(const py::object& limit) {
+  if (limit.is_none()) return std::nullopt;
+  if (py::isinstance<py::str>(limit)) {
+    auto bytes = parseByteSize(limit.cast<std::string>());
+    if (!bytes)
+      throw LibraryError("memory_limit '" + limit.cast<std::string>() +
+                         "': " + bytes.error().message);
+    return bytes.value();
+  }
+  if (py::isinstance<py::bool_>(limit) || !py::isinstance<py::int_>(limit))
+    throw LibraryError("memory_limit: expected bytes (an int) or a size such as \"8GB\"");
+  const long long bytes = limit.cast<long long>();
+  if (bytes <= 0) throw LibraryError("memory_limit: must be a positive number of bytes");
+  return static_cast<uint64_t>(bytes);
+}
+
+CaptureMode captureArgument(const std::string& capture) {
+  if (capture == "tile") return CaptureMode::TileOwned;
+  if (capture == "parallel") return CaptureMode::FragmentParallel;
+  throw LibraryError("capture '" + capture + "': expected tile or parallel");
+}
+
+RasterOptions rasterArgument(int width, int height, int threads) {
+  if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize)
+    throw LibraryError("width/height " + std::to_string(width) + "x" + std::to_string(height) +
+                       ": must be in [1, " + std::to_string(kMaxImageSize) + "]");
+  if (threads < 0 || threads > 1024)
+    throw LibraryError("threads " + std::to_string(threads) + ": must be in [0, 1024]");
+  RasterOptions ro;
+  ro.width = width;
+  ro.height = height;
+  ro.threads = threads;
+  return ro;
+}
+
+Camera cameraArgument(const Scene& scene, const py::object& camera, const py::object& view,
+                      double zoom) {
+  if (!(zoom >= 0.01 && zoom <= 100.0)) throw LibraryError("zoom: must be in [0.01, 100]");
+  if (!camera.is_none() && !view.is_none())
+    throw LibraryError("view and camera: give one camera, not both");
+  Camera c;
+  if (!camera.is_none()) {
+    if (py::isinstance<py::str>(camera)) {  // the command line's text, "EX,EY,EZ,TX,TY,TZ,..."
+      c = unwrap(parseCameraSpec(camera.cast<std::string>(), "camera"));
+    } else {
+      std::vector<double> v;
+      for (const py::handle item : camera) v.push_back(item.cast<double>());
+      c = unwrap(cameraFromNumbers(v, "camera"));
+    }
+  } else if (!view.is_none()) {
+    const long long i = view.cast<long long>();
+    if (i < 0) throw LibraryError("view: must be a camera index (0-based)");
+    if (i >= static_cast<long long>(scene.cameras.size()))
+      throw LibraryError(scene.name + ": view " + std::to_string(i) + " but the scene has " +
+                         std::to_string(scene.cameras.size()) + " camera(s)");
+    c = scene.cameras[static_cast<size_t>(i)];
+  } else if (scene.defaultCamera) {
+    c = *scene.defaultCamera;
+  } else {
+    c = frameBounds(sceneBounds(scene));
+  }
+  c.eye = c.target + (c.eye - c.target) / static_cast<float>(zoom);
+  return c;
+}
+
+std::shared_ptr<const learn::Model> modelArgument(const py::object& model) {
+  if (py::isinstance<py::str>(model) || py::hasattr(model, "__fspath__")) {
+    const std::string path = pathText(model, "model");
+    learn::Model read;
+    {
+      py::gil_scoped_release release;
+      read = unwrap(learn::readModel(path));
+    }
+    unwrap(checkDkbModel(read, path));
+    return std::make_shared<const learn::Model>(std::move(read));
+  }
+  if (!py::isinstance<learn::Model>(model))
+    throw py::type_error("model: expected an mfr.Model or a .mfrnn path");
+  auto object = model.cast<std::shared_ptr<learn::Model>>();
+  unwrap(checkDkbModel(*object, "(mfr.Model)"));
+  return object;
+}
+
+ImportanceParams importanceArgument(const py::dict& params) {
+  ImportanceParams ip;
+  for (const auto& [key, value] : params) {
+    const std::string k = py::str(key);
+    const auto number = [&](float lo, float hi, bool openLow) {
+      const double v = value.cast<double>();
+      if (!(openLow ? v > lo : v >= lo) || !(v <= hi))
+        throw LibraryError("importance['" + k + "']: must be in " + (openLow ? "(" : "[") +
+                           std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      return static_cast<float>(v);
+    };
+    if (k == "alpha") {
+      ip.alpha = number(0.0f, 1.0f, false);
+    } else if (k == "n_limit") {
+      ip.nLimit = number(1.0f, 1e6f, false);
+    } else if (k == "periphery_d") {
+      ip.peripheryExponent = number(0.0f, 100.0f, true);
+    } else if (k == "noise") {
+      ip.noise = number(0.0f, 1.0f, false);
+    } else if (k == "fovea") {
+      const std::vector<double> v = numbers(value.cast<py::object>(), "importance['fovea']");
+      if (v.size() != 2) throw LibraryError("importance['fovea']: expected two pixel coordinates");
+      ip.fovea = glm::vec2(v[0], v[1]);
+    } else if (k == "depth_term") {
+      ip.useDepth = value.cast<bool>();
+    } else if (k == "periphery_term") {
+      ip.usePeriphery = value.cast<bool>();
+    } else if (k == "fresnel_term") {
+      ip.useFresnel = value.cast<bool>();
+    } else if (k == "noise_term") {
+      ip.useNoise = value.cast<bool>();
+    } else {
+      throw LibraryError("importance: unknown parameter '" + k +
+                         "' (alpha, n_limit, periphery_d, fovea, noise, depth_term, "
+                         "periphery_term, fresnel_term, noise_term)");
+    }
+  }
+  return ip;
+}
+
+Image8 image8Argument(const py::array& image, const char* what) {
+  const std::string name = what;
+  if (image.ndim() != 3 || image.shape(0) < 1 || image.shape(1) < 1)
+    throw py::value_error(name + ": expected an array (height, width, channels), got " +
+                          std::to_string(image.ndim()) + " dimensions");
+  const py::ssize_t h = image.shape(0), w = image.shape(1), c = image.shape(2);
+  if (h > kMaxImageSize || w > kMaxImageSize)
+    throw py::value_error(name + ": larger than " + std::to_string(kMaxImageSize) + " pixels");
+  const py::dtype dtype = image.dtype();
+  if (dtype.is(py::dtype::of<uint8_t>())) {
+    if (c != 3 && c != 4)
+      throw py::value_error(name + ": a uint8 (sRGB) image needs 3 or 4 channels, got " +
+                            std::to_string(c));
+    const auto pixels = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>(image);
+    Image8 out;
+    out.width = static_cast<int>(w);
+    out.height = static_cast<int>(h);
+    out.rgba.resize(static_cast<size_t>(w * h * 4), 255);
+    const uint8_t* src = pixels.data();
+    for (size_t i = 0; i < static_cast<size_t>(w * h); ++i)
+      std::memcpy(&out.rgba[4 * i], src + c * i, static_cast<size_t>(c));
+    return out;
+  }
+  if (dtype.kind() == 'f') {
+    if (c != 3)
+      throw py::value_error(name + ": a floating-point (linear) image needs 3 channels, got " +
+                            std::to_string(c));
+    const auto pixels = py::array_t<float, py::array::c_style | py::array::forcecast>(image);
+    ImageRGB linear(static_cast<int>(w), static_cast<int>(h));
+    std::memcpy(linear.pixels.data(), pixels.data(), sizeof(float) * 3 * linear.pixels.size());
+    return encodeSrgb(linear);
+  }
+  throw py::value_error(name + ": expected uint8 sRGB or floating-point linear values, got dtype " +
+                        std::string(py::str(static_cast<py::handle>(dtype))));
+}
+
+}  // namespace mfr::python

@@ -1,0 +1,97 @@
+"""mfr.compare writes the folder `mfr compare` writes for the same options: same files, same PNG
+bytes, same results.json and results.csv but for timings; and its errors."""
+
+import csv
+import html
+import io
+import os
+import re
+
+import pytest
+
+import mfr
+from conftest import read_json, without_times
+
+SCENE = "procedural:bottles?count=3"
+SIZE = 32
+BUDGETS = ["40KB", "80KB"]
+METHODS = ["fkb", "vkb", "dkb"]
+
+
+@pytest.fixture(scope="module")
+def folders(tmp_path_factory, cli):
+    import subprocess
+    d = tmp_path_factory.mktemp("compare")
+    subprocess.run([cli, "compare", SCENE, "--width", str(SIZE), "--height", str(SIZE),
+                    "--budget", ",".join(BUDGETS), "--methods", ",".join(METHODS),
+                    "--threads", "2", "--out", str(d / "cli"), "--quiet"], check=True)
+    results = mfr.compare(SCENE, d / "py", BUDGETS, methods=METHODS, width=SIZE, height=SIZE,
+                          threads=2)
+    return d / "cli", d / "py", results
+
+
+def csv_without_times(path):
+    rows = list(csv.reader(io.StringIO(path.read_text())))
+    keep = [i for i, name in enumerate(rows[0]) if not (name.startswith("time_") or
+                                                         name == "total_ms")]
+    return [[row[i] for i in keep] for row in rows]
+
+
+def test_same_files_and_images(folders):
+    cli, py, _ = folders
+    files = sorted(os.listdir(cli))
+    assert files == sorted(os.listdir(py))
+    pngs = [f for f in files if f.endswith(".png")]
+    # ground truth, its depth complexity, per run image + flip + k-map, + importance (vkb, dkb)
+    assert len(pngs) == 2 + len(BUDGETS) * (3 * len(METHODS) + 2)
+    for name in pngs:
+        assert (cli / name).read_bytes() == (py / name).read_bytes(), name
+    assert {"results.json", "results.csv", "report.html"} <= set(files)
+
+
+def test_same_results(folders):
+    cli, py, results = folders
+    cli_json, py_json = read_json(cli / "results.json"), read_json(py / "results.json")
+    assert results == py_json  # the returned dict is the file
+    assert without_times(cli_json) == without_times(py_json)
+    assert py_json["mfr_version"] == mfr.__version__
+    assert [b["budget_label"] for b in py_json["budgets"]] == BUDGETS
+    assert csv_without_times(cli / "results.csv") == csv_without_times(py / "results.csv")
+    report = html.unescape((py / "report.html").read_text())
+    assert "mfr.compare('procedural:bottles?count=3'" in report
+    assert "fkb_40KB.png" in report
+
+
+def test_metrics_recomputed_from_the_files(folders):
+    _, py, results = folders
+    run = results["budgets"][1]["methods"][0]
+    m = mfr.metrics(py / results["ground_truth"]["image"], py / run["image"],
+                    ppd=results["flip_pixels_per_degree"])
+    assert m["flip_mean"] == run["flip_mean"] and m["mse_linear"] == run["mse_linear"]
+
+
+def test_compare_errors(tmp_path):
+    kwargs = dict(width=SIZE, height=SIZE)
+    with pytest.raises(mfr.Error, match="method list is empty"):
+        mfr.compare(SCENE, tmp_path / "a", "40KB", methods=[], **kwargs)
+    with pytest.raises(mfr.Error, match="nosuch"):
+        mfr.compare(SCENE, tmp_path / "a", "40KB", methods=["fkb", "nosuch"], **kwargs)
+    with pytest.raises(mfr.Error, match="listed twice"):
+        mfr.compare(SCENE, tmp_path / "a", ["40KB", "40960"], methods=["fkb"], **kwargs)
+    with pytest.raises(mfr.Error, match="none of the methods uses it"):
+        mfr.compare(SCENE, tmp_path / "a", "40KB", methods=["fkb"], model="m.mfrnn", **kwargs)
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    with pytest.raises(mfr.Error, match="cannot create the output folder"):
+        mfr.compare(SCENE, blocker, "40KB", methods=["fkb"], **kwargs)
+    # a budget too small for a method is recorded, not raised
+    r = mfr.compare(SCENE, tmp_path / "b", "2KB", methods=["fkb"], **kwargs)
+    assert "error" in r["methods"][0]
+
+
+def test_default_methods_are_the_clis(run_cli):
+    help_text = run_cli("compare", "--help").stdout
+    default = re.search(r"--methods TEXT +Methods, comma-separated \(default ([a-z0-9+,-]+)\)",
+                        help_text)
+    assert default, help_text
+    assert tuple(default.group(1).split(",")) == mfr.DEFAULT_COMPARE_METHODS

@@ -1,0 +1,398 @@
+// The peer methods (wboit, mboit, mlab) against closed forms computed here in double precision
+// from the fragments' own colours and depths (read off the exact A-buffer's nodes): one layer
+// (every preset exact), N layers of one colour and alpha, two layers in both submission orders,
+// MLAB's order-dependent merge, MBOIT's transmittance bounds against the true step function on
+// random depth sets, MLAB with k >= depth complexity equal to the A-buffer, the documented memory
+// layout within several budgets and sizes, and which command-line options apply to them.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "mfr/core/color.hpp"
+#include "mfr/core/image.hpp"
+#include "mfr/method/mboit.hpp"
+#include "mfr/method/memory_model.hpp"
+#include "mfr/method/method_options.hpp"
+#include "mfr/method/mlab.hpp"
+#include "mfr/method/render.hpp"
+#include "mfr/method/wboit.hpp"
+#include "mfr/scene/draw_order.hpp"
+#include "mfr/scene/load.hpp"
+#include "test_util.hpp"
+#include "tsan/capture_cases.hpp"
+
+namespace mfr {
+namespace {
+
+constexpr int kSize = 16;
+const glm::vec3 kBg(0.2f, 0.4f, 0.6f);
+
+struct Layer {
+  float z;  // world z of the full-screen plane (further away: more negative)
+  glm::vec4 color;
+};
+
+RasterFrame frameOf(const std::vector<Layer>& layers, int size = kSize) {
+  std::vector<test::TestTriangle> tris;
+  for (const Layer& l : layers) {
+    const auto r = test::screenRect(-1, -1, size + 1, size + 1, size, l.z, l.color);
+    tris.insert(tris.end(), r.begin(), r.end());
+  }
+  return std::move(*test::buildFrame(test::makeScene(tris), test::screenCamera(), size, size, 2));
+}
+
+RenderOutput run(const RasterFrame& frame, const std::string& preset,
+                 std::optional<uint64_t> budget = 1u << 20, std::optional<uint32_t> k = {},
+                 CaptureMode mode = CaptureMode::TileOwned) {
+  MethodDesc m = methodPreset(preset).value();
+  if (k) m.k = *k;
+  RenderOptions o;
+  o.background = kBg;
+  o.keepStores = true;
+  o.capture = mode;
+  if (m.allocation != AllocationPolicy::Unbounded) o.budgetBytes = budget;
+  auto out = render(frame, m, o);
+  EXPECT_TRUE(out.ok()) << preset << ": " << (out.ok() ? "" : out.error().message);
+  return std::move(out.value());
+}
+
+// A pixel's fragments as the A-buffer captured them, nearest first: (depth, linear rgb, alpha).
+struct Frag {
+  double d, r, g, b, a;
+  bool operator==(const Frag&) const = default;
+};
+std::vector<std::vector<Frag>> fragmentsOf(const RasterFrame& frame) {
+  const RenderOutput ab = run(frame, "abuffer");
+  std::vector<std::vector<Frag>> out;
+  for (const std::vector<FragmentNode>& nodes : test::capturedSets(ab)) {
+    std::vector<Frag> px;
+    for (FragmentNode n : nodes) {
+      const glm::vec4 c = unpackFragmentColor(nodeColor(n));
+      px.push_back({nodeDepth(n), c.r, c.g, c.b, c.a});
+    }
+    out.push_back(px);
+  }
+  return out;
+}
+
+glm::dvec3 overTruth(const std::vector<Frag>& f) {
+  glm::dvec3 c(0.0);
+  double T = 1.0;
+  for (const Frag& x : f) {
+    c += T * x.a * glm::dvec3(x.r, x.g, x.b);
+    T *= 1.0 - x.a;
+  }
+  return c + T * glm::dvec3(kBg);
+}
+
+// McGuire & Bavoil Eq. 5 with the Eq. 10 weight, written out independently
+glm::dvec3 wboitExpected(const std::vector<Frag>& f) {
+  glm::dvec3 sum(0.0);
+  double sumA = 0.0, reveal = 1.0;
+  for (const Frag& x : f) {
+    const double w = x.a * std::max(0.01, 3000.0 * std::pow(1.0 - x.d, 3.0));
+    sum += w * x.a * glm::dvec3(x.r, x.g, x.b);
+    sumA += w * x.a;
+    reveal *= 1.0 - x.a;
+  }
+  return sum / std::clamp(sumA, 1e-4, 5e4) * (1.0 - reveal) + reveal * glm::dvec3(kBg);
+}
+
+double maxDiff(const ImageRGB& img, size_t p, glm::dvec3 expected) {
+  const glm::dvec3 d = glm::abs(glm::dvec3(img.pixels[p]) - expected);
+  return std::max({d.x, d.y, d.z});
+}
+
+TEST(PeerMethods, OneLayerEveryPresetIsExact) {
+  const RasterFrame frame = frameOf({{-1.0f, {0.8f, 0.3f, 0.1f, 0.6f}}});
+  const auto frags = fragmentsOf(frame);
+  for (const std::string& preset : presetNames()) {
+    const RenderOutput out = run(frame, preset);
+    double worst = 0.0;
+    for (size_t p = 0; p < frags.size(); ++p) {
+      ASSERT_EQ(frags[p].size(), 1u);
+      worst = std::max(worst, maxDiff(out.image, p, overTruth(frags[p])));
+    }
+    EXPECT_LT(worst, 2e-6) << preset;
+  }
+}
+
+TEST(PeerMethods, NLayersOfOneColourAndAlpha) {
+  // one colour and alpha: WBOIT's weighted average is that colour and its coverage 1 - (1-a)^N,
+  // MBOIT's normalised colour too with total transmittance exp(-N ln(1/(1-a))) = (1-a)^N, and
+  // MLAB's merges are "over" of equal layers: all three exact for any N (MLAB even with k = 1)
+  const glm::vec4 c(0.1f, 0.7f, 0.4f, 0.35f);
+  for (int n : {1, 2, 3, 5, 8}) {
+    std::vector<Layer> layers;
+    for (int i = 0; i < n; ++i) layers.push_back({-0.3f - 0.4f * static_cast<float>(i), c});
+    const RasterFrame frame = frameOf(layers);
+    const auto frags = fragmentsOf(frame);
+    for (const char* preset : {"wboit", "mboit", "mlab"})
+      for (std::optional<uint32_t> k : {std::optional<uint32_t>(1), std::optional<uint32_t>()}) {
+        if (k && std::string(preset) != "mlab") continue;
+        const RenderOutput out = run(frame, preset, 1u << 20, k);
+        double worst = 0.0;
+        for (size_t p = 0; p < frags.size(); ++p) {
+          ASSERT_EQ(frags[p].size(), static_cast<size_t>(n));
+          worst = std::max(worst, maxDiff(out.image, p, overTruth(frags[p])));
+        }
+        EXPECT_LT(worst, 2e-5) << preset << " N = " << n << " k " << k.value_or(0);
+      }
+  }
+}
+
+TEST(PeerMethods, TwoLayersInBothOrders) {
+  const Layer nearL{-0.5f, {1.0f, 0.1f, 0.1f, 0.5f}}, farL{-1.5f, {0.1f, 0.2f, 1.0f, 0.7f}};
+  const RasterFrame nearFirst = frameOf({nearL, farL}), farFirst = frameOf({farL, nearL});
+  const auto frags = fragmentsOf(nearFirst);
+  ASSERT_EQ(frags, fragmentsOf(farFirst)) << "the two frames must hold the same fragments";
+  for (const char* preset : {"wboit", "mboit", "mlab"}) {
+    const RenderOutput a = run(nearFirst, preset), b = run(farFirst, preset);
+    // two floats add and multiply commutatively; MLAB with k = 2 >= 2 merges nothing
+    EXPECT_EQ(a.image.pixels, b.image.pixels) << preset << ": depends on the submission order";
+    for (size_t p = 0; p < frags.size(); ++p) {
+      const std::vector<Frag>& f = frags[p];
+      ASSERT_EQ(f.size(), 2u);
+      glm::dvec3 expected;
+      double tol = 2e-6;
+      if (std::string(preset) == "wboit") {
+        expected = wboitExpected(f);
+      } else if (std::string(preset) == "mlab") {
+        expected = overTruth(f);
+      } else {
+        // MBOIT: with two fragments the reconstruction is the 2-point distribution itself, so
+        // T(near) = (1-a_near)^0.25 (overestimation 0.25 of its own absorbance) and
+        // T(far) = (1-a_near) (1-a_far)^0.25; up to the bias 5e-7
+        const double t0 = std::pow(1.0 - f[0].a, 0.25);
+        const double t1 = (1.0 - f[0].a) * std::pow(1.0 - f[1].a, 0.25);
+        const glm::dvec3 acc = t0 * f[0].a * glm::dvec3(f[0].r, f[0].g, f[0].b) +
+                               t1 * f[1].a * glm::dvec3(f[1].r, f[1].g, f[1].b);
+        const double accA = t0 * f[0].a + t1 * f[1].a;
+        const double total = (1.0 - f[0].a) * (1.0 - f[1].a);
+        expected = (1.0 - total) * acc / accA + total * glm::dvec3(kBg);
+        tol = 1e-3;
+      }
+      ASSERT_LT(maxDiff(a.image, p, expected), tol) << preset << " pixel " << p;
+    }
+  }
+  // WBOIT is not "over": it is measurably off here (the over result differs)
+  const RenderOutput w = run(nearFirst, "wboit");
+  EXPECT_GT(maxDiff(w.image, 0, overTruth(frags[0])), 1e-2);
+}
+
+TEST(PeerMethods, MlabMergesTheTwoFarthestInArrivalOrder) {
+  // k = 1, fragments arriving far, near, middle: near goes in front of far and far is merged
+  // behind it; the middle one arrives behind the merged node and is merged behind it too, so MLAB
+  // composites near, far, middle (the known order error of a full store)
+  const Layer nearL{-0.5f, {1.0f, 0.2f, 0.1f, 0.5f}}, midL{-1.0f, {0.1f, 1.0f, 0.2f, 0.6f}},
+      farL{-1.5f, {0.1f, 0.2f, 1.0f, 0.7f}};
+  const RasterFrame frame = frameOf({farL, nearL, midL});
+  const auto frags = fragmentsOf(frame);
+  const RenderOutput out = run(frame, "mlab", 1u << 20, 1u);
+  EXPECT_EQ(out.stats.lost, 2u * frags.size());  // two merges per pixel
+  for (size_t p = 0; p < frags.size(); ++p) {
+    const std::vector<Frag>& f = frags[p];  // nearest first: near, mid, far
+    ASSERT_EQ(f.size(), 3u);
+    const glm::dvec3 expected = overTruth({f[0], f[2], f[1]});
+    ASSERT_LT(maxDiff(out.image, p, expected), 2e-6) << p;
+    ASSERT_GT(maxDiff(out.image, p, overTruth(f)), 1e-3) << p;
+  }
+  // with k = 2: [far] -> [near, far] -> mid lands between, far merged behind mid: exact
+  const RenderOutput two = run(frame, "mlab", 1u << 20, 2u);
+  for (size_t p = 0; p < frags.size(); ++p)
+    ASSERT_LT(maxDiff(two.image, p, overTruth(frags[p])), 2e-6) << p;
+}
+
+TEST(PeerMethods, MboitTransmittanceBoundsTheTrueStepFunction) {
+  // overestimation 0 gives a lower bound on the absorbance in front of z (T at or above the true
+  // transmittance of the fragments strictly in front), 1 an upper bound (T at or below the
+  // transmittance including the fragments at z); 0.25 lies between. The paper's bias 5e-7 and
+  // float32 moments loosen the bounds by at most `tol` (measured 1e-6 over these sets).
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u01(0.0f, 1.0f), alpha(0.05f, 0.9f);
+  std::uniform_int_distribution<int> count(1, 12);
+  const double tol = 1e-4;  // measured: 1e-6
+  double worst = 0.0;
+  int queries = 0;
+  for (int set = 0; set < 300; ++set) {
+    MboitPixel px;
+    std::vector<std::pair<float, float>> frags;  // depth, alpha
+    const int n = count(rng);
+    for (int i = 0; i < n; ++i) {
+      frags.push_back({u01(rng), alpha(rng)});
+      px.addMoments(frags.back().first, frags.back().second);
+    }
+    std::vector<float> zs;
+    for (int i = 0; i < 8; ++i) zs.push_back(u01(rng));
+    for (const auto& f : frags) zs.push_back(f.first);
+    for (float z : zs) {
+      double strict = 1.0, inclusive = 1.0;
+      for (const auto& [d, a] : frags) {
+        const double t = 1.0 - std::min(a, kMboitMaxAlpha);
+        if (d < z) strict *= t;
+        if (d <= z) inclusive *= t;
+      }
+      const float w = mboitWarpDepth(z);
+      const double lower = mboitTransmittance(px.b0, px.moments, w, kMboitBias, 1.0f);
+      const double upper = mboitTransmittance(px.b0, px.moments, w, kMboitBias, 0.0f);
+      const double mid = mboitTransmittance(px.b0, px.moments, w);
+      ASSERT_GE(upper, strict - tol) << "set " << set << " z " << z;
+      ASSERT_LE(lower, inclusive + tol) << "set " << set << " z " << z;
+      ASSERT_LE(mid, upper + 1e-6);
+      ASSERT_GE(mid, lower - 1e-6);
+      worst = std::max({worst, strict - upper, lower - inclusive});
+      ++queries;
+    }
+  }
+  EXPECT_GT(queries, 3000);
+  RecordProperty("worst_bound_violation", std::to_string(worst));
+}
+
+TEST(PeerMethods, MlabWithKAtLeastDepthComplexityEqualsTheABuffer) {
+  for (const char* spec : {"procedural:hairball?strands=120", "procedural:bottles"}) {
+    const Scene scene = loadScene(spec).value();
+    const auto frame = test::buildFrame(scene, *scene.defaultCamera, 48, 40, 2);
+    ASSERT_TRUE(frame);
+    const RenderOutput ab = run(*frame, "abuffer");
+    const uint32_t maxN = ab.stats.maxDepthComplexity.value();
+    ASSERT_GT(maxN, 4u) << spec;
+    const RenderOutput mlab = run(*frame, "mlab", std::nullopt, maxN);
+    EXPECT_EQ(mlab.stats.lost, 0u);
+    double worst = 0.0;
+    for (size_t p = 0; p < ab.image.pixels.size(); ++p)
+      worst = std::max(worst, maxDiff(mlab.image, p, glm::dvec3(ab.image.pixels[p])));
+    EXPECT_LT(worst, 1e-5) << spec;  // a c T vs. c (a T): float rounding only
+    // and in fewer nodes it is not the A-buffer any more
+    const RenderOutput small = run(*frame, "mlab", std::nullopt, 1u);
+    EXPECT_GT(small.stats.lost, 0u);
+  }
+}
+
+TEST(PeerMethods, BudgetsFollowTheDocumentedLayout) {
+  const Scene scene = loadScene("procedural:bottles").value();
+  for (auto [w, h] : {std::pair{16, 16}, std::pair{40, 24}, std::pair{64, 48}}) {
+    const auto frame = test::buildFrame(scene, *scene.defaultCamera, w, h, 2);
+    ASSERT_TRUE(frame);
+    const uint64_t P = static_cast<uint64_t>(w) * h;
+    for (bool parallel : {false, true}) {
+      const CaptureMode mode = parallel ? CaptureMode::FragmentParallel : CaptureMode::TileOwned;
+      const uint64_t lock = parallel ? 4 : 0;  // wboit/mboit need it only in parallel mode
+      for (uint64_t perPixelBudget : {21ull, 36ull, 40ull, 75ull, 200ull}) {
+        const uint64_t M = perPixelBudget * P + 13;
+        // documented: wboit 20 B/pixel, mboit 36 B/pixel, mlab 4 counter + 4 lock + 20 k
+        const std::pair<const char*, uint64_t> fixed[] = {{"wboit", 20 + lock},
+                                                          {"mboit", 36 + lock}};
+        for (const auto& [preset, perPixel] : fixed) {
+          MethodDesc m = methodPreset(preset).value();
+          RenderOptions o;
+          o.budgetBytes = M;
+          o.capture = mode;
+          auto out = render(*frame, m, o);
+          if (perPixel * P > M) {
+            ASSERT_FALSE(out.ok()) << preset << " " << M;
+            EXPECT_NE(out.error().message.find("too small for " + std::string(preset)),
+                      std::string::npos)
+                << out.error().message;
+            EXPECT_EQ(out.error().message.find('\n'), std::string::npos);
+            continue;
+          }
+          ASSERT_TRUE(out.ok()) << preset << ": " << out.error().message;
+          EXPECT_EQ(out->stats.bytesUsed, perPixel * P) << preset;
+          EXPECT_LE(out->stats.bytesUsed, M);
+          EXPECT_EQ(out->stats.lost, 0u);
+          EXPECT_EQ(MemoryModel::of(m, parallel).fragmentSlots(M, P), 0u) << "F(M): no nodes";
+        }
+        MethodDesc m = methodPreset("mlab").value();
+        RenderOptions o;
+        o.budgetBytes = M;
+        o.capture = mode;
+        auto out = render(*frame, m, o);
+        const uint64_t k = M > 8 * P ? (M - 8 * P) / 20 / P : 0;
+        if (k == 0) {
+          ASSERT_FALSE(out.ok()) << M;
+          EXPECT_NE(out.error().message.find("too small"), std::string::npos);
+          continue;
+        }
+        ASSERT_TRUE(out.ok()) << out.error().message;
+        EXPECT_EQ(out->stats.globalK, k);
+        EXPECT_EQ(out->stats.bytesUsed, 8 * P + 20 * k * P);
+        EXPECT_LE(out->stats.bytesUsed, M);
+        EXPECT_EQ(out->stats.bytesByCategory.at("nodes"), 20 * k * P);
+      }
+    }
+  }
+}
+
+TEST(PeerMethods, OptionsThatApply) {
+  const MethodDesc wboit = methodPreset("wboit").value(), mboit = methodPreset("mboit").value(),
+                   mlab = methodPreset("mlab").value(), fkb = methodPreset("fkb").value();
+  EXPECT_TRUE(checkMethodOption(MethodOption::K, mlab).ok());
+  EXPECT_FALSE(checkMethodOption(MethodOption::K, wboit).ok());
+  EXPECT_FALSE(checkMethodOption(MethodOption::K, mboit).ok());
+  for (const MethodDesc* m : {&wboit, &mboit, &mlab})
+    EXPECT_FALSE(checkMethodOption(MethodOption::Composite, *m).ok()) << m->name;
+  EXPECT_TRUE(checkMethodOption(MethodOption::Composite, fkb).ok());
+  for (const char* p : {"wboit+occupancy", "mboit+occupancy", "mlab+occupancy"})
+    EXPECT_FALSE(methodPreset(p).ok()) << p;
+  // a desc pairing a peer rule with another allocation is refused, not run
+  MethodDesc bad = fkb;
+  bad.compositing = Compositing::WeightedBlended;
+  const RasterFrame frame = frameOf({{-1.0f, {1, 1, 1, 0.5f}}});
+  RenderOptions o;
+  o.budgetBytes = 1u << 20;
+  EXPECT_FALSE(render(frame, bad, o).ok());
+}
+
+// --shuffle-draw-order: the same scene with its triangles submitted in a seeded random order.
+// Exact and k-buffer methods keep the same nearest set (the node order (depth, colour) is total)
+// and, with the kbuffer rule, give byte-identical images; hybrid tails, WBOIT and MBOIT sum in
+// another order (tolerances below: 1e-5 linear for the hybrid tail and WBOIT, 5e-3 for MBOIT);
+// MLAB with k >= n(p) merges nothing and is byte-identical.
+TEST(PeerMethods, ShuffledDrawOrderOverEveryPreset) {
+  for (const char* spec :
+       {"procedural:hairball?strands=120", "procedural:bottles", "procedural:smoke"}) {
+    const Scene scene = loadScene(spec).value();
+    Scene shuffled = scene;
+    shuffleDrawOrder(shuffled, 1234);
+    ASSERT_NE(scene.indices, shuffled.indices);
+    const auto a = test::buildFrame(scene, *scene.defaultCamera, 40, 40, 2);
+    const auto b = test::buildFrame(shuffled, *scene.defaultCamera, 40, 40, 2);
+    ASSERT_TRUE(a && b);
+    const uint64_t budget = 40 * 40 * 44;  // overflows every bounded k-buffer here
+    for (const std::string& preset : presetNames()) {
+      const RenderOutput x = run(*a, preset, budget), y = run(*b, preset, budget);
+      const std::string what = std::string(spec) + " " + preset;
+      const MethodDesc m = methodPreset(preset).value();
+      float worst = 0.0f;
+      for (size_t p = 0; p < x.image.pixels.size(); ++p) {
+        const glm::vec3 d = glm::abs(x.image.pixels[p] - y.image.pixels[p]);
+        worst = std::max({worst, d.r, d.g, d.b});
+      }
+      if (kBufferFamilyRule(m.compositing)) {
+        EXPECT_EQ(test::capturedSets(x), test::capturedSets(y)) << what;
+        if (m.compositing == Compositing::KBuffer)
+          EXPECT_EQ(encodeSrgb(x.image).rgba, encodeSrgb(y.image).rgba) << what;
+        else
+          EXPECT_LT(worst, 1e-5f) << what << " (hybrid tail sums)";
+      } else if (preset == "mlab") {
+        const uint32_t maxN = run(*a, "abuffer").stats.maxDepthComplexity.value();
+        const RenderOutput xk = run(*a, preset, std::nullopt, maxN),
+                           yk = run(*b, preset, std::nullopt, maxN);
+        EXPECT_EQ(encodeSrgb(xk.image).rgba, encodeSrgb(yk.image).rgba) << what;
+      } else {
+        // WBOIT's sums: last bits only; MBOIT's reconstruction from float32 moments (bias 5e-7)
+        // amplifies the moments' last-bit differences (measured up to 1.4e-3 linear here)
+        EXPECT_LT(worst, preset == "wboit" ? 1e-5f : 5e-3f) << what << " (sums in another order)";
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mfr
