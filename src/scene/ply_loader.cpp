@@ -132,6 +132,8 @@ class PlyChecker {
       if (w.empty() || w[0] == "comment" || w[0] == "obj_info") continue;
       if (w[0] == "end_header") break;
       if (w[0] == "format") {
+        // assimp and this check would read different formats (and assimp leaks on it)
+        if (haveFormat) return "PLY header has a second format line";
         if (w.size() != 3 || w[2] != "1.0") return "bad PLY format line";
         if (w[1] == "ascii")
           format_ = PlyFormat::Ascii;
