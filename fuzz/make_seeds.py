@@ -199,6 +199,16 @@ def ply_seeds():
           "0 0 0 255 0 0\n1 0 0 0 255 0\n1 1 0 0 0 255\n0 1 0 9 9 9\n0.5 0.5 1 1 2 3\n"
           "4 0 1 2 3\n3 0 1 4\n0 1\n")
     write("ply", "truncated.ply", "ply\nformat ascii 1.0\nelement vertex 3\nend_header\n1 2\n")
+    xyz = "property float x\nproperty float y\nproperty float z\n"
+    write("ply", "tristrips.ply",
+          "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + "element tristrips 1\n"
+          "property list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n1 1 0\n"
+          "6 0 1 2 -1 900 901\n")
+    write("ply", "face_extra_lists.ply",
+          "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + "property float s\nproperty float t\n"
+          "element face 1\nproperty list uchar int vertex_indices\nproperty uchar red\n"
+          "property list uchar float texcoord\nend_header\n0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n"
+          "3 0 1 2 7 4 0.1 0.2 0.3 0.4\n")
 
 
 def json_scene_seeds():

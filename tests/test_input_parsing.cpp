@@ -1,9 +1,13 @@
-// The small parsers of user input the fuzzers (fuzz/) drive: --camera (parseCameraSpec), byte
-// sizes, method names and compositing rules quoting hostile text on one line, and the procedural
-// triangle cap (LoadOptions::maxProceduralTriangles).
+// The small parsers of user input the fuzzers (fuzz/) drive: --camera (parseCameraSpec); byte
+// sizes, method names and compositing rules quoting hostile text on one line; the procedural
+// triangle cap (LoadOptions::maxProceduralTriangles); PLY headers that assimp would misread.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -98,6 +102,44 @@ TEST(ProceduralLimit, TriangleCapIsCheckedBeforeBuilding) {
   ASSERT_FALSE(loaded.ok());
   EXPECT_NE(loaded.error().message.find("limit 100"), std::string::npos) << loaded.error().message;
   EXPECT_TRUE(loadScene("procedural:layers?k=8&r=16").ok()) << "the default cap is 50 million";
+}
+
+// PLY headers that assimp reads otherwise than mfr's structure check (found by fuzz/fuzz_ply.cpp:
+// a heap overflow inside assimp, an assertion, a leak) are refused before assimp sees them.
+TEST(PlyHeaders, WhatAssimpMisreadsIsRefusedWithOneLine) {
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("mfr_ply_headers_" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string xyz = "property float x\nproperty float y\nproperty float z\n";
+  const std::string faces = "element face 1\nproperty list uchar int vertex_indices\n";
+  const std::string body = "end_header\n0 0 0\n1 0 0\n1 1 0\n3 0 1 2\n";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"ply\nformat ascii 1.0\nelement vertex 1\n" + xyz + "element vertex 2\n" + xyz + faces +
+           body,
+       "element 'vertex' is declared twice"},
+      {"ply\nformat ascii 1.0\nformat binary_big_endian 1.0\nelement vertex 3\n" + xyz + faces +
+           body,
+       "second format line"},
+      {"ply\nformat ascii 1.0\nelement vertex 3\n" + xyz +
+           std::string("property float \0nx\n", 19) + faces + body,
+       "control character"},
+  };
+  int i = 0;
+  for (const auto& [text, expected] : cases) {
+    const std::string path = (dir / ("case" + std::to_string(i++) + ".ply")).string();
+    std::ofstream(path, std::ios::binary) << text;
+    auto scene = loadScene(path);
+    ASSERT_FALSE(scene.ok()) << expected;
+    EXPECT_TRUE(isOneLine(scene.error().message)) << scene.error().message;
+    EXPECT_NE(scene.error().message.find(expected), std::string::npos) << scene.error().message;
+    EXPECT_NE(scene.error().message.find(path), std::string::npos) << scene.error().message;
+  }
+  // the same file with one vertex element and one format line loads
+  const std::string good = (dir / "good.ply").string();
+  std::ofstream(good, std::ios::binary)
+      << "ply\nformat ascii 1.0\nelement vertex 3\n" + xyz + faces + body;
+  EXPECT_TRUE(loadScene(good).ok());
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

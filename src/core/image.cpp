@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <limits>
 #include <string>
+#include <string_view>
 
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/color.hpp"
@@ -60,6 +61,25 @@ Result<void> writePng(const std::string& path, const Image8& image) {
   return {};
 }
 
+Result<void> checkPngChunks(const uint8_t* bytes, size_t size, const std::string& what) {
+  static const uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (size < 8 || !std::equal(bytes, bytes + 8, kSignature)) return {};
+  size_t offset = 8;
+  while (size - offset >= 8) {  // length and type; data and CRC follow
+    const uint32_t length = uint32_t{bytes[offset]} << 24 | uint32_t{bytes[offset + 1]} << 16 |
+                            uint32_t{bytes[offset + 2]} << 8 | uint32_t{bytes[offset + 3]};
+    const std::string_view type(reinterpret_cast<const char*>(bytes + offset + 4), 4);
+    const size_t left = size - offset - 8;
+    if (length > left || left - length < 4)
+      return makeError(what + ": PNG chunk " + quoteInput(type) + " declares " +
+                       std::to_string(length) + " bytes, the file has " +
+                       std::to_string(left >= 4 ? left - 4 : 0) + " left");
+    offset += 12 + size_t{length};
+    if (type == "IEND") break;
+  }
+  return {};
+}
+
 Result<Image8> readPng(const std::string& path) {
   // a regular file (a FIFO is refused, not waited on) of less than 2 GiB
   auto bytes = readRegularFileBytes(path, path, std::numeric_limits<int>::max());
@@ -67,6 +87,7 @@ Result<Image8> readPng(const std::string& path) {
   static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (bytes->size() < 8 || !std::equal(bytes->begin(), bytes->begin() + 8, kSignature))
     return makeError(path + ": not a PNG file");
+  MFR_TRY(checkPngChunks(bytes->data(), bytes->size(), path));
   const auto size = static_cast<int>(bytes->size());
   int w = 0, h = 0, n = 0;
   if (!stbi_info_from_memory(bytes->data(), size, &w, &h, &n)) {

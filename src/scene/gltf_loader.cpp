@@ -33,6 +33,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mfr/core/file_access.hpp"
+#include "mfr/core/image.hpp"
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
@@ -735,6 +736,8 @@ Result<void> GltfSceneBuilder::decodeTextures() {
     const auto imageIndex = static_cast<size_t>(image);
     if (imageIndex >= images_.bytes.size() || images_.bytes[imageIndex].empty()) continue;
     const std::vector<unsigned char>& bytes = images_.bytes[imageIndex];
+    if (auto chunks = checkPngChunks(bytes.data(), bytes.size(), nameOf(imageIndex)); !chunks)
+      return fail(chunks.error().message);  // before stb allocates what a chunk declares
     int width = 0, height = 0, channels = 0;
     if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max()) ||
         !stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &width, &height,

@@ -10,6 +10,7 @@
 #include <filesystem>
 
 #include "mfr/core/file_access.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/scene/procedural.hpp"
 
 namespace mfr {
@@ -50,8 +51,10 @@ Result<Scene> loadScene(const std::string& source, const LoadOptions& options) {
                              : loadFile(source, options);
   if (!loaded) {  // make sure the message names the source (procedural errors may not)
     const std::string& message = loaded.error().message;
-    if (message.find(source) == std::string::npos) return makeError(source + ": " + message);
-    return loaded.error();
+    // one line whatever the source and the file hold (a name or a key may contain newlines)
+    if (message.find(source) == std::string::npos)
+      return makeError(oneLine(source, 200) + ": " + oneLine(message));
+    return makeError(oneLine(message));
   }
   Scene scene = std::move(*loaded);
   scene.name = source;

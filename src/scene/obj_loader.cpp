@@ -34,6 +34,7 @@
 #include <vector>
 
 #include "mfr/core/file_access.hpp"
+#include "mfr/core/image.hpp"
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
@@ -132,6 +133,7 @@ Result<Texture> loadTexture(const fs::path& file, const std::string& what, uint6
   auto bytes = readRegularFileBytes(
       file, what, std::min<uint64_t>(memoryLimit, std::numeric_limits<int>::max()));
   if (!bytes) return bytes.error();
+  MFR_TRY(checkPngChunks(bytes->data(), bytes->size(), what));  // before stb trusts a chunk length
   const auto size = static_cast<int>(bytes->size());
   int width = 0, height = 0, channels = 0;
   if (stbi_info_from_memory(bytes->data(), size, &width, &height, &channels)) {

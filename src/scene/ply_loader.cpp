@@ -150,6 +150,10 @@ class PlyChecker {
         const unsigned long long count = std::strtoull(w[2].c_str(), &end, 10);
         if (*end != '\0' || w[2][0] == '-' || count > std::numeric_limits<uint32_t>::max())
           return "bad PLY element count '" + w[2] + "'";
+        // assimp fills the first element of a name with the data of all of them (a heap
+        // overflow when a later "vertex" element is larger): names must be unique
+        for (const PlyElement& e : elements_)
+          if (e.name == w[1]) return "PLY element " + quoteInput(w[1]) + " is declared twice";
         elements_.push_back({w[1], count, {}});
       } else if (w[0] == "property") {
         if (elements_.empty()) return "PLY property before any element";
