@@ -24,9 +24,9 @@
 
 #include "mfr/core/image.hpp"
 #include "mfr/core/result.hpp"
+#include "mfr/cpu/raster_frame.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/method.hpp"
-#include "mfr/method/render.hpp"
-#include "mfr/raster/raster_frame.hpp"
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/load.hpp"
 

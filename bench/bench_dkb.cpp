@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "bench_common.hpp"
+#include "mfr/cpu/deep_importance.hpp"
 #include "mfr/learn/model_file.hpp"
-#include "mfr/method/deep_importance.hpp"
 
 namespace {
 

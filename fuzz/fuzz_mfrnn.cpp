@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "fuzz_util.hpp"
+#include "mfr/cpu/deep_importance.hpp"
 #include "mfr/learn/model_file.hpp"
-#include "mfr/method/deep_importance.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   auto model = mfr::learn::decodeModel(data, size, "fuzz.mfrnn");

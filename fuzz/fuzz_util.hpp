@@ -21,9 +21,9 @@
 #include <system_error>
 
 #include "mfr/core/result.hpp"
+#include "mfr/cpu/raster_frame.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/method.hpp"
-#include "mfr/method/render.hpp"
-#include "mfr/raster/raster_frame.hpp"
 #include "mfr/scene/load.hpp"
 #include "mfr/scene/scene.hpp"
 

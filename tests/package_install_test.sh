@@ -19,8 +19,8 @@ libdir=$(cd "$prefix" && dirname "$(find . -name libmfr.a | head -1)")
 libdir=${libdir#./}
 
 # --- installed files ---------------------------------------------------------------------------
-for f in bin/mfr include/mfr/mfr.hpp include/mfr/method/render.hpp include/mfr/scene/load.hpp \
-         include/mfr/raster/raster_frame_impl.hpp "$libdir/libmfr.a" \
+for f in bin/mfr include/mfr/mfr.hpp include/mfr/cpu/render.hpp include/mfr/engine/engine.hpp include/mfr/scene/load.hpp \
+         include/mfr/cpu/raster_frame_impl.hpp "$libdir/libmfr.a" \
          "$libdir/cmake/mfr/mfrConfig.cmake" "$libdir/cmake/mfr/mfrConfigVersion.cmake" \
          "$libdir/cmake/mfr/mfrTargets.cmake" "$libdir/pkgconfig/mfr.pc" \
          share/mfr/models/dkb-default.mfrnn; do

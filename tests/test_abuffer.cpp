@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-#include "mfr/method/render.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/scene/load.hpp"
 #include "mfr/scene/procedural_geometry.hpp"
 #include "test_util.hpp"

@@ -23,7 +23,7 @@
 #include "cli_runner.hpp"
 #include "gltf_quads.hpp"
 #include "mfr/core/image.hpp"
-#include "mfr/method/render.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/scene/load.hpp"
 #include "reference_shading.hpp"
 

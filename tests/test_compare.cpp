@@ -16,6 +16,7 @@
 
 #include "cli_runner.hpp"
 #include "mfr/compare/compare.hpp"
+#include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
 #include "mfr/scene/camera.hpp"
@@ -36,17 +37,19 @@ const std::vector<std::string> kMethods = {"fkb", "kplus-dynamic", "vkb", "vkb-f
 
 // ---- library -------------------------------------------------------------------------------
 
-RasterFrame makeFrame() {
-  auto scene = loadScene(kScene);
-  EXPECT_TRUE(scene.ok());
-  RasterOptions ro;
-  ro.width = ro.height = kSize;
-  ro.threads = 2;
+CpuEngine& engine() {
+  static CpuEngine cpu(EngineOptions{2, 16});
+  return cpu;
+}
+
+// The scene outlives every view of it (a view may point at its textures).
+std::unique_ptr<PreparedView> makeView() {
+  static const Scene scene = loadScene(kScene).value();
   const Camera camera =
-      scene->defaultCamera ? *scene->defaultCamera : frameBounds(sceneBounds(scene.value()));
-  auto frame = RasterFrame::build(scene.value(), camera, ro);
-  EXPECT_TRUE(frame.ok());
-  return std::move(frame.value());
+      scene.defaultCamera ? *scene.defaultCamera : frameBounds(sceneBounds(scene));
+  auto view = engine().prepare(View{&scene, camera, kSize, kSize});
+  EXPECT_TRUE(view.ok());
+  return std::move(view.value());
 }
 
 CompareOptions defaultOptions() {
@@ -60,7 +63,7 @@ CompareOptions defaultOptions() {
 class CompareLibrary : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    frame_ = new RasterFrame(makeFrame());
+    view_ = makeView().release();
     int calls = 0, lastDone = -1, lastTotal = -1;
     CompareOptions o = defaultOptions();
     o.progress = [&](const std::string&, int done, int total) {
@@ -68,7 +71,7 @@ class CompareLibrary : public ::testing::Test {
       lastDone = done;
       lastTotal = total;
     };
-    auto r = runComparison(*frame_, o);
+    auto r = runComparison(engine(), *view_, o);
     ASSERT_TRUE(r.ok()) << r.error().message;
     result_ = new CompareResult(std::move(r.value()));
     EXPECT_GT(calls, 10);
@@ -77,19 +80,19 @@ class CompareLibrary : public ::testing::Test {
   }
   static void TearDownTestSuite() {
     delete result_;
-    delete frame_;
+    delete view_;
     result_ = nullptr;
-    frame_ = nullptr;
+    view_ = nullptr;
   }
   static const CompareRun& run(size_t budget, const std::string& method) {
     for (const CompareRun& r : result_->budgets.at(budget).runs)
       if (r.method == method) return r;
     throw std::runtime_error("no run " + method);
   }
-  static RasterFrame* frame_;
+  static PreparedView* view_;
   static CompareResult* result_;
 };
-RasterFrame* CompareLibrary::frame_ = nullptr;
+PreparedView* CompareLibrary::view_ = nullptr;
 CompareResult* CompareLibrary::result_ = nullptr;
 
 TEST_F(CompareLibrary, EveryMethodAtEveryBudgetInOrder) {
@@ -310,9 +313,9 @@ TEST_F(CompareLibrary, HtmlReportIsSelfContainedAndShowsEverything) {
 }
 
 TEST(CompareOptionsCheck, BadOptionsAreErrorsNamingTheInput) {
-  static const RasterFrame frame = makeFrame();
+  static const std::unique_ptr<PreparedView> view = makeView();
   const auto error = [&](CompareOptions o) {
-    auto r = runComparison(frame, o);
+    auto r = runComparison(engine(), *view, o);
     return r.ok() ? std::string() : r.error().message;
   };
   CompareOptions o = defaultOptions();
@@ -331,13 +334,13 @@ TEST(CompareOptionsCheck, BadOptionsAreErrorsNamingTheInput) {
 }
 
 TEST(CompareOptionsCheck, SingleBudgetHasNoPlotsAndHybridIsRecorded) {
-  static const RasterFrame frame = makeFrame();
+  static const std::unique_ptr<PreparedView> view = makeView();
   CompareOptions o;
   o.methods = {"kplus-sb"};
   o.budgets = {1u << 20};
   o.compositing = Compositing::Hybrid;
   o.scene = kScene;
-  auto r = runComparison(frame, o);
+  auto r = runComparison(engine(), *view, o);
   ASSERT_TRUE(r.ok()) << r.error().message;
   ASSERT_TRUE(r->budgets[0].runs[0].ok()) << *r->budgets[0].runs[0].error;
   EXPECT_EQ(r->budgets[0].label, "1MB");

@@ -54,7 +54,7 @@ void expectThreadIndependent(const std::string& preset, const std::string& compo
     ASSERT_EQ(run.exitCode, 0) << preset << " " << composite << " threads " << threads << ": "
                                << run.err;
     const nlohmann::json j = nlohmann::json::parse(readBytes(stats));
-    EXPECT_EQ(j["tile_workers"], threads) << "the cap was not lifted";
+    EXPECT_EQ(j["engine_counters"]["tile_workers"], threads) << "the cap was not lifted";
     if (!peer) {
       EXPECT_EQ(j["compositing"], composite);
     }

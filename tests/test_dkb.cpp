@@ -11,13 +11,13 @@
 #include <nlohmann/json.hpp>
 
 #include "mfr/core/color.hpp"
+#include "mfr/cpu/deep_importance.hpp"
+#include "mfr/cpu/optimal_oracle.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/learn/model_file.hpp"
-#include "mfr/method/deep_importance.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/optimal_allocation.hpp"
-#include "mfr/method/optimal_oracle.hpp"
-#include "mfr/method/render.hpp"
 #include "mfr/scene/load.hpp"
 #include "test_util.hpp"
 

@@ -13,7 +13,7 @@
 #include <tuple>
 #include <vector>
 
-#include "mfr/capture/fragment_stores.hpp"
+#include "mfr/cpu/fragment_stores.hpp"
 
 namespace mfr {
 namespace {

@@ -7,8 +7,8 @@
 #include <map>
 #include <string>
 
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/memory_model.hpp"
-#include "mfr/method/render.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr {

@@ -12,8 +12,8 @@
 #include <string>
 #include <vector>
 
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/memory_model.hpp"
-#include "mfr/method/render.hpp"
 #include "mfr/scene/load.hpp"
 #include "test_util.hpp"
 #include "tsan/capture_cases.hpp"

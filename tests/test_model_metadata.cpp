@@ -11,9 +11,9 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "mfr/cpu/deep_importance.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/learn/model_file.hpp"
-#include "mfr/method/deep_importance.hpp"
 
 namespace mfr {
 namespace {

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "mfr/capture/occupancy_map.hpp"
+#include "mfr/cpu/occupancy_map.hpp"
 
 namespace mfr {
 namespace {

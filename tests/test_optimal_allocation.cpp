@@ -5,10 +5,10 @@
 #include <random>
 
 #include "mfr/core/color.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/compositing.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/optimal_allocation.hpp"
-#include "mfr/method/render.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr {

@@ -16,11 +16,11 @@
 
 #include "mfr/core/color.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/mboit.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/method/mlab.hpp"
-#include "mfr/method/render.hpp"
 #include "mfr/method/wboit.hpp"
 #include "mfr/scene/draw_order.hpp"
 #include "mfr/scene/load.hpp"

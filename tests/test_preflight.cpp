@@ -16,9 +16,9 @@
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/memory_limit.hpp"
+#include "mfr/cpu/raster_frame.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/method.hpp"
-#include "mfr/method/render.hpp"
-#include "mfr/raster/raster_frame.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace {

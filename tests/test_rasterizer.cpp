@@ -6,7 +6,7 @@
 #include <random>
 
 #include "mfr/core/color.hpp"
-#include "mfr/raster/raster_frame.hpp"
+#include "mfr/cpu/raster_frame.hpp"
 #include "test_util.hpp"
 
 namespace mfr {

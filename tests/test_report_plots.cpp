@@ -24,6 +24,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mfr/compare/compare.hpp"
+#include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/load.hpp"
 #include "mfr/scene/scene.hpp"
@@ -288,17 +289,14 @@ const std::vector<Scenario>& scenarios() {
   return s;
 }
 
-RasterFrame makeFrame() {
-  auto scene = loadScene(kScene);
-  EXPECT_TRUE(scene.ok()) << (scene.ok() ? std::string() : scene.error().message);
-  RasterOptions ro;
-  ro.width = ro.height = kSize;
-  ro.threads = 2;
+// The scene outlives every view of it (a view may point at its textures).
+std::unique_ptr<PreparedView> makeView(Engine& engine) {
+  static const Scene scene = loadScene(kScene).value();
   const Camera camera =
-      scene->defaultCamera ? *scene->defaultCamera : frameBounds(sceneBounds(scene.value()));
-  auto frame = RasterFrame::build(scene.value(), camera, ro);
-  EXPECT_TRUE(frame.ok());
-  return std::move(frame.value());
+      scene.defaultCamera ? *scene.defaultCamera : frameBounds(sceneBounds(scene));
+  auto view = engine.prepare(View{&scene, camera, kSize, kSize});
+  EXPECT_TRUE(view.ok());
+  return std::move(view.value());
 }
 
 struct PlotSpec {
@@ -317,13 +315,14 @@ class ReportPlots : public ::testing::TestWithParam<size_t> {};
 
 TEST_P(ReportPlots, EveryPlottedPointIsTheJsonValue) {
   const Scenario& sc = scenarios()[GetParam()];
-  const RasterFrame frame = makeFrame();
+  CpuEngine engine(EngineOptions{2, 16});
+  const std::unique_ptr<PreparedView> view = makeView(engine);
   CompareOptions o;
   o.methods = sc.methods;
   o.budgets = sc.budgets;
   o.scene = kScene;
   o.compositing = Compositing::KBuffer;  // explicit: independent of the presets' defaults
-  auto r = runComparison(frame, o);
+  auto r = runComparison(engine, *view, o);
   ASSERT_TRUE(r.ok()) << r.error().message;
   const nlohmann::json j = compareToJson(r.value());
   const std::string html = compareReportHtml(r.value(), ReportInfo{});

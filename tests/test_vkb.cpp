@@ -4,9 +4,9 @@
 
 #include <cmath>
 
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/importance.hpp"
 #include "mfr/method/memory_model.hpp"
-#include "mfr/method/render.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr {

@@ -167,22 +167,22 @@ int run(const CompareArgs& a, const std::string& version) {
   if (!prepared) return fail(prepared.error().message);
   options.memoryLimitBytes = a.scene.memoryLimitBytes().value();  // checked by prepareScene
   options.background = prepared->scene.background;
-  RasterOptions ro;
-  ro.width = a.scene.width;
-  ro.height = a.scene.height;
-  ro.threads = a.scene.threads;
+  auto engine = makeSceneEngine(a.scene);
+  if (!engine) return fail(engine.error().message);
   progress.set("setting up " + a.scene.source);
-  auto frame = RasterFrame::build(prepared->scene, prepared->cameras.front(), ro);
-  if (!frame) return fail(a.scene.source + ": " + frame.error().message);
+  auto view = (*engine)->prepare(sceneView(*prepared, a.scene, prepared->cameras.front()));
+  if (!view) return fail(a.scene.source + ": " + view.error().message);
   if (prepared->previousCamera) {  // --orbit-view I: view I - 1 precedes it (vkb's Fresnel term)
-    auto previous = RasterFrame::build(prepared->scene, *prepared->previousCamera, ro);
+    auto previous = (*engine)->prepare(sceneView(*prepared, a.scene, *prepared->previousCamera));
     if (!previous) return fail(a.scene.source + ": " + previous.error().message);
-    options.previousNearestCosine = nearestCosine(previous.value());
+    auto cosine = (*engine)->nearestCosine(**previous);
+    if (!cosine) return fail(a.scene.source + ": " + cosine.error().message);
+    options.previousNearestCosine = std::move(cosine.value());
   }
   options.progress = [&progress](const std::string& stage, int done, int total) {
     progress.set(stage, done, total);
   };
-  auto result = runComparison(frame.value(), options);
+  auto result = runComparison(**engine, **view, options);
   if (!result) return fail(a.scene.source + ": " + result.error().message);
   const CompareResult& r = result.value();
 
@@ -215,7 +215,7 @@ Runner addCompareCommand(CLI::App& app) {
       "compare",
       "Render the ground truth and several methods at several budgets; write images, metrics "
       "(results.json, results.csv) and an HTML report");
-  args->scene.add(*cmd);
+  args->scene.add(*cmd, true, true);
   cmd->add_option("--budget,--budgets,-M", args->budgets,
                   "Memory budgets, comma-separated, e.g. 20MB,40MB (MB = 2^20 bytes)")
       ->required();

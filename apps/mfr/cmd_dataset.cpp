@@ -6,8 +6,8 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "mfr/cpu/raster_frame.hpp"
 #include "mfr/learn/dataset.hpp"
-#include "mfr/raster/raster_frame.hpp"
 
 namespace mfr::cli {
 namespace {

@@ -8,7 +8,6 @@
 #include "common.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/memory_model.hpp"
-#include "mfr/method/render.hpp"
 
 namespace mfr::cli {
 namespace {
@@ -24,13 +23,16 @@ int run(const SceneOptions& o) {
     (m.alphaMode == AlphaMode::Blend ? blend : m.alphaMode == AlphaMode::Mask ? mask : opaque)++;
   nlohmann::json views = nlohmann::json::array();
   const MemoryModel abuffer = MemoryModel::of(methodPreset("abuffer").value());
+  auto engine = makeSceneEngine(o);
+  if (!engine) return fail(engine.error().message);
   for (size_t v = 0; v < prepared->cameras.size(); ++v) {
     progress.set("counting fragments", static_cast<int>(v),
                  static_cast<int>(prepared->cameras.size()));
-    RasterOptions ro{o.width, o.height, 32, o.threads};
-    auto frame = RasterFrame::build(scene, prepared->cameras[v], ro);
-    if (!frame) return fail(o.source + ": " + frame.error().message);
-    const std::vector<uint32_t> n = countFragments(frame.value());
+    auto view = (*engine)->prepare(sceneView(*prepared, o, prepared->cameras[v]));
+    if (!view) return fail(o.source + ": " + view.error().message);
+    auto counted = (*engine)->countFragments(**view);
+    if (!counted) return fail(o.source + ": " + counted.error().message);
+    const std::vector<uint32_t>& n = counted.value();
     uint64_t total = 0, covered = 0;
     uint32_t maxN = 0;
     for (uint32_t c : n) {
@@ -38,7 +40,7 @@ int run(const SceneOptions& o) {
       covered += c > 0;
       maxN = std::max(maxN, c);
     }
-    const Camera& c = frame->camera();
+    const Camera& c = prepared->cameras[v];
     views.push_back(
         {{"view", v},
          {"camera",
@@ -50,7 +52,7 @@ int run(const SceneOptions& o) {
          {"covered_pixels", covered},
          {"max_depth_complexity", maxN},
          {"mean_depth_complexity", covered ? double(total) / covered : 0.0},
-         {"abuffer_bytes", abuffer.overhead(frame->pixelCount()) + total * kNodeBytes}});
+         {"abuffer_bytes", abuffer.overhead((*view)->pixelCount()) + total * kNodeBytes}});
   }
   nlohmann::json j = {{"scene", o.source},
                       {"triangles", scene.triangleCount()},
@@ -63,6 +65,7 @@ int run(const SceneOptions& o) {
                       {"cameras_in_file", scene.cameras.size()},
                       {"width", o.width},
                       {"height", o.height},
+                      {"engine", (*engine)->describe()},
                       {"views", views}};
   if (o.json) {
     std::printf("%s\n", j.dump(2).c_str());
@@ -74,6 +77,10 @@ int run(const SceneOptions& o) {
   std::printf("triangles   %zu (%zu vertices)\n", scene.triangleCount(), scene.vertexCount());
   std::printf("materials   %zu (%zu blend, %zu mask, %zu opaque), %zu textures\n",
               scene.materials.size(), blend, mask, opaque, scene.textures.size());
+  std::string engineText;
+  for (const auto& [key, value] : (*engine)->describe())
+    engineText += (engineText.empty() ? "" : ", ") + key + " " + value;
+  std::printf("engine      %s\n", engineText.c_str());
   for (const auto& v : views)
     std::printf(
         "view %-3d    %dx%d: %llu fragments on %llu pixels, depth complexity max %u mean "
@@ -91,7 +98,7 @@ int run(const SceneOptions& o) {
 Runner addInfoCommand(CLI::App& app) {
   auto options = std::make_shared<SceneOptions>();
   CLI::App* cmd = app.add_subcommand("info", "Scene statistics and A-buffer cost");
-  options->add(*cmd);
+  options->add(*cmd, true, true);
   return [options] { return run(*options); };
 }
 

@@ -11,8 +11,8 @@
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/colormap.hpp"
 #include "mfr/core/units.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/method_options.hpp"
-#include "mfr/method/render.hpp"
 #include "mfr/method/stats_json.hpp"
 
 namespace mfr::cli {
@@ -148,27 +148,25 @@ int run(const RenderArgs& a) {
   options.background = scene.background;
   const int views = static_cast<int>(prepared->cameras.size());
   nlohmann::json allStats = nlohmann::json::array();
+  auto engine = makeSceneEngine(a.scene);
+  if (!engine) return fail(engine.error().message);
   std::vector<float> previousCosine;  // importance methods: nearest |n.v| of the previous view
   if (prepared->previousCamera && method->allocation == AllocationPolicy::Importance &&
       method->importanceSource == ImportanceSource::Heuristic) {
-    RasterOptions ro;  // --orbit-view I: view I - 1 precedes it, as in the full orbit
-    ro.width = a.scene.width;
-    ro.height = a.scene.height;
-    ro.threads = a.scene.threads;
-    auto frame = RasterFrame::build(scene, *prepared->previousCamera, ro);
-    if (!frame) return fail(a.scene.source + ": " + frame.error().message);
-    previousCosine = nearestCosine(frame.value());
+    // --orbit-view I: view I - 1 precedes it, as in the full orbit
+    auto previous = (*engine)->prepare(sceneView(*prepared, a.scene, *prepared->previousCamera));
+    if (!previous) return fail(a.scene.source + ": " + previous.error().message);
+    auto cosine = (*engine)->nearestCosine(**previous);
+    if (!cosine) return fail(a.scene.source + ": " + cosine.error().message);
+    previousCosine = std::move(cosine.value());
   }
+  const int width = a.scene.width, height = a.scene.height;
   for (int v = 0; v < views; ++v) {
     progress.set("rendering " + method->name, v, views);
-    RasterOptions ro;
-    ro.width = a.scene.width;
-    ro.height = a.scene.height;
-    ro.threads = a.scene.threads;
-    auto frame = RasterFrame::build(scene, prepared->cameras[v], ro);
-    if (!frame) return fail(a.scene.source + ": " + frame.error().message);
+    auto view = (*engine)->prepare(sceneView(*prepared, a.scene, prepared->cameras[v]));
+    if (!view) return fail(a.scene.source + ": " + view.error().message);
     options.previousNearestCosine = previousCosine.empty() ? nullptr : &previousCosine;
-    auto result = render(frame.value(), method.value(), options);
+    auto result = (*engine)->render(**view, method.value(), options);
     if (!result) return fail(a.scene.source + ": " + result.error().message);
     previousCosine = result->nearestCosine;
     const std::string out = viewPath(a.out, v, views);
@@ -176,17 +174,19 @@ int run(const RenderArgs& a) {
     if (!written) return fail(written.error().message);
     try {
       if (!a.depthComplexity.empty()) {
-        const std::vector<uint32_t> n = result->depthComplexity.empty()
-                                            ? countFragments(frame.value())
-                                            : result->depthComplexity;
-        writeMap(viewPath(a.depthComplexity, v, views), n, ro.width, ro.height,
-                 "fragments per pixel");
+        std::vector<uint32_t> n = result->depthComplexity;
+        if (n.empty()) {
+          auto counted = (*engine)->countFragments(**view);
+          if (!counted) return fail(a.scene.source + ": " + counted.error().message);
+          n = std::move(counted.value());
+        }
+        writeMap(viewPath(a.depthComplexity, v, views), n, width, height, "fragments per pixel");
       }
       if (!a.kMap.empty())
-        writeMap(viewPath(a.kMap, v, views), result->kMap, ro.width, ro.height, "k(p)");
+        writeMap(viewPath(a.kMap, v, views), result->kMap, width, height, "k(p)");
       const ImportanceMaps& imp = result->importance;
       if (!a.importanceMap.empty() && !imp.importance.empty())
-        writeMap(viewPath(a.importanceMap, v, views), imp.importance, ro.width, ro.height,
+        writeMap(viewPath(a.importanceMap, v, views), imp.importance, width, height,
                  "importance I(p)");
       if (!a.importanceFactors.empty() && !imp.importance.empty()) {
         const std::filesystem::path dir(a.importanceFactors);
@@ -198,11 +198,11 @@ int run(const RenderArgs& a) {
             {"periphery", &imp.periphery},
             {"fresnel", &imp.fresnel}};
         for (const auto& [name, values] : factors)
-          writeMap((dir / (std::string(name) + suffix)).string(), *values, ro.width, ro.height,
+          writeMap((dir / (std::string(name) + suffix)).string(), *values, width, height,
                    std::string("I_") + name);
         std::vector<float> noise(imp.noise.size());
         for (size_t i = 0; i < noise.size(); ++i) noise[i] = imp.noise[i] + 0.05f;
-        writeMap((dir / (std::string("noise") + suffix)).string(), noise, ro.width, ro.height,
+        writeMap((dir / (std::string("noise") + suffix)).string(), noise, width, height,
                  "noise + 0.05");
       }
     } catch (const std::exception& e) {
@@ -210,14 +210,12 @@ int run(const RenderArgs& a) {
     }
     nlohmann::json stats = statsToJson(result->stats);
     stats["scene"] = a.scene.source;
-    stats["width"] = ro.width;
-    stats["height"] = ro.height;
+    stats["width"] = width;
+    stats["height"] = height;
     stats["image"] = out;
     stats["view"] = v;
     stats["compositing"] = toString(method->compositing);
     stats["capture"] = a.capture;
-    stats["threads"] = frame->threads();
-    stats["tile_workers"] = frame->arenaThreads();
     allStats.push_back(stats);
     if (!a.scene.quiet && !a.scene.json) {
       const RenderStats& s = result->stats;
@@ -245,7 +243,7 @@ int run(const RenderArgs& a) {
 Runner addRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method");
-  args->scene.add(*cmd);
+  args->scene.add(*cmd, true, true);
   cmd->add_option("--out,-o", args->out, "Output PNG (sRGB)");
   cmd->add_option("--depth-complexity", args->depthComplexity,
                   "Write the fragments-per-pixel map (colour-mapped PNG with legend)");

@@ -17,9 +17,9 @@
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/plot.hpp"
+#include "mfr/cpu/deep_importance.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/learn/model_file.hpp"
-#include "mfr/method/deep_importance.hpp"
 
 namespace mfr::cli {
 namespace {

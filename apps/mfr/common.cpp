@@ -9,14 +9,14 @@
 
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/units.hpp"
-#include "mfr/method/deep_importance.hpp"
-#include "mfr/raster/raster_frame.hpp"
+#include "mfr/cpu/deep_importance.hpp"
+#include "mfr/cpu/raster_frame.hpp"
 #include "mfr/scene/camera_spec.hpp"
 #include "mfr/scene/draw_order.hpp"
 
 namespace mfr::cli {
 
-void SceneOptions::add(CLI::App& app, bool sceneArgument) {
+void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
   if (sceneArgument)
     app.add_option("scene", source,
                    "Scene file (.gltf .glb .obj .ply .json) or procedural:NAME[?k=v&...]")
@@ -51,6 +51,26 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument) {
                  "Refuse to allocate buffers larger than this, e.g. 8GB (default: " +
                      std::to_string(static_cast<int>(kDefaultMemoryShare * 100)) +
                      "% of the physical memory, " + formatBytes(defaultMemoryLimit()) + ")");
+  if (engineOption) {
+    std::string names;
+    for (const std::string& n : engineNames()) names += (names.empty() ? "" : "|") + n;
+    app.add_option("--engine", engine, "Engine that renders: " + names + " (default cpu)");
+  }
+}
+
+Result<std::unique_ptr<Engine>> makeSceneEngine(const SceneOptions& o) {
+  EngineOptions eo;
+  eo.threads = o.threads;
+  return makeEngine(o.engine, eo);
+}
+
+View sceneView(const PreparedScene& prepared, const SceneOptions& o, const Camera& camera) {
+  View v;
+  v.scene = &prepared.scene;
+  v.camera = camera;
+  v.width = o.width;
+  v.height = o.height;
+  return v;
 }
 
 Result<uint64_t> SceneOptions::memoryLimitBytes() const {

@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "mfr/core/result.hpp"
+#include "mfr/engine/engine.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/scene/load.hpp"
@@ -39,9 +40,11 @@ struct SceneOptions {
   bool json = false;
   bool allowOutsideReferences = false;  // files named in a scene may lie outside its folder
   std::string memoryLimit;              // --memory-limit (empty: defaultMemoryLimit())
+  std::string engine = "cpu";           // --engine (render, compare, info)
 
-  /// Registers the options (and the positional scene unless the command takes several).
-  void add(CLI::App& app, bool sceneArgument = true);
+  /// Registers the options (and the positional scene unless the command takes several; --engine
+  /// for the commands that run on either engine).
+  void add(CLI::App& app, bool sceneArgument = true, bool engineOption = false);
   /// --memory-limit in bytes, or the default share of the physical memory.
   Result<uint64_t> memoryLimitBytes() const;
 };
@@ -56,6 +59,12 @@ struct PreparedScene {
 
 /// Loads the scene, applies overrides and resolves the cameras. Errors name the input.
 Result<PreparedScene> prepareScene(const SceneOptions& options);
+
+/// The engine named by --engine, running --threads workers.
+Result<std::unique_ptr<Engine>> makeSceneEngine(const SceneOptions& options);
+
+/// The view of a prepared scene from one of its cameras at --width x --height.
+View sceneView(const PreparedScene& prepared, const SceneOptions& options, const Camera& camera);
 
 /// "out.png" -> "out_v003.png" when rendering several views.
 std::string viewPath(const std::string& path, int view, int views);

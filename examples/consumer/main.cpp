@@ -21,15 +21,17 @@ int main(int argc, char** argv) {
   if (!scene) return fail(scene.error());
   const mfr::Camera camera =
       scene->defaultCamera.value_or(mfr::frameBounds(mfr::sceneBounds(*scene)));
-  auto frame = mfr::RasterFrame::build(*scene, camera, {.width = 256, .height = 256});
-  if (!frame) return fail(frame.error());
+  auto engine = mfr::makeEngine("cpu");
+  if (!engine) return fail(engine.error());
+  auto view = (*engine)->prepare({.scene = &*scene, .camera = camera, .width = 256, .height = 256});
+  if (!view) return fail(view.error());
   auto bytes = mfr::parseByteSize(budget);
   if (!bytes) return fail(bytes.error());
   for (const std::string preset : {"kplus-dynamic", "dkb"}) {
     auto method = mfr::methodPreset(preset);
     if (!method) return fail(method.error());
-    auto out =
-        mfr::render(*frame, *method, {.budgetBytes = *bytes, .background = scene->background});
+    auto out = (*engine)->render(**view, *method,
+                                 {.budgetBytes = *bytes, .background = scene->background});
     if (!out) return fail(out.error());
     std::printf("%s\n", mfr::statsToJson(out->stats).dump().c_str());
     auto written = mfr::writePng(outDir + "/" + preset + ".png", mfr::encodeSrgb(out->image));

@@ -4,10 +4,10 @@
 #include <cstddef>
 
 #include "common.hpp"
+#include "mfr/cpu/deep_importance.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/learn/mlp.hpp"
 #include "mfr/learn/model_file.hpp"
-#include "mfr/method/deep_importance.hpp"
 #include "mfr/method/dkb_features.hpp"
 
 namespace mfr::python {

@@ -5,6 +5,7 @@
 #include "mfr/compare/compare.hpp"
 #include "mfr/compare/compare_output.hpp"
 #include "mfr/core/units.hpp"
+#include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
@@ -121,9 +122,10 @@ py::object compare(const py::object& sceneArg, const std::string& out,
   std::string jsonText;
   {
     py::gil_scoped_release release;
-    auto frame = RasterFrame::build(*scene.scene, cam, ro);
-    if (!frame) throw LibraryError(scene.source + ": " + frame.error().message);
-    auto result = runComparison(frame.value(), options);
+    CpuEngine engine(EngineOptions{ro.threads, ro.tileSize});
+    auto view = engine.prepare(View{&*scene.scene, cam, ro.width, ro.height});
+    if (!view) throw LibraryError(scene.source + ": " + view.error().message);
+    auto result = runComparison(engine, **view, options);
     if (!result) throw LibraryError(scene.source + ": " + result.error().message);
     ReportInfo info;
     info.mfrVersion = std::string("mfr ") + MFR_VERSION;

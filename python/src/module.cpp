@@ -9,13 +9,14 @@
 #include "common.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/units.hpp"
+#include "mfr/cpu/cpu_engine.hpp"
+#include "mfr/cpu/deep_importance.hpp"
+#include "mfr/cpu/raster_frame.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/learn/model_file.hpp"
-#include "mfr/method/deep_importance.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/method/method_options.hpp"
-#include "mfr/method/render.hpp"
 #include "mfr/method/stats_json.hpp"
-#include "mfr/raster/raster_frame.hpp"
 #include "mfr/scene/load.hpp"
 #include "scene_options.hpp"
 
@@ -118,18 +119,16 @@ PyRenderResult renderScene(const py::object& sceneArg, const std::string& method
   const Camera cam = cameraArgument(*scene.scene, camera, view, zoom);
 
   RenderOutput out;
-  int frameThreads = 0, tileWorkers = 0;
   {
     py::gil_scoped_release release;
-    auto frame = RasterFrame::build(*scene.scene, cam, ro);
-    if (!frame) throw LibraryError(scene.source + ": " + frame.error().message);
-    auto rendered = render(frame.value(), m, options);
+    CpuEngine engine(EngineOptions{ro.threads, ro.tileSize});
+    auto view = engine.prepare(View{&*scene.scene, cam, ro.width, ro.height});
+    if (!view) throw LibraryError(scene.source + ": " + view.error().message);
+    auto rendered = engine.render(**view, m, options);
     if (!rendered) throw LibraryError(scene.source + ": " + rendered.error().message);
     out = std::move(rendered.value());
     if (wantDepthComplexity && out.depthComplexity.empty())
-      out.depthComplexity = countFragments(frame.value());
-    frameThreads = frame->threads();
-    tileWorkers = frame->arenaThreads();
+      out.depthComplexity = unwrap(engine.countFragments(**view));
   }
 
   // the statistics exactly as `mfr render --stats-json` writes them (less "image": no file)
@@ -140,8 +139,6 @@ PyRenderResult renderScene(const py::object& sceneArg, const std::string& method
   stats["view"] = 0;
   stats["compositing"] = toString(m.compositing);
   stats["capture"] = capture;
-  stats["threads"] = frameThreads;
-  stats["tile_workers"] = tileWorkers;
 
   const py::ssize_t h = ro.height, w = ro.width;
   const size_t pixels = static_cast<size_t>(h) * static_cast<size_t>(w);

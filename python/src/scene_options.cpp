@@ -5,7 +5,7 @@
 #include <cstring>
 
 #include "mfr/core/units.hpp"
-#include "mfr/method/deep_importance.hpp"
+#include "mfr/cpu/deep_importance.hpp"
 #include "mfr/scene/camera_spec.hpp"
 #include "mfr/scene/load.hpp"
 

@@ -8,10 +8,10 @@
 
 #include "common.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/cpu/raster_frame.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/importance.hpp"
-#include "mfr/method/render.hpp"
-#include "mfr/raster/raster_frame.hpp"
 #include "mfr/scene/scene.hpp"
 
 namespace mfr::python {

@@ -118,7 +118,8 @@ std::string budgetLabel(uint64_t bytes) {
   return s;
 }
 
-Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptions& options) {
+Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
+                                    const CompareOptions& options) {
   if (options.methods.empty()) return makeError("--methods: the method list is empty");
   if (options.budgets.empty()) return makeError("--budget: no budget given");
   std::vector<MethodDesc> methods;
@@ -145,8 +146,8 @@ Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptio
   if (!(options.flipPixelsPerDegree > 0.0 && std::isfinite(options.flipPixelsPerDegree)))
     return makeError("FLIP pixels per degree: must be finite and positive");
 
-  const int w = frame.width(), h = frame.height();
-  const uint64_t pixels = frame.pixelCount();
+  const int w = view.width(), h = view.height();
+  const uint64_t pixels = view.pixelCount();
   const int totalSteps = 1 + static_cast<int>(methods.size() * options.budgets.size());
   int step = 0;
   const auto progress = [&](const std::string& stage) {
@@ -155,6 +156,7 @@ Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptio
 
   CompareResult result;
   result.scene = options.scene;
+  result.engine = std::string(engine.name());
   result.width = w;
   result.height = h;
   result.compositing = options.compositing;
@@ -172,7 +174,7 @@ Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptio
   progress("rendering the ground truth (abuffer)");
   auto abuffer = methodPreset("abuffer");
   if (!abuffer) return abuffer.error();
-  auto truth = render(frame, abuffer.value(), renderOptions);
+  auto truth = engine.render(view, abuffer.value(), renderOptions);
   if (!truth) return makeError("ground truth (abuffer): " + truth.error().message);
   ++step;
   CompareRun& gt = result.groundTruth;
@@ -203,7 +205,7 @@ Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptio
       progress("rendering " + method.name + " at " + cb.label);
       RenderOptions ro = renderOptions;
       ro.budgetBytes = budget;
-      auto out = render(frame, method, ro);
+      auto out = engine.render(view, method, ro);
       if (!out) {
         run.error = out.error().message;
         kMaps.emplace_back();
@@ -253,6 +255,7 @@ nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersi
   nlohmann::json j;
   if (!mfrVersion.empty()) j["mfr_version"] = mfrVersion;
   j["scene"] = r.scene;
+  j["engine"] = r.engine;
   j["width"] = r.width;
   j["height"] = r.height;
   j["compositing"] = r.compositing ? toString(*r.compositing) : "per-method";

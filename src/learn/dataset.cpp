@@ -14,8 +14,9 @@
 
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/quote.hpp"
+#include "mfr/cpu/deep_importance.hpp"
+#include "mfr/cpu/optimal_oracle.hpp"
 #include "mfr/method/optimal_allocation.hpp"
-#include "mfr/method/optimal_oracle.hpp"
 
 namespace mfr::learn {
 namespace {

@@ -20,17 +20,17 @@
 #include <cmath>
 #include <string>
 
-#include "pipeline.hpp"
+#include "mfr/method/allocation.hpp"
 
-namespace mfr::detail {
+namespace mfr {
 namespace {
 
 std::string bytesText(uint64_t b) {
   return std::to_string(b) + " B";
 }
 
-std::string sizeText(const RasterFrame& f) {
-  return std::to_string(f.width()) + "x" + std::to_string(f.height());
+std::string sizeText(const PixelLayout& f) {
+  return std::to_string(f.width) + "x" + std::to_string(f.height);
 }
 
 // Store of a pixel: the K+B-SB rule picks the heap when the pixel overflows and k > 16.
@@ -95,7 +95,7 @@ void fillByImportance(const std::vector<uint32_t>& n, const std::vector<float>& 
   }
 }
 
-Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
+Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
                             const MemoryModel& memory, std::optional<uint64_t> budget,
                             const std::vector<uint32_t>& n, const std::vector<float>& importanceIn,
                             const std::vector<uint32_t>& oracleK) {
@@ -110,7 +110,7 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
       if (!usable(i)) i = 0.0f;
   }
   const std::vector<float>& importance = clean ? importanceIn : sanitized;
-  const uint64_t pixels = frame.pixelCount();
+  const uint64_t pixels = frame.pixels();
   const uint64_t overhead = memory.overhead(pixels);
   const std::string& name = method.name;
   Allocation a;
@@ -264,20 +264,21 @@ Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
   for (size_t p = 0; p < pixels; ++p)
     a.kind[p] = pickStore(method.store, n.empty() ? a.capacity[p] + 1 : n[p], a.capacity[p]);
 
-  // exclusive prefix sum in tile-major order
+  // exclusive prefix sum in tile-major order (row-major: one tile as wide and high as the frame)
   a.offsets.assign(pixels, 0);
   uint64_t running = 0;
-  for (int tile = 0; tile < frame.tileCount(); ++tile) {
-    const TileRect r = frame.tileRect(tile);
-    for (int y = r.y0; y <= r.y1; ++y)
-      for (int x = r.x0; x <= r.x1; ++x) {
-        const size_t p = static_cast<size_t>(y) * frame.width() + x;
-        a.offsets[p] = running;
-        running += a.capacity[p];
-      }
-  }
+  const int tw = frame.tileSize > 0 ? frame.tileSize : std::max(frame.width, 1);
+  const int th = frame.tileSize > 0 ? frame.tileSize : std::max(frame.height, 1);
+  for (int ty = 0; ty < frame.height; ty += th)
+    for (int tx = 0; tx < frame.width; tx += tw)
+      for (int y = ty; y < std::min(frame.height, ty + th); ++y)
+        for (int x = tx; x < std::min(frame.width, tx + tw); ++x) {
+          const size_t p = static_cast<size_t>(y) * static_cast<size_t>(frame.width) + x;
+          a.offsets[p] = running;
+          running += a.capacity[p];
+        }
   MFR_CHECK(running == a.slots);
   return a;
 }
 
-}  // namespace mfr::detail
+}  // namespace mfr

@@ -19,11 +19,11 @@ glm::vec3 premultiplied(uint32_t rgba) {
 
 }  // namespace
 
-void FeatureAccumulator::add(const Fragment& f) {
+void FeatureAccumulator::add(float depth, uint32_t rgba) {
   ++n;
-  nearest = std::min(nearest, makeNode(f));
-  farthest = std::max(farthest, f.depth);
-  premultipliedSum += premultiplied(f.rgba);
+  nearest = std::min(nearest, makeNode(depth, rgba));
+  farthest = std::max(farthest, depth);
+  premultipliedSum += premultiplied(rgba);
 }
 
 void ImageFeatureStats::add(const FeatureAccumulator& a) {
@@ -63,15 +63,6 @@ PixelFeatures pixelFeatures(const FeatureAccumulator& pixel, const ImageFeatureS
   f[10] = image.nearest;
   f[11] = image.farthest;
   return f;
-}
-
-std::vector<FeatureAccumulator> accumulateFeatures(const RasterFrame& frame) {
-  std::vector<FeatureAccumulator> pixels(frame.pixelCount());
-  frame.forEachTile([&](int tile) {
-    frame.rasterizeTile<ShadeMode::Full>(
-        tile, EmitAll{[&](const Fragment& f) { pixels[f.pixel].add(f); }});
-  });
-  return pixels;
 }
 
 ImageFeatureStats imageFeatureStats(const std::vector<FeatureAccumulator>& pixels) {

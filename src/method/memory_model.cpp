@@ -1,6 +1,5 @@
 #include "mfr/method/memory_model.hpp"
 
-#include "mfr/capture/occupancy_map.hpp"
 #include "mfr/method/mboit.hpp"
 #include "mfr/method/mlab.hpp"
 #include "mfr/method/wboit.hpp"
@@ -14,7 +13,7 @@ MemoryModel MemoryModel::of(const MethodDesc& method, bool fragmentParallel) {
   m.counter = noNodes ? 0 : 4;
   m.offset = prefixSum ? 4 : 0;
   m.lock = method.perPixelLock || fragmentParallel ? 4 : 0;
-  m.occupancy = method.occupancyWords > 0 ? OccupancyMap::bytesPerPixel(method.occupancyWords) : 0;
+  m.occupancy = method.occupancyWords > 0 ? occupancyBytesPerPixel(method.occupancyWords) : 0;
   m.tail = method.compositing == Compositing::Hybrid ? 20 : 0;
   m.previous = method.allocation == AllocationPolicy::Importance &&
                        method.importanceSource == ImportanceSource::Heuristic

@@ -30,6 +30,8 @@ nlohmann::json statsToJson(const RenderStats& s) {
   nlohmann::json times = nlohmann::json::object();
   for (const PassTime& p : s.passes) times[p.name] = p.ms;
   j["time_ms"] = times;
+  if (!s.engine.empty()) j["engine"] = s.engine;
+  if (!s.engineCounters.empty()) j["engine_counters"] = s.engineCounters;
   j["total_ms"] = s.totalMs();
   if (s.oracle) {
     const OracleReport& o = *s.oracle;

@@ -29,10 +29,10 @@
 #include <string>
 #include <vector>
 
+#include "mfr/cpu/raster_frame.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/method/method_options.hpp"
-#include "mfr/method/render.hpp"
-#include "mfr/raster/raster_frame.hpp"
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/load.hpp"
 

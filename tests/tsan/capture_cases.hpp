@@ -14,8 +14,8 @@
 #include <vector>
 
 #include "../test_util.hpp"
-#include "mfr/method/render.hpp"
-#include "mfr/raster/raster_frame.hpp"
+#include "mfr/cpu/raster_frame.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr::test {

@@ -18,10 +18,10 @@
 
 #include "mfr/core/image.hpp"
 #include "mfr/core/result.hpp"
+#include "mfr/engine/engine.hpp"
 #include "mfr/method/method.hpp"
-#include "mfr/method/render.hpp"
+#include "mfr/method/render_output.hpp"
 #include "mfr/metrics/flip.hpp"
-#include "mfr/raster/raster_frame.hpp"
 
 namespace mfr {
 
@@ -83,6 +83,7 @@ struct CompareBudget {
 
 struct CompareResult {
   std::string scene;
+  std::string engine;  // the engine that rendered every run and the ground truth
   int width = 0, height = 0;
   std::optional<Compositing> compositing;  // CompareOptions::compositing (none: per preset)
   CaptureMode capture = CaptureMode::TileOwned;
@@ -99,7 +100,8 @@ struct CompareResult {
 /// A method failing at a budget is not an error: its run carries the message.
 /// The result owns its images and statistics: the frame (and its scene) may go once it returns.
 /// compare_output.hpp writes the result as `mfr compare` does (writeComparison).
-Result<CompareResult> runComparison(const RasterFrame& frame, const CompareOptions& options);
+Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
+                                    const CompareOptions& options);
 
 /// "20MB" for whole MiB, "400KB" for whole KiB, else "12345B" (file-name safe).
 std::string budgetLabel(uint64_t bytes);

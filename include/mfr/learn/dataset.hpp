@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "mfr/core/result.hpp"
+#include "mfr/cpu/raster_frame.hpp"
 #include "mfr/method/dkb_features.hpp"
 
 namespace mfr::learn {

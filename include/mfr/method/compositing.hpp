@@ -19,7 +19,7 @@
 #include <glm/glm.hpp>
 
 #include "mfr/core/color.hpp"
-#include "mfr/raster/fragment.hpp"
+#include "mfr/method/fragment_node.hpp"
 
 namespace mfr {
 

@@ -25,8 +25,7 @@
 
 #include <glm/glm.hpp>
 
-#include "mfr/raster/fragment.hpp"
-#include "mfr/raster/raster_frame.hpp"
+#include "mfr/method/fragment_node.hpp"
 
 namespace mfr {
 
@@ -45,7 +44,7 @@ struct FeatureAccumulator {
   FragmentNode nearest = kFarNode;
   float farthest = 0.0f;
   glm::vec3 premultipliedSum{0.0f};
-  void add(const Fragment& f);
+  void add(float depth, uint32_t rgba);
 };
 
 /// Image-level quantities of the frame (over covered pixels).
@@ -61,9 +60,6 @@ struct ImageFeatureStats {
 /// The 12 inputs of a covered pixel; `slots` = F(M).
 PixelFeatures pixelFeatures(const FeatureAccumulator& pixel, const ImageFeatureStats& image,
                             uint64_t slots);
-
-/// The whole-frame feature pass (tile-parallel, deterministic): one accumulator per pixel.
-std::vector<FeatureAccumulator> accumulateFeatures(const RasterFrame& frame);
 
 /// Image statistics of a feature pass.
 ImageFeatureStats imageFeatureStats(const std::vector<FeatureAccumulator>& pixels);

@@ -57,6 +57,12 @@ namespace mfr {
 inline constexpr uint64_t kNodeBytes = 8;
 inline constexpr uint64_t kHistogramBins = 1024;
 
+/// Bytes per pixel of an occupancy map of `words` 32-bit bucket words: near and far depth and the
+/// culling threshold (4 bytes each), then the bitmap (occupancy-map-culling.txt, sec. 3).
+inline constexpr uint64_t occupancyBytesPerPixel(int words) {
+  return 12 + 4 * static_cast<uint64_t>(words);
+}
+
 struct MemoryModel {
   uint64_t counter = 4, offset = 0, lock = 0, occupancy = 0, tail = 0, previous = 0;  // per pixel
   uint64_t accum = 0;          // per pixel: wboit / mboit accumulators

@@ -9,7 +9,6 @@
 #include <string>
 #include <vector>
 
-#include "mfr/capture/fragment_stores.hpp"
 #include "mfr/core/result.hpp"
 #include "mfr/method/importance.hpp"
 
@@ -29,6 +28,9 @@ enum class AllocationPolicy : uint8_t {
   Optimal,     // offline oracle: k(p) minimising the hybrid error from an exact A-buffer pre-pass
   NoNodes,     // no fragment nodes: per-pixel accumulators only (wboit, mboit)
 };
+
+/// The store of one pixel, as the allocation picked it from the StoreChoice.
+enum class StoreKind : uint8_t { Append, MaxArray, MaxHeap };
 
 /// Which store holds a pixel's fragments.
 enum class StoreChoice : uint8_t {

@@ -30,8 +30,8 @@
 
 #include <glm/glm.hpp>
 
+#include "mfr/method/fragment_node.hpp"
 #include "mfr/method/method.hpp"
-#include "mfr/raster/fragment.hpp"
 
 namespace mfr {
 

@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "mfr/method/render.hpp"
+#include "mfr/method/render_output.hpp"
 
 namespace mfr {
 

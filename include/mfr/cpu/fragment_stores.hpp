@@ -24,11 +24,10 @@
 #include <cstdint>
 #include <utility>
 
-#include "mfr/raster/fragment.hpp"
+#include "mfr/method/fragment_node.hpp"
+#include "mfr/method/method.hpp"
 
 namespace mfr {
-
-enum class StoreKind : uint8_t { Append, MaxArray, MaxHeap };
 
 /// Plain memory access (one owner per pixel).
 struct PlainAccess {

@@ -10,8 +10,8 @@
 #include <glm/glm.hpp>
 
 #include "mfr/core/result.hpp"
+#include "mfr/cpu/raster_frame.hpp"
 #include "mfr/method/method.hpp"
-#include "mfr/raster/raster_frame.hpp"
 
 namespace mfr {
 

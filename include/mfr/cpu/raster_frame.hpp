@@ -19,7 +19,7 @@
 
 #include "mfr/core/color.hpp"
 #include "mfr/core/result.hpp"
-#include "mfr/raster/fragment.hpp"
+#include "mfr/cpu/fragment.hpp"
 #include "mfr/scene/scene.hpp"
 
 namespace mfr {
@@ -94,6 +94,7 @@ class RasterFrame {
   int arenaThreads() const;
   const Camera& camera() const { return camera_; }
 
+  int tileSize() const { return tileSize_; }
   int tileCount() const { return tilesX_ * tilesY_; }
   TileRect tileRect(int tile) const;
   /// Triangle set-ups overlapping a tile, in primitive order.
@@ -169,4 +170,4 @@ int maxTileWorkers();
 
 }  // namespace mfr
 
-#include "mfr/raster/raster_frame_impl.hpp"
+#include "mfr/cpu/raster_frame_impl.hpp"

@@ -19,8 +19,9 @@
 #include <vector>
 
 #include "mfr/core/result.hpp"
+#include "mfr/cpu/raster_frame.hpp"
 #include "mfr/method/dkb_features.hpp"
-#include "mfr/raster/raster_frame.hpp"
+#include "mfr/method/dkb_model.hpp"
 
 namespace mfr {
 
@@ -38,14 +39,7 @@ std::vector<float> predictImportance(const RasterFrame& frame, const learn::Mode
                                      const ImageFeatureStats& image, uint64_t slots,
                                      double* featureMs = nullptr, double* inferenceMs = nullptr);
 
-/// Checks that a model fits the deep k-buffer: 12 inputs, 1 output, metadata declaring the feature
-/// set kDkbFeatureSet ("features") and, if it declares a target ("target"), the target definition
-/// learn::kDkbTargetScaling. `name` names the model in the message.
-Result<void> checkDkbModel(const learn::Model& model, const std::string& name);
-
-/// The model shipped in the repository (models/dkb-default.mfrnn, compiled into the library),
-/// decoded once. An error when the build had no model file, or when the model does not declare
-/// both kDkbFeatureSet and learn::kDkbTargetScaling (stale against the code: retrain it).
-Result<std::shared_ptr<const learn::Model>> builtinDkbModel();
+/// The whole-frame feature pass (tile-parallel, deterministic): one accumulator per pixel.
+std::vector<FeatureAccumulator> accumulateFeatures(const RasterFrame& frame);
 
 }  // namespace mfr

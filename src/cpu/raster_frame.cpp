@@ -1,6 +1,6 @@
 // Frame set-up of the CPU rasterizer: vertex transform, homogeneous clipping, triangle set-up in
 // 8-bit sub-pixel fixed point, and binning into tiles (see raster_frame.hpp for the rules).
-#include "mfr/raster/raster_frame.hpp"
+#include "mfr/cpu/raster_frame.hpp"
 
 #include <algorithm>
 #include <cmath>

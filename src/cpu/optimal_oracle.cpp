@@ -1,12 +1,12 @@
 // The optimal k-buffer's pre-pass (DHOIT sec. 3.1.2): exact A-buffer, sorted pixels, error curves.
-#include "mfr/method/optimal_oracle.hpp"
+#include "mfr/cpu/optimal_oracle.hpp"
 
 #include <algorithm>
 #include <string>
 
 #include "mfr/core/memory_limit.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/optimal_allocation.hpp"
-#include "mfr/method/render.hpp"
 
 namespace mfr {
 

@@ -1,7 +1,7 @@
 // render(): the pass structure every method shares,
 //   [count] -> allocate -> [depth range -> occupancy fill -> occupancy count] -> capture -> resolve
 // and the statistics and memory accounting of the run.
-#include "mfr/method/render.hpp"
+#include "mfr/cpu/render.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -14,10 +14,10 @@
 
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/units.hpp"
+#include "mfr/cpu/deep_importance.hpp"
+#include "mfr/cpu/optimal_oracle.hpp"
 #include "mfr/learn/model_file.hpp"
-#include "mfr/method/deep_importance.hpp"
 #include "mfr/method/optimal_allocation.hpp"
-#include "mfr/method/optimal_oracle.hpp"
 #include "pipeline.hpp"
 
 namespace mfr {
@@ -54,7 +54,7 @@ class PassTimer {
   std::vector<PassTime>& passes_;
 };
 
-void buildOccupancy(const RasterFrame& frame, const detail::Allocation& alloc, OccupancyMap& occ,
+void buildOccupancy(const RasterFrame& frame, const Allocation& alloc, OccupancyMap& occ,
                     PassTimer& timer) {
   timer.run("depth_range", [&] {
     frame.forEachTile([&](int tile) {
@@ -80,9 +80,8 @@ void buildOccupancy(const RasterFrame& frame, const detail::Allocation& alloc, O
   });
 }
 
-ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method,
-                 const detail::Allocation& alloc, const detail::Stores& stores,
-                 glm::vec3 background) {
+ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method, const Allocation& alloc,
+                 const detail::Stores& stores, glm::vec3 background) {
   if (detail::isPeerRule(method.compositing))
     return detail::resolvePeer(frame, method, alloc, stores, background);
   ImageRGB image(frame.width(), frame.height());
@@ -141,12 +140,6 @@ Result<OracleChoice> optimalK(const RasterFrame& frame, const MethodDesc& method
 }
 
 }  // namespace
-
-double RenderStats::totalMs() const {
-  double total = 0.0;
-  for (const PassTime& p : passes) total += p.ms;
-  return total;
-}
 
 std::vector<float> nearestCosine(const RasterFrame& frame) {
   std::vector<FragmentNode> nearest(frame.pixelCount(), kFarNode);
@@ -304,11 +297,11 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
 
   // allocate
   auto allocated = timer.run("allocate", [&] {
-    return detail::allocate(frame, method, memory, options.budgetBytes, out.depthComplexity,
-                            out.importance.importance, oracleK);
+    return allocate(PixelLayout{frame.width(), frame.height(), frame.tileSize()}, method, memory,
+                    options.budgetBytes, out.depthComplexity, out.importance.importance, oracleK);
   });
   if (!allocated) return allocated.error();
-  detail::Allocation& alloc = allocated.value();
+  Allocation& alloc = allocated.value();
   ledger.add("k", alloc.capacity);
   ledger.add("k", alloc.reservedK);
   ledger.add("offsets", alloc.offsets);

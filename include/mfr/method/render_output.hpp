@@ -1,5 +1,7 @@
-// Runs a method description on a rasterized frame: count -> allocate -> [occupancy] -> capture ->
-// resolve, with exact memory accounting and per-pass statistics.
+// What every engine's render of one frame with one method takes and gives: the options, the
+// statistics both engines report (memory as MemoryModel charges it, fragments captured and lost,
+// per-pass time) and the output image and maps. Backend-neutral: the CPU engine
+// (mfr/cpu/render.hpp) and any other engine (mfr/engine/engine.hpp) fill the same structures.
 #pragma once
 
 #include <cstdint>
@@ -11,10 +13,8 @@
 #include <glm/glm.hpp>
 
 #include "mfr/core/image.hpp"
-#include "mfr/core/result.hpp"
+#include "mfr/method/fragment_node.hpp"
 #include "mfr/method/importance.hpp"
-#include "mfr/method/method.hpp"
-#include "mfr/raster/raster_frame.hpp"
 
 namespace mfr {
 
@@ -87,6 +87,10 @@ struct RenderStats {
   std::optional<double> meanDepthComplexity;   // over covered pixels
   std::vector<PassTime> passes;
   std::optional<OracleReport> oracle;  // optimal / optimal-greedy
+  /// The engine that rendered (Engine::name) and what only it measures (the CPU engine: threads,
+  /// tile_workers), beside the shared fields above.
+  std::string engine;
+  std::map<std::string, double> engineCounters;
   double lostPercent() const {
     return fragmentsGenerated ? 100.0 * static_cast<double>(lost) / fragmentsGenerated : 0.0;
   }
@@ -106,30 +110,5 @@ struct RenderOutput {
   std::vector<uint64_t> offsets;
   std::vector<uint32_t> counts;
 };
-
-/// Renders one frame with one method: the passes of the method's description (count, importance
-/// or oracle, allocate, [occupancy], capture, resolve) on the frame's worker threads. The output is
-/// byte-identical for any thread count (tile-owned capture; see docs/ARCHITECTURE.md).
-///
-/// Errors (one line, the caller adds the scene's name): a bounded method without a budget or k;
-/// a budget too small for the method's per-pixel words and one fragment per (covered) pixel, for
-/// an explicit k, or (abuffer with a budget) for every fragment; a deep k-buffer model that does
-/// not fit (checkDkbModel) or a missing built-in model; an inconsistent hand-made description
-/// (e.g. occupancy culling without a bounded k); buffers larger than options.memoryLimitBytes, or
-/// an allocation that fails anyway (named by its pass; std::bad_alloc never escapes). A
-/// previousNearestCosine of another size than the frame is ignored (as if absent).
-///
-/// Lifetimes: `frame` (and so its Scene) and `options.previousNearestCosine` are only read during
-/// the call; the RenderOutput owns all its data. Neither the frame nor the method is modified, so
-/// one frame can be rendered with many methods in turn.
-Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
-                            const RenderOptions& options);
-
-/// Per-pixel fragment counts n(p) (a Coverage count pass), rows top to bottom; what
-/// RenderOutput::depthComplexity holds when the method counts.
-std::vector<uint32_t> countFragments(const RasterFrame& frame);
-
-/// |n.v| of each pixel's nearest fragment (0 where none), quantised to 8 bits.
-std::vector<float> nearestCosine(const RasterFrame& frame);
 
 }  // namespace mfr

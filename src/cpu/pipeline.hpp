@@ -8,29 +8,17 @@
 #include <string>
 #include <vector>
 
-#include "mfr/capture/occupancy_map.hpp"
+#include "mfr/cpu/fragment_stores.hpp"
+#include "mfr/cpu/occupancy_map.hpp"
+#include "mfr/cpu/render.hpp"
+#include "mfr/method/allocation.hpp"
 #include "mfr/method/compositing.hpp"
 #include "mfr/method/mboit.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/mlab.hpp"
-#include "mfr/method/render.hpp"
 #include "mfr/method/wboit.hpp"
 
 namespace mfr::detail {
-
-/// Slots per pixel and where they live (tile-major prefix-sum order).
-struct Allocation {
-  std::vector<uint32_t> capacity;  // k(p)
-  std::vector<uint64_t> offsets;   // first slot of pixel p
-  std::vector<StoreKind> kind;     // store used by pixel p
-  uint64_t slots = 0;              // total nodes materialised
-  std::optional<uint32_t> globalK;
-  // Importance allocation: the paper's k(p) may exceed n(p); those slots are reserved (and
-  // accounted for) but never filled, so the engine materialises only min(k(p), n(p)).
-  std::vector<uint32_t> reservedK;  // k(p) as allocated (empty: same as capacity)
-  uint64_t reservedSlots = 0;       // sum of k(p): the nodes the memory model charges
-  uint64_t scratchBytes = 0;        // temporary buffers of the policy (histogram, k before caps)
-};
 
 /// The CPU engine's measured memory: each buffer's bytes, added where it is allocated.
 class BufferLedger {
@@ -55,13 +43,6 @@ class BufferLedger {
  private:
   std::map<std::string, uint64_t> bytes_;
 };
-
-/// Turns the policy, the budget and (when a count pass ran) n(p) into k(p) and offsets.
-Result<Allocation> allocate(const RasterFrame& frame, const MethodDesc& method,
-                            const MemoryModel& memory, std::optional<uint64_t> budget,
-                            const std::vector<uint32_t>& fragmentCounts,
-                            const std::vector<float>& importance,
-                            const std::vector<uint32_t>& oracleK);
 
 struct CaptureCounters {
   uint64_t generated = 0, culledOccupancy = 0, culledKPlus = 0, rejected = 0, inserted = 0,

@@ -24,6 +24,8 @@
 #include <limits>
 #include <vector>
 
+#include "mfr/method/memory_model.hpp"
+
 namespace mfr {
 
 class OccupancyMap {
@@ -38,7 +40,7 @@ class OccupancyMap {
         threshold_(pixels, kNoCulling),
         bits_(pixels * static_cast<size_t>(words), 0u) {}
 
-  static size_t bytesPerPixel(int words) { return 12 + 4 * static_cast<size_t>(words); }
+  static size_t bytesPerPixel(int words) { return occupancyBytesPerPixel(words); }
   int words() const { return words_; }
   uint32_t buckets() const { return 32u * static_cast<uint32_t>(words_); }
 

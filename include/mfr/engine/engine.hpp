@@ -1,0 +1,80 @@
+// The seam between the method descriptions and the machines that run them. An Engine turns a
+// scene seen from a camera at a size into a PreparedView (the CPU engine: transformed, clipped
+// and binned triangles; a GPU engine: uploaded geometry and its framebuffer) and renders any
+// number of methods on it. Both engines take the same MethodDesc and RenderOptions and fill the
+// same RenderOutput (mfr/method/render_output.hpp); what only one engine measures goes into
+// RenderStats::engineCounters, not into the shared fields.
+//
+//   scene, camera, size --prepare--> PreparedView --render(method, options)--> RenderOutput
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "mfr/core/result.hpp"
+#include "mfr/method/method.hpp"
+#include "mfr/method/render_output.hpp"
+#include "mfr/scene/camera.hpp"
+#include "mfr/scene/scene.hpp"
+
+namespace mfr {
+
+/// One frame to render: the scene (it must outlive the PreparedView: the CPU engine's triangles
+/// point at its textures), the camera and the image size.
+struct View {
+  const Scene* scene = nullptr;
+  Camera camera;
+  int width = 512;
+  int height = 512;
+};
+
+/// Engine settings. `threads` (0 = all cores) and `tileSize` are the CPU engine's.
+struct EngineOptions {
+  int threads = 0;
+  int tileSize = 16;
+};
+
+/// A view set up by one engine for any number of renders. Owned by the caller; render() takes it
+/// back from the engine that made it (another engine's view is an error).
+class PreparedView {
+ public:
+  virtual ~PreparedView() = default;
+  virtual int width() const = 0;
+  virtual int height() const = 0;
+  size_t pixelCount() const { return static_cast<size_t>(width()) * static_cast<size_t>(height()); }
+};
+
+class Engine {
+ public:
+  virtual ~Engine() = default;
+  /// "cpu" or "gl".
+  virtual std::string_view name() const = 0;
+  /// What the engine runs on, as key/value lines for `mfr info` and the report's set-up table.
+  virtual std::map<std::string, std::string> describe() const = 0;
+  /// Sets up a view. Errors (one line): the size, the scene or the camera (see RasterFrame::build).
+  virtual Result<std::unique_ptr<PreparedView>> prepare(const View& view) = 0;
+  /// Renders one method on a prepared view (the passes of the method's description).
+  virtual Result<RenderOutput> render(const PreparedView& view, const MethodDesc& method,
+                                      const RenderOptions& options) = 0;
+  /// n(p) of every pixel (a coverage count pass), rows top to bottom.
+  virtual Result<std::vector<uint32_t>> countFragments(const PreparedView& view) = 0;
+  /// |n.v| of each pixel's nearest fragment (0 where none), quantised to 8 bits: the previous
+  /// frame's input of the importance allocation (RenderOptions::previousNearestCosine).
+  virtual Result<std::vector<float>> nearestCosine(const PreparedView& view) = 0;
+
+  /// prepare + render, for a single method.
+  Result<RenderOutput> render(const View& view, const MethodDesc& method,
+                              const RenderOptions& options);
+};
+
+/// The names makeEngine accepts, in order.
+std::vector<std::string> engineNames();
+
+/// An engine by name ("cpu"; "gl" when the build has the OpenGL engine). Errors (one line): an
+/// unknown name, listing the known ones; an engine that cannot start on this machine.
+Result<std::unique_ptr<Engine>> makeEngine(std::string_view name, const EngineOptions& options = {});
+
+}  // namespace mfr

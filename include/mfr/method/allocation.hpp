@@ -1,0 +1,52 @@
+// The allocation step every engine shares: the method's policy, the budget M and what the
+// earlier passes measured (n(p), importance I(p), the oracle's k(p)) give each pixel's slots k(p)
+// and where its nodes live (an exclusive prefix sum). A pure function of its inputs: no frame, no
+// engine. Policies and their papers: src/method/allocation.cpp.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include "mfr/core/result.hpp"
+#include "mfr/method/memory_model.hpp"
+#include "mfr/method/method.hpp"
+
+namespace mfr {
+
+/// The frame's pixels and the order of the node pool: offsets run tile by tile (tileSize x
+/// tileSize tiles, row-major inside a tile and over tiles; the S-buffer's clustering for
+/// locality), or row by row when tileSize is 0 (a full-screen prefix sum on the GPU).
+struct PixelLayout {
+  int width = 0;
+  int height = 0;
+  int tileSize = 0;
+  uint64_t pixels() const { return static_cast<uint64_t>(width) * static_cast<uint64_t>(height); }
+};
+
+/// Slots per pixel and where they live.
+struct Allocation {
+  std::vector<uint32_t> capacity;  // k(p)
+  std::vector<uint64_t> offsets;   // first slot of pixel p
+  std::vector<StoreKind> kind;     // store used by pixel p
+  uint64_t slots = 0;              // total nodes materialised
+  std::optional<uint32_t> globalK;
+  // Importance allocation: the paper's k(p) may exceed n(p); those slots are reserved (and
+  // accounted for) but never filled, so the engine materialises only min(k(p), n(p)).
+  std::vector<uint32_t> reservedK;  // k(p) as allocated (empty: same as capacity)
+  uint64_t reservedSlots = 0;       // sum of k(p): the nodes the memory model charges
+  uint64_t scratchBytes = 0;        // temporary buffers of the policy (histogram, k before caps)
+};
+
+/// Turns the policy, the budget and (when a count pass ran) n(p) into k(p) and offsets.
+/// `fragmentCounts`: n(p) (empty when the method does not count); `importance`: I(p) of the
+/// importance policies; `oracleK`: the optimal policy's k(p). Errors (one line): a budget too
+/// small for the per-pixel words and one node per (covered) pixel, a bounded policy with neither
+/// budget nor k, an explicit k that does not fit.
+Result<Allocation> allocate(const PixelLayout& layout, const MethodDesc& method,
+                            const MemoryModel& memory, std::optional<uint64_t> budget,
+                            const std::vector<uint32_t>& fragmentCounts,
+                            const std::vector<float>& importance,
+                            const std::vector<uint32_t>& oracleK);
+
+}  // namespace mfr
