@@ -1,0 +1,44 @@
+// Fixed-k max-array k-buffer capture with the k+ culling test (Vasilakis and Fudos, k+-buffer):
+// pixel p owns the k nodes nodes[p * k .. p * k + k), initialised to the far node, with the maximum
+// always in slot 0. A fragment not nearer than that maximum is culled before the critical section
+// (its depth word alone is compared there: slot 0's depth word only decreases, so a stale read is
+// conservative). Otherwise it takes the pixel's spin-lock (imageAtomicExchange); the loop is around
+// the critical section, not a spin inside it, so lanes of one SIMD group cannot deadlock.
+layout(std430, binding = kBindNodes) coherent buffer Nodes {
+  uvec2 nodes[];
+};
+layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
+uniform uint uK;
+
+void main() {
+  FragmentData f;
+  if (!exactCoverage(f)) discard;
+  vec4 base;
+  if (!surface(f, false, base)) discard;
+  const uvec2 node = uvec2(floatBitsToUint(fragmentDepth(f)), shade(f, base));
+  const uint first = uint(f.pixel) * uK;
+  if (node.x > nodes[first].x) return;  // k+ test
+  bool done = false;
+  while (!done) {
+    if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
+      const uvec2 maxNode = nodes[first];
+      if (nodeLess(node, maxNode)) {
+        // replace the maximum; the new maximum of the k moves to slot 0
+        uint maxIndex = 0u;
+        uvec2 m = node;
+        for (uint i = 1u; i < uK; ++i) {
+          const uvec2 s = nodes[first + i];
+          if (nodeLess(m, s)) {
+            m = s;
+            maxIndex = i;
+          }
+        }
+        if (maxIndex != 0u) nodes[first + maxIndex] = node;
+        nodes[first] = m;
+      }
+      memoryBarrierBuffer();
+      imageAtomicExchange(uLocks, f.pixel, kLockFree);
+      done = true;
+    }
+  }
+}

@@ -1,0 +1,71 @@
+// Resolve: one invocation per pixel sorts the pixel's captured nodes in place (insertion sort in
+// the node buffer, so any count fits) and composites them front to back in linear RGB over the
+// background with the CPU engine's kbuffer rule (mfr::compositeKBuffer), operation for operation.
+layout(local_size_x = kResolveGroupSize) in;
+
+layout(std430, binding = kBindCounts) readonly buffer Counts {
+  uint counts[];
+};
+layout(std430, binding = kBindOffsets) readonly buffer Offsets {
+  uint offsets[];
+};
+layout(std430, binding = kBindNodes) buffer Nodes {
+  uvec2 nodes[];
+};
+layout(std430, binding = kBindImage) writeonly buffer Image {
+  float image[];  // linear RGB, 3 floats per pixel, rows top to bottom
+};
+layout(std430, binding = kBindColorTables) readonly buffer ColorTables {
+  uint colorTables[];
+};
+
+uniform uint uPixels;
+uniform uint uK;  // 0: A-buffer (n(p) nodes at offsets[p]); k > 0: k slots at p * k
+uniform vec3 uBackground;
+uniform float uInv255;
+
+float srgb8ToLinear(uint code) {
+  return uintBitsToFloat(colorTables[kTableLinearBase + code]);
+}
+
+void main() {
+  const uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
+  const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
+  if (p >= uPixels) return;
+  uint first, slots, n;
+  if (uK == 0u) {
+    first = offsets[p];
+    slots = counts[p];
+    n = slots;
+  } else {
+    first = p * uK;
+    slots = uK;  // empty slots hold the far node and sort last
+    n = min(counts[p], uK);
+  }
+  for (uint i = 1u; i < slots; ++i) {
+    const uvec2 v = nodes[first + i];
+    uint j = i;
+    while (j > 0u && nodeLess(v, nodes[first + j - 1u])) {
+      nodes[first + j] = nodes[first + j - 1u];
+      --j;
+    }
+    nodes[first + j] = v;
+  }
+  vec3 color = vec3(0.0);
+  float T = 1.0;
+  for (uint i = 0u; i < n; ++i) {
+    const uint rgba = nodes[first + i].y;
+    precise float a = float(rgba >> 24) * uInv255;
+    const vec3 c = vec3(srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
+                        srgb8ToLinear((rgba >> 16) & 0xffu));
+    precise float w = a * T;
+    precise vec3 sum = color + c * w;
+    color = sum;
+    precise float nextT = T * (1.0 - a);
+    T = nextT;
+  }
+  precise vec3 result = color + T * uBackground;
+  image[3u * p + 0u] = result.r;
+  image[3u * p + 1u] = result.g;
+  image[3u * p + 2u] = result.b;
+}
