@@ -413,13 +413,15 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
   State& s = *state_;
   const bool isABuffer =
       method.allocation == AllocationPolicy::Unbounded && method.store == StoreChoice::Append;
-  const bool isKBuffer = method.allocation == AllocationPolicy::FixedK &&
-                         method.store == StoreChoice::MaxArray && method.k && *method.k > 0;
+  const bool isKBuffer =
+      method.allocation == AllocationPolicy::FixedK &&
+      (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap) && method.k &&
+      *method.k > 0;
   if ((!isABuffer && !isKBuffer) || method.occupancyWords != 0 ||
       method.compositing != Compositing::KBuffer)
     return makeError("--engine gl: method " + method.name +
-                     " is not in the GL engine yet (abuffer and fixed-k max-array k-buffers with "
-                     "an explicit k)");
+                     " is not in the GL engine yet (abuffer and fixed-k max-array or max-heap "
+                     "k-buffers with an explicit k)");
   const uint32_t k = isKBuffer ? *method.k : 0u;
   const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
 
@@ -482,6 +484,8 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
       clearUint(locks, kLockFree);
       glProgramUniform1ui(s.progKBuffer, loc(s.progKBuffer, "uK"), k);
+      glProgramUniform1ui(s.progKBuffer, loc(s.progKBuffer, "uStore"),
+                          method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
       pass("capture", [&] {
         glUseProgram(s.progKBuffer);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);

@@ -48,6 +48,10 @@ struct Case {
   int width, height;
 };
 
+void PrintTo(const Case& c, std::ostream* os) {
+  *os << c.scene << " " << c.width << "x" << c.height;
+}
+
 std::string caseName(const testing::TestParamInfo<Case>& info) {
   std::string s = info.param.scene.substr(info.param.scene.find(':') + 1);
   return s + "_" + std::to_string(info.param.width) + "x" + std::to_string(info.param.height);
@@ -193,6 +197,16 @@ TEST_P(GlVsCpu, ABufferNodesAndImageEqualTheCpuEngine) {
 TEST_P(GlVsCpu, KBufferK4NodesAndImageEqualTheCpuKPlusArray) {
   MethodDesc method = methodPreset("kplus-array").value();
   method.k = 4;
+  const RenderOutput cpu = cpuRender(method);
+  const GlRenderOutput gl = glRender(method);
+  expectSameNodes(cpu, gl);
+  expectSameImage(cpu.image, gl.image);
+  printPasses(gl);
+}
+
+TEST_P(GlVsCpu, KBufferHeapK5NodesAndImageEqualTheCpuKPlusHeap) {
+  MethodDesc method = methodPreset("kplus-heap").value();
+  method.k = 5;
   const RenderOutput cpu = cpuRender(method);
   const GlRenderOutput gl = glRender(method);
   expectSameNodes(cpu, gl);

@@ -54,10 +54,10 @@ struct GlRenderOutput {
 };
 
 /// One scene and view uploaded to GL once; render() runs a method on it any number of times.
-/// Supported methods (this slice): `abuffer` (unbounded, append) and fixed-k max-array k-buffers
-/// with an explicit k (`fkb`, `kplus-array`, `zbuffer`); anything else is an error naming the
-/// method. The engine must be used on the thread where its context is current, and the context
-/// must outlive it.
+/// Supported methods (this slice): `abuffer` (unbounded, append) and fixed-k max-array or max-heap
+/// k-buffers with an explicit k (`fkb`, `kplus-array`, `kplus-heap`, `zbuffer`; the k+ test runs
+/// for all of them: it changes no captured set); anything else is an error naming the method. The
+/// engine must be used on the thread where its context is current, and the context must outlive it.
 class GlEngine {
  public:
   /// Errors (one line): the size outside [1, 16384] or above GL's limits, a scene failing

@@ -21,6 +21,8 @@ MFR_GL_CONST(uint, kNodeHiIndex, 0u)            // uvec2 component holding the d
 MFR_GL_CONST(uint, kFarDepthBits, 0x7f800000u)  // +inf: the empty node (mfr::kFarNode)
 MFR_GL_CONST(uint, kLockFree, 0u)               // per-pixel spin-lock values
 MFR_GL_CONST(uint, kLockHeld, 1u)
+MFR_GL_CONST(uint, kStoreMaxArray, 0u)  // k-buffer stores (uStore)
+MFR_GL_CONST(uint, kStoreMaxHeap, 1u)
 MFR_GL_CONST(uint, kScanGroupSize, 256u)     // prefix sum: threads per work group
 MFR_GL_CONST(uint, kScanItemsPerThread, 4u)  // consecutive elements per thread
 MFR_GL_CONST(uint, kResolveGroupSize, 64u)   // resolve: pixels per work group
