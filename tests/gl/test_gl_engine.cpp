@@ -10,6 +10,7 @@
 #include <cstring>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -57,6 +58,59 @@ std::string caseName(const testing::TestParamInfo<Case>& info) {
   return s + "_" + std::to_string(info.param.width) + "x" + std::to_string(info.param.height);
 }
 
+void compareNodes(const RenderOutput& cpu, const GlRenderOutput& gl, int width) {
+  const size_t pixels = cpu.counts.size();
+  ASSERT_EQ(gl.nodeCounts.size(), pixels);
+  size_t identical = 0, depthOnly = 0, different = 0, nodes = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    std::vector<FragmentNode> a(
+        cpu.nodes.begin() + static_cast<ptrdiff_t>(cpu.offsets[p]),
+        cpu.nodes.begin() + static_cast<ptrdiff_t>(cpu.offsets[p] + cpu.counts[p]));
+    std::vector<FragmentNode> b(
+        gl.nodes.begin() + static_cast<ptrdiff_t>(gl.nodeOffsets[p]),
+        gl.nodes.begin() + static_cast<ptrdiff_t>(gl.nodeOffsets[p] + gl.nodeCounts[p]));
+    std::sort(a.begin(), a.end());
+    ASSERT_TRUE(std::is_sorted(b.begin(), b.end())) << "pixel " << p;
+    nodes += a.size();
+    if (a == b) {
+      ++identical;
+      continue;
+    }
+    bool close = a.size() == b.size();
+    for (size_t i = 0; close && i < a.size(); ++i) {
+      const float da = nodeDepth(a[i]), db = nodeDepth(b[i]);
+      close = nodeColor(a[i]) == nodeColor(b[i]) &&
+              std::fabs(da - db) <= 1e-6f * std::max(std::fabs(da), 1e-30f);
+    }
+    if (close) {
+      ++depthOnly;
+    } else {
+      if (different < 10)
+        std::cout << "  nodes differ at pixel (" << p % width << ", " << p / width << "): CPU "
+                  << a.size() << ", GL " << b.size() << "\n";
+      ++different;
+    }
+  }
+  std::cout << "  nodes: " << nodes << " CPU nodes; pixels identical " << identical
+            << ", depth within 1e-6 " << depthOnly << ", different " << different << " of "
+            << pixels << "\n";
+  EXPECT_EQ(different, 0u);
+}
+
+void compareImages(const ImageRGB& cpu, const ImageRGB& gl) {
+  ASSERT_EQ(cpu.pixels.size(), gl.pixels.size());
+  float maxDiff = 0.0f;
+  size_t exact = 0;
+  for (size_t i = 0; i < cpu.pixels.size(); ++i) {
+    const glm::vec3 d = glm::abs(cpu.pixels[i] - gl.pixels[i]);
+    maxDiff = std::max({maxDiff, d.r, d.g, d.b});
+    exact += cpu.pixels[i] == gl.pixels[i];
+  }
+  std::cout << "  image: max |CPU - GL| " << maxDiff << " (linear), pixels bit-identical " << exact
+            << " of " << cpu.pixels.size() << "\n";
+  EXPECT_LE(maxDiff, 1.0f / 255.0f);
+}
+
 class GlVsCpu : public testing::TestWithParam<Case> {
  protected:
   void SetUp() override {
@@ -96,58 +150,9 @@ class GlVsCpu : public testing::TestWithParam<Case> {
   // Same captured node set per pixel (the CPU stores are unsorted; GL's are sorted by the
   // resolve). Returns the pixels whose sets differ.
   void expectSameNodes(const RenderOutput& cpu, const GlRenderOutput& gl) const {
-    const size_t pixels = frame_->pixelCount();
-    ASSERT_EQ(cpu.counts.size(), pixels);
-    ASSERT_EQ(gl.nodeCounts.size(), pixels);
-    size_t identical = 0, depthOnly = 0, different = 0, nodes = 0;
-    for (size_t p = 0; p < pixels; ++p) {
-      std::vector<FragmentNode> a(
-          cpu.nodes.begin() + static_cast<ptrdiff_t>(cpu.offsets[p]),
-          cpu.nodes.begin() + static_cast<ptrdiff_t>(cpu.offsets[p] + cpu.counts[p]));
-      std::vector<FragmentNode> b(
-          gl.nodes.begin() + static_cast<ptrdiff_t>(gl.nodeOffsets[p]),
-          gl.nodes.begin() + static_cast<ptrdiff_t>(gl.nodeOffsets[p] + gl.nodeCounts[p]));
-      std::sort(a.begin(), a.end());
-      ASSERT_TRUE(std::is_sorted(b.begin(), b.end())) << "pixel " << p;
-      nodes += a.size();
-      if (a == b) {
-        ++identical;
-        continue;
-      }
-      bool close = a.size() == b.size();
-      for (size_t i = 0; close && i < a.size(); ++i) {
-        const float da = nodeDepth(a[i]), db = nodeDepth(b[i]);
-        close = nodeColor(a[i]) == nodeColor(b[i]) &&
-                std::fabs(da - db) <= 1e-6f * std::max(std::fabs(da), 1e-30f);
-      }
-      if (close) {
-        ++depthOnly;
-      } else {
-        if (different < 10)
-          std::cout << "  nodes differ at pixel (" << p % frame_->width() << ", "
-                    << p / frame_->width() << "): CPU " << a.size() << ", GL " << b.size() << "\n";
-        ++different;
-      }
-    }
-    std::cout << "  nodes: " << nodes << " CPU nodes; pixels identical " << identical
-              << ", depth within 1e-6 " << depthOnly << ", different " << different << " of "
-              << pixels << "\n";
-    EXPECT_EQ(different, 0u);
+    compareNodes(cpu, gl, frame_->width());
   }
-
-  void expectSameImage(const ImageRGB& cpu, const ImageRGB& gl) const {
-    ASSERT_EQ(cpu.pixels.size(), gl.pixels.size());
-    float maxDiff = 0.0f;
-    size_t exact = 0;
-    for (size_t i = 0; i < cpu.pixels.size(); ++i) {
-      const glm::vec3 d = glm::abs(cpu.pixels[i] - gl.pixels[i]);
-      maxDiff = std::max({maxDiff, d.r, d.g, d.b});
-      exact += cpu.pixels[i] == gl.pixels[i];
-    }
-    std::cout << "  image: max |CPU - GL| " << maxDiff << " (linear), pixels bit-identical "
-              << exact << " of " << cpu.pixels.size() << "\n";
-    EXPECT_LE(maxDiff, 1.0f / 255.0f);
-  }
+  void expectSameImage(const ImageRGB& cpu, const ImageRGB& gl) const { compareImages(cpu, gl); }
 
   static void printPasses(const GlRenderOutput& gl) {
     std::cout << "  GL passes:";
@@ -238,6 +243,88 @@ INSTANTIATE_TEST_SUITE_P(Scenes, GlVsCpu,
                                          Case{"procedural:hairball", 128, 128},
                                          Case{"procedural:hairball", 131, 97}),
                          caseName);
+
+// Overlapping tilted quads with a small RGBA texture (uvs beyond [0, 1] and negative: repeat
+// wrapping), Blend, Mask (alpha test on the texture's alpha) and Opaque materials: the texture
+// sampling and alpha test paths, which the procedural scenes do not use.
+Scene texturedQuads(std::optional<float> alphaOverride) {
+  Scene s;
+  s.name = "textured quads";
+  Texture t;
+  t.width = 7;
+  t.height = 5;
+  for (int y = 0; y < t.height; ++y)
+    for (int x = 0; x < t.width; ++x) {
+      t.rgba.push_back(static_cast<uint8_t>((x * 37 + y * 11) % 256));
+      t.rgba.push_back(static_cast<uint8_t>((x * 5 + y * 71) % 256));
+      t.rgba.push_back(static_cast<uint8_t>((x * 93 + y * 29) % 256));
+      t.rgba.push_back(static_cast<uint8_t>((x + y) % 3 == 0 ? 20 : 40 + 50 * ((x * y) % 5)));
+    }
+  s.textures.push_back(t);
+  Material blend;
+  blend.baseColor = {0.9f, 0.8f, 0.7f, 0.6f};
+  blend.baseColorTexture = 0;
+  blend.alphaMode = AlphaMode::Blend;
+  Material mask;
+  mask.baseColor = {1.0f, 0.9f, 1.0f, 1.0f};
+  mask.baseColorTexture = 0;
+  mask.alphaMode = AlphaMode::Mask;
+  mask.alphaCutoff = 0.45f;
+  Material opaque;
+  opaque.baseColor = {0.2f, 0.6f, 0.3f, 1.0f};
+  opaque.alphaMode = AlphaMode::Opaque;
+  s.materials = {blend, mask, opaque};
+  for (int q = 0; q < 6; ++q) {
+    const float z = -0.35f * static_cast<float>(q), dx = 0.13f * static_cast<float>(q) - 0.3f;
+    const float tilt = 0.2f * static_cast<float>(q % 3) - 0.2f;
+    const uint32_t base = static_cast<uint32_t>(s.positions.size());
+    const glm::vec2 corners[4] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+    for (const glm::vec2& c : corners) {
+      s.positions.push_back({c.x + dx, c.y * 0.8f, z + tilt * c.x});
+      s.normals.push_back(glm::normalize(glm::vec3(-tilt + 0.1f * c.y, 0.15f * c.x, 1.0f)));
+      s.uvs.push_back({(c.x + 1.0f) * 1.9f - 1.3f, (c.y + 1.0f) * 1.6f - 0.7f});
+    }
+    for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) s.indices.push_back(base + i);
+    s.triangleMaterial.push_back(static_cast<uint32_t>(q % 3));
+    s.triangleMaterial.push_back(static_cast<uint32_t>(q % 3));
+  }
+  Camera camera;
+  camera.eye = {0.4f, 0.5f, 3.0f};
+  camera.target = {0.0f, 0.0f, -0.8f};
+  camera.fovYDegrees = 50.0f;
+  s.defaultCamera = camera;
+  s.alphaOverride = alphaOverride;
+  return s;
+}
+
+TEST(GlEngine, TexturedMaskedQuadsEqualTheCpuEngine) {
+  MFR_REQUIRE_GL();
+  for (std::optional<float> alphaOverride : {std::optional<float>(), std::optional<float>(0.5f)}) {
+    const Scene scene = texturedQuads(alphaOverride);
+    const int width = 101, height = 67;
+    auto frame =
+        RasterFrame::build(scene, *scene.defaultCamera, RasterOptions{width, height, 16, 0});
+    ASSERT_TRUE(frame.ok()) << frame.error().message;
+    auto engine =
+        GlEngine::create(sharedContext().value(), scene, *scene.defaultCamera, width, height);
+    ASSERT_TRUE(engine.ok()) << engine.error().message;
+    const MethodDesc method = methodPreset("abuffer").value();
+    RenderOptions cpuOptions;
+    cpuOptions.keepStores = true;
+    cpuOptions.background = kBackground;
+    auto cpu = render(*frame, method, cpuOptions);
+    ASSERT_TRUE(cpu.ok()) << cpu.error().message;
+    GlRenderOptions glOptions;
+    glOptions.background = kBackground;
+    glOptions.readNodes = true;
+    auto gl = engine->render(method, glOptions);
+    ASSERT_TRUE(gl.ok()) << gl.error().message;
+    EXPECT_EQ(gl->counts, countFragments(*frame));
+    EXPECT_GT(gl->fragments, 5000u);
+    compareNodes(*cpu, *gl, width);
+    compareImages(cpu->image, gl->image);
+  }
+}
 
 TEST(GlContext, ReportsRendererAndExtensions) {
   MFR_REQUIRE_GL();
