@@ -1,5 +1,6 @@
-// Resolve: one invocation per pixel sorts the pixel's captured nodes in place (insertion sort in
-// the node buffer, so any count fits) and composites them front to back in linear RGB over the
+// Resolve: one invocation per pixel sorts the pixel's captured nodes (insertion sort in a local
+// array when they fit in kResolveLocalNodes, else in place in the node buffer, so any count works),
+// writes them back sorted, and composites them front to back in linear RGB over the
 // background with the CPU engine's kbuffer rule (mfr::compositeKBuffer), operation for operation.
 layout(local_size_x = kResolveGroupSize) in;
 
@@ -42,14 +43,32 @@ void main() {
     slots = uK;  // empty slots hold the far node and sort last
     n = min(counts[p], uK);
   }
-  for (uint i = 1u; i < slots; ++i) {
-    const uvec2 v = nodes[first + i];
-    uint j = i;
-    while (j > 0u && nodeLess(v, nodes[first + j - 1u])) {
-      nodes[first + j] = nodes[first + j - 1u];
-      --j;
+  if (slots <= kResolveLocalNodes) {
+    uvec2 local[kResolveLocalNodes];
+    for (uint i = 0u; i < slots; ++i) {
+      const uvec2 v = nodes[first + i];
+      uint j = i;
+      while (j > 0u) {  // (no local[j - 1] read at j == 0, not even short-circuited)
+        const uvec2 previous = local[j - 1u];
+        if (!nodeLess(v, previous)) break;
+        local[j] = previous;
+        --j;
+      }
+      local[j] = v;
     }
-    nodes[first + j] = v;
+    for (uint i = 0u; i < slots; ++i) nodes[first + i] = local[i];
+  } else {
+    for (uint i = 1u; i < slots; ++i) {
+      const uvec2 v = nodes[first + i];
+      uint j = i;
+      while (j > 0u) {
+        const uvec2 previous = nodes[first + j - 1u];
+        if (!nodeLess(v, previous)) break;
+        nodes[first + j] = previous;
+        --j;
+      }
+      nodes[first + j] = v;
+    }
   }
   vec3 color = vec3(0.0);
   float T = 1.0;

@@ -23,10 +23,11 @@ MFR_GL_CONST(uint, kLockFree, 0u)               // per-pixel spin-lock values
 MFR_GL_CONST(uint, kLockHeld, 1u)
 MFR_GL_CONST(uint, kStoreMaxArray, 0u)  // k-buffer stores (uStore)
 MFR_GL_CONST(uint, kStoreMaxHeap, 1u)
-MFR_GL_CONST(uint, kScanGroupSize, 256u)     // prefix sum: threads per work group
-MFR_GL_CONST(uint, kScanItemsPerThread, 4u)  // consecutive elements per thread
-MFR_GL_CONST(uint, kResolveGroupSize, 64u)   // resolve: pixels per work group
-MFR_GL_CONST(uint, kMaxClipVertices, 12u)    // Sutherland-Hodgman polygon capacity
+MFR_GL_CONST(uint, kScanGroupSize, 256u)      // prefix sum: threads per work group
+MFR_GL_CONST(uint, kScanItemsPerThread, 4u)   // consecutive elements per thread
+MFR_GL_CONST(uint, kResolveGroupSize, 64u)    // resolve: pixels per work group
+MFR_GL_CONST(uint, kResolveLocalNodes, 128u)  // resolve: nodes sorted in a local array
+MFR_GL_CONST(uint, kMaxClipVertices, 12u)     // Sutherland-Hodgman polygon capacity
 
 // binding points: SSBOs (at most 8, GL 4.3's minimum of bindings) and image units (2)
 MFR_GL_CONST(uint, kBindCounts, 0u)       // n(p): r32ui imageBuffer unit (count), SSBO (resolve)
