@@ -12,15 +12,40 @@ layout(std430, binding = kBindNodes) coherent buffer Nodes {
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
 uniform uint uK;
 uniform uint uStore;  // kStoreMaxArray or kStoreMaxHeap
+uniform uint uOccupancyWords;  // 0: no occupancy culling
+layout(std430, binding = kBindOccRange) readonly buffer Range {
+  uint range[];
+};
+layout(std430, binding = kBindOccThreshold) readonly buffer Threshold {
+  uint threshold[];
+};
+layout(std430, binding = kBindCaptureStats) buffer CaptureStats {
+  uint culledOccupancy;
+  uint culledKPlus;
+};
 
 void main() {
   FragmentData f;
   if (!exactCoverage(f)) discard;
   vec4 base;
   if (!surface(f, false, base)) discard;
-  const uvec2 node = uvec2(floatBitsToUint(fragmentDepth(f)), shade(f, base));
-  const uint first = uint(f.pixel) * uK;
-  if (node.x > nodes[first].x) return;  // k+ test
+  const float depth = fragmentDepth(f);
+  const uint p = uint(f.pixel);
+  if (uOccupancyWords > 0u) {  // occupancy test: behind the pixel's k-th occupied bucket
+    const uint t = threshold[p];
+    if (t != kOccupancyNoCulling &&
+        occupancyBucket(depth, uintBitsToFloat(range[2u * p]), uintBitsToFloat(range[2u * p + 1u]),
+                        32u * uOccupancyWords) > t) {
+      atomicAdd(culledOccupancy, 1u);
+      return;
+    }
+  }
+  const uvec2 node = uvec2(floatBitsToUint(depth), shade(f, base));
+  const uint first = p * uK;
+  if (node.x > nodes[first].x) {  // k+ test
+    atomicAdd(culledKPlus, 1u);
+    return;
+  }
   bool done = false;
   while (!done) {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {

@@ -178,3 +178,15 @@ uint shade(FragmentData f, vec4 base) {
   precise vec3 rgb = base.rgb * light;
   return packColor(rgb, base.a);
 }
+
+// occupancy map bucket of depth z (mfr::OccupancyMap::bucket): monotone in z, shared by the fill
+// pass and the capture's test
+uint occupancyBucket(float z, float zn, float zf, uint buckets) {
+  if (!(zf > zn)) return 0u;
+  precise float num = z - zn;
+  precise float den = zf - zn;
+  precise float q = num / den;
+  precise float t = q * float(buckets);
+  const uint b = t > 0.0 ? uint(t) : 0u;
+  return b < buckets ? b : buckets - 1u;
+}

@@ -175,12 +175,13 @@ struct GlEngine::State {
   GLsizei indexCount = 0;
   GLuint fbo = 0;
   GLuint progCount = 0, progABuffer = 0, progKBuffer = 0, progScan = 0, progScanAdd = 0,
-         progResolve = 0;
+         progResolve = 0, progDepthRange = 0, progOccFill = 0, progOccCount = 0;
   GLuint query = 0;
   std::map<std::string, uint64_t> sceneBytes;
 
   ~State() {
-    for (GLuint p : {progCount, progABuffer, progKBuffer, progScan, progScanAdd, progResolve})
+    for (GLuint p : {progCount, progABuffer, progKBuffer, progScan, progScanAdd, progResolve,
+                     progDepthRange, progOccFill, progOccCount})
       if (p) glDeleteProgram(p);
     if (!sceneBuffers.empty())
       glDeleteBuffers(static_cast<GLsizei>(sceneBuffers.size()), sceneBuffers.data());
@@ -320,6 +321,16 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto kbuffer = raster("capture_kbuffer.frag");
   if (!kbuffer) return kbuffer.error();
   s->progKBuffer = *kbuffer;
+  auto depthRange = raster("depth_range.frag");
+  if (!depthRange) return depthRange.error();
+  s->progDepthRange = *depthRange;
+  auto occFill = raster("occupancy_fill.frag");
+  if (!occFill) return occFill.error();
+  s->progOccFill = *occFill;
+  auto occCount =
+      linkProgram("occupancy_count.comp", {{GL_COMPUTE_SHADER, "occupancy_count.comp"}});
+  if (!occCount) return occCount.error();
+  s->progOccCount = *occCount;
   auto scanProgram = linkProgram("prefix_sum.comp", {{GL_COMPUTE_SHADER, "prefix_sum.comp"}});
   if (!scanProgram) return scanProgram.error();
   s->progScan = *scanProgram;
@@ -329,7 +340,8 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto resolve = linkProgram("resolve.comp", {{GL_COMPUTE_SHADER, "resolve.comp"}});
   if (!resolve) return resolve.error();
   s->progResolve = *resolve;
-  for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer}) s->setRasterUniforms(p);
+  for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill})
+    s->setRasterUniforms(p);
 
   // geometry, once
   const size_t vertices = scene.positions.size();
@@ -417,7 +429,8 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       method.allocation == AllocationPolicy::FixedK &&
       (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap) && method.k &&
       *method.k > 0;
-  if ((!isABuffer && !isKBuffer) || method.occupancyWords != 0 ||
+  if ((!isABuffer && !isKBuffer) || (isABuffer && method.occupancyWords != 0) ||
+      method.occupancyWords < 0 || method.occupancyWords > 64 ||
       method.compositing != Compositing::KBuffer)
     return makeError("--engine gl: method " + method.name +
                      " is not in the GL engine yet (abuffer and fixed-k max-array or max-heap "
@@ -478,21 +491,68 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       });
     } else {
       nodeCount = uint64_t{pixels} * k;
+      const uint32_t words = static_cast<uint32_t>(method.occupancyWords);
+      const GLuint stats = fb.make("capture counters", 8);
+      clearUint(stats, 0);
+      GLuint range = stats, threshold = stats;
+      if (words > 0) {
+        // occupancy culling: depth range, bitmap fill, k-th occupied bucket
+        range = fb.make("occupancy", uint64_t{pixels} * 8);
+        const uint32_t init[2] = {kFarDepthBits, 0u};
+        glClearNamedBufferData(range, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT, init);
+        const GLuint bitmap = fb.make("occupancy", uint64_t{pixels} * words * 4);
+        clearUint(bitmap, 0);
+        threshold = fb.make("occupancy", uint64_t{pixels} * 4);
+        pass("depth range", [&] {
+          glUseProgram(s.progDepthRange);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccRange, range);
+          s.drawScene();
+          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        });
+        pass("occupancy fill", [&] {
+          glUseProgram(s.progOccFill);
+          glProgramUniform1ui(s.progOccFill, loc(s.progOccFill, "uWords"), words);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccRange, range);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
+          s.drawScene();
+          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        });
+        pass("occupancy count", [&] {
+          const GLuint p = s.progOccCount;
+          glUseProgram(p);
+          glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+          glProgramUniform1ui(p, loc(p, "uWords"), words);
+          glProgramUniform1ui(p, loc(p, "uK"), k);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccThreshold, threshold);
+          dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        });
+      }
       nodes = fb.make("nodes", nodeCount * kNodeBytes);
       const uint32_t far[2] = {kFarDepthBits, 0u};
       glClearNamedBufferData(nodes, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT, far);
       const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
       clearUint(locks, kLockFree);
-      glProgramUniform1ui(s.progKBuffer, loc(s.progKBuffer, "uK"), k);
-      glProgramUniform1ui(s.progKBuffer, loc(s.progKBuffer, "uStore"),
+      const GLuint p = s.progKBuffer;
+      glProgramUniform1ui(p, loc(p, "uK"), k);
+      glProgramUniform1ui(p, loc(p, "uStore"),
                           method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
+      glProgramUniform1ui(p, loc(p, "uOccupancyWords"), words);
       pass("capture", [&] {
-        glUseProgram(s.progKBuffer);
+        glUseProgram(p);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccRange, range);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccThreshold, threshold);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCaptureStats, stats);
         fb.bindImage(locks, kBindLocks);
         s.drawScene();
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
       });
+      uint32_t culled[2] = {0, 0};
+      glGetNamedBufferSubData(stats, 0, 8, culled);
+      out.culledOccupancy = culled[0];
+      out.culledKPlus = culled[1];
     }
 
     const GLuint image = fb.make("image", uint64_t{pixels} * 12);

@@ -219,6 +219,26 @@ TEST_P(GlVsCpu, KBufferHeapK5NodesAndImageEqualTheCpuKPlusHeap) {
   printPasses(gl);
 }
 
+// Occupancy culling (d = 1 and 2 words): the same nearest sets, and since the maps and the test
+// do not depend on arrival order, the same number of fragments culled by the occupancy test.
+TEST_P(GlVsCpu, OccupancyCullingEqualsTheCpuEngine) {
+  for (const char* preset : {"kplus-array+occupancy", "kplus-heap+occupancy"}) {
+    MethodDesc method = methodPreset(preset).value();
+    method.k = 4;
+    method.occupancyWords = std::string(preset) == "kplus-heap+occupancy" ? 2 : 1;
+    const RenderOutput cpu = cpuRender(method);
+    const GlRenderOutput gl = glRender(method);
+    std::cout << "  " << preset << " d=" << method.occupancyWords << ": culled by occupancy CPU "
+              << cpu.stats.culledOccupancy << ", GL " << gl.culledOccupancy << "; by k+ CPU "
+              << cpu.stats.culledKPlus << ", GL " << gl.culledKPlus << "\n";
+    EXPECT_EQ(gl.culledOccupancy, cpu.stats.culledOccupancy) << preset;
+    EXPECT_GT(gl.culledOccupancy, 0u) << preset;
+    expectSameNodes(cpu, gl);
+    expectSameImage(cpu.image, gl.image);
+    printPasses(gl);
+  }
+}
+
 TEST_P(GlVsCpu, ThreeRunsAreByteIdentical) {
   for (const char* preset : {"abuffer", "kplus-array"}) {
     MethodDesc method = methodPreset(preset).value();

@@ -50,13 +50,16 @@ struct GlRenderOutput {
   std::vector<uint32_t> nodeCounts;
   std::map<std::string, uint64_t> bufferBytes;  // every GL buffer the frame allocated, by name
   uint64_t totalBufferBytes() const;
+  uint64_t culledOccupancy = 0;    // k-buffers: rejected by the occupancy test (order-independent)
+  uint64_t culledKPlus = 0;        // k-buffers: rejected by the k+ test (depends on arrival order)
   std::vector<GlPassTime> passes;  // count, prefix sum, capture, resolve (timed run)
 };
 
 /// One scene and view uploaded to GL once; render() runs a method on it any number of times.
 /// Supported methods (this slice): `abuffer` (unbounded, append) and fixed-k max-array or max-heap
 /// k-buffers with an explicit k (`fkb`, `kplus-array`, `kplus-heap`, `zbuffer`; the k+ test runs
-/// for all of them: it changes no captured set); anything else is an error naming the method. The
+/// for all of them: it changes no captured set), optionally with occupancy culling (`+occupancy`,
+/// d = occupancyWords); anything else is an error naming the method. The
 /// engine must be used on the thread where its context is current, and the context must outlive it.
 class GlEngine {
  public:

@@ -23,24 +23,29 @@ MFR_GL_CONST(uint, kLockFree, 0u)               // per-pixel spin-lock values
 MFR_GL_CONST(uint, kLockHeld, 1u)
 MFR_GL_CONST(uint, kStoreMaxArray, 0u)  // k-buffer stores (uStore)
 MFR_GL_CONST(uint, kStoreMaxHeap, 1u)
-MFR_GL_CONST(uint, kScanGroupSize, 256u)      // prefix sum: threads per work group
-MFR_GL_CONST(uint, kScanItemsPerThread, 4u)   // consecutive elements per thread
-MFR_GL_CONST(uint, kResolveGroupSize, 64u)    // resolve: pixels per work group
-MFR_GL_CONST(uint, kResolveLocalNodes, 128u)  // resolve: nodes sorted in a local array
-MFR_GL_CONST(uint, kMaxClipVertices, 12u)     // Sutherland-Hodgman polygon capacity
+MFR_GL_CONST(uint, kOccupancyNoCulling, 0xffffffffu)  // mfr::OccupancyMap::kNoCulling
+MFR_GL_CONST(uint, kScanGroupSize, 256u)              // prefix sum: threads per work group
+MFR_GL_CONST(uint, kScanItemsPerThread, 4u)           // consecutive elements per thread
+MFR_GL_CONST(uint, kResolveGroupSize, 64u)            // resolve: pixels per work group
+MFR_GL_CONST(uint, kResolveLocalNodes, 128u)          // resolve: nodes sorted in a local array
+MFR_GL_CONST(uint, kMaxClipVertices, 12u)             // Sutherland-Hodgman polygon capacity
 
 // binding points: SSBOs (at most 8, GL 4.3's minimum of bindings) and image units (2)
-MFR_GL_CONST(uint, kBindCounts, 0u)       // n(p): r32ui imageBuffer unit (count), SSBO (resolve)
-MFR_GL_CONST(uint, kBindOffsets, 1u)      // exclusive prefix sum of n(p)
-MFR_GL_CONST(uint, kBindNodes, 2u)        // uvec2 nodes
-MFR_GL_CONST(uint, kBindFill, 3u)         // A-buffer per-pixel fill counters
-MFR_GL_CONST(uint, kBindImage, 3u)        // resolve output: linear RGB floats (resolve only)
-MFR_GL_CONST(uint, kBindMaterials, 4u)    // materials
-MFR_GL_CONST(uint, kBindTriMaterial, 5u)  // material index per triangle
-MFR_GL_CONST(uint, kBindColorTables, 6u)  // srgb8ToLinear, coarseSrgb8, lowerBound
-MFR_GL_CONST(uint, kBindTexels, 7u)       // every texture's RGBA8 texels, one uint each
-MFR_GL_CONST(uint, kBindLocks, 1u)        // r32ui imageBuffer unit of the spin-locks
-MFR_GL_CONST(uint, kBindScanIn, 0u)       // prefix sum level: input, output, block sums
+MFR_GL_CONST(uint, kBindCounts, 0u)        // n(p): r32ui imageBuffer unit (count), SSBO (resolve)
+MFR_GL_CONST(uint, kBindOffsets, 1u)       // exclusive prefix sum of n(p)
+MFR_GL_CONST(uint, kBindNodes, 2u)         // uvec2 nodes
+MFR_GL_CONST(uint, kBindFill, 3u)          // A-buffer per-pixel fill counters
+MFR_GL_CONST(uint, kBindImage, 3u)         // resolve output: linear RGB floats (resolve only)
+MFR_GL_CONST(uint, kBindMaterials, 4u)     // materials
+MFR_GL_CONST(uint, kBindTriMaterial, 5u)   // material index per triangle
+MFR_GL_CONST(uint, kBindColorTables, 6u)   // srgb8ToLinear, coarseSrgb8, lowerBound
+MFR_GL_CONST(uint, kBindTexels, 7u)        // every texture's RGBA8 texels, one uint each
+MFR_GL_CONST(uint, kBindLocks, 1u)         // r32ui imageBuffer unit of the spin-locks
+MFR_GL_CONST(uint, kBindOccRange, 0u)      // occupancy: zn, zf bits per pixel
+MFR_GL_CONST(uint, kBindOccThreshold, 1u)  // occupancy: j_k per pixel
+MFR_GL_CONST(uint, kBindOccBits, 3u)       // occupancy: bitmaps (fill and count passes)
+MFR_GL_CONST(uint, kBindCaptureStats, 3u)  // k-buffer capture: culled counters
+MFR_GL_CONST(uint, kBindScanIn, 0u)        // prefix sum level: input, output, block sums
 MFR_GL_CONST(uint, kBindScanOut, 1u)
 MFR_GL_CONST(uint, kBindScanSums, 2u)
 
