@@ -1,7 +1,7 @@
 // Occupancy culling, pass 1: each pixel's nearest and farthest fragment depth (as uint bits:
 // depths are non-negative, so their unsigned order is their order).
-layout(std430, binding = kBindOccRange) coherent buffer Range {
-  uint range[];  // 2 per pixel: zn, zf
+layout(std430, binding = kBindOccupancy) coherent buffer Range {
+  uint range[];  // kOccupancyWords per pixel: zn, zf, j_k
 };
 
 void main() {
@@ -10,6 +10,6 @@ void main() {
   vec4 base;
   if (!surface(f, true, base)) discard;
   const uint z = floatBitsToUint(fragmentDepth(f));
-  atomicMin(range[2u * uint(f.pixel)], z);
-  atomicMax(range[2u * uint(f.pixel) + 1u], z);
+  atomicMin(range[kOccupancyWords * uint(f.pixel)], z);
+  atomicMax(range[kOccupancyWords * uint(f.pixel) + 1u], z);
 }

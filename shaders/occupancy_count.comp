@@ -5,8 +5,8 @@ layout(local_size_x = kResolveGroupSize) in;
 layout(std430, binding = kBindOccBits) readonly buffer Bits {
   uint bits[];
 };
-layout(std430, binding = kBindOccThreshold) writeonly buffer Threshold {
-  uint threshold[];
+layout(std430, binding = kBindOccupancy) buffer Occupancy {
+  uint occupancy[];  // kOccupancyWords per pixel: zn, zf, j_k
 };
 uniform uint uPixels;
 uniform uint uWords;
@@ -28,5 +28,5 @@ void main() {
       b &= b - 1u;
     }
   }
-  threshold[p] = result;
+  occupancy[kOccupancyWords * p + 2u] = result;
 }

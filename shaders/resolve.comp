@@ -1,7 +1,8 @@
 // Resolve: one invocation per pixel sorts the pixel's captured nodes (insertion sort in a local
 // array when they fit in kResolveLocalNodes, else in place in the node buffer, so any count works),
 // writes them back sorted, and composites them front to back in linear RGB over the
-// background with the CPU engine's kbuffer rule (mfr::compositeKBuffer), operation for operation.
+// background with the CPU engine's kbuffer rule (mfr::compositeKBuffer), operation for operation,
+// or its hybrid rule (mfr::compositeHybrid) with the pixel's tail.
 layout(local_size_x = kResolveGroupSize) in;
 
 layout(std430, binding = kBindCounts) readonly buffer Counts {
@@ -20,6 +21,11 @@ layout(std430, binding = kBindColorTables) readonly buffer ColorTables {
   uint colorTables[];
 };
 
+layout(std430, binding = kBindResolveTails) readonly buffer Tails {
+  uint tails[];  // kTailWords per pixel
+};
+
+uniform uint uHybrid;  // 1: mfr::compositeHybrid with the pixel's tail
 uniform uint uPixels;
 uniform uint uK;  // 0: A-buffer (n(p) nodes at offsets[p]); k > 0: k slots at p * k
 uniform vec3 uBackground;
@@ -83,7 +89,23 @@ void main() {
     precise float nextT = T * (1.0 - a);
     T = nextT;
   }
-  precise vec3 result = color + T * uBackground;
+  vec3 behind = uBackground;
+  if (uHybrid != 0u) {
+    const uint t = kTailWords * p;
+    const float tailAlphaSum = uintBitsToFloat(tails[t + 3u]);
+    const uint tailCount = tails[t + 4u];
+    if (tailCount != 0u && tailAlphaSum > 0.0) {
+      const vec3 sum = vec3(uintBitsToFloat(tails[t]), uintBitsToFloat(tails[t + 1u]),
+                            uintBitsToFloat(tails[t + 2u]));
+      precise vec3 tailColor = sum / tailAlphaSum;
+      precise float avgAlpha = tailAlphaSum / float(tailCount);
+      // GLSL pow is exp2(y log2 x), not std::pow: last bits differ from the CPU engine
+      precise float tailAlpha = 1.0 - pow(max(0.0, 1.0 - avgAlpha), float(tailCount));
+      precise vec3 mixed = tailAlpha * tailColor + (1.0 - tailAlpha) * uBackground;
+      behind = mixed;
+    }
+  }
+  precise vec3 result = color + T * behind;
   image[3u * p + 0u] = result.r;
   image[3u * p + 1u] = result.g;
   image[3u * p + 2u] = result.b;

@@ -429,9 +429,10 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       method.allocation == AllocationPolicy::FixedK &&
       (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap) && method.k &&
       *method.k > 0;
+  const bool hybrid = isKBuffer && method.compositing == Compositing::Hybrid;
   if ((!isABuffer && !isKBuffer) || (isABuffer && method.occupancyWords != 0) ||
       method.occupancyWords < 0 || method.occupancyWords > 64 ||
-      method.compositing != Compositing::KBuffer)
+      (method.compositing != Compositing::KBuffer && !hybrid))
     return makeError("--engine gl: method " + method.name +
                      " is not in the GL engine yet (abuffer and fixed-k max-array or max-heap "
                      "k-buffers with an explicit k)");
@@ -469,7 +470,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
                       GL_BUFFER_UPDATE_BARRIER_BIT);
     });
 
-    GLuint offsets = 0, nodes = 0;
+    GLuint offsets = 0, nodes = 0, tails = 0;
     uint64_t nodeCount = 0;
     if (isABuffer) {
       offsets = fb.make("offsets", uint64_t{pixels} * 4);
@@ -494,25 +495,31 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       const uint32_t words = static_cast<uint32_t>(method.occupancyWords);
       const GLuint stats = fb.make("capture counters", 8);
       clearUint(stats, 0);
-      GLuint range = stats, threshold = stats;
+      if (hybrid) {
+        tails = fb.make("tails", uint64_t{pixels} * kTailWords * 4);
+        clearUint(tails, 0);
+      } else {
+        tails = stats;  // not read
+      }
+      GLuint range = stats;
       if (words > 0) {
         // occupancy culling: depth range, bitmap fill, k-th occupied bucket
-        range = fb.make("occupancy", uint64_t{pixels} * 8);
-        const uint32_t init[2] = {kFarDepthBits, 0u};
-        glClearNamedBufferData(range, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT, init);
+        range = fb.make("occupancy", uint64_t{pixels} * kOccupancyWords * 4);
+        static_assert(kOccupancyWords == 3);
+        const uint32_t init[3] = {kFarDepthBits, 0u, kOccupancyNoCulling};
+        glClearNamedBufferData(range, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
         const GLuint bitmap = fb.make("occupancy", uint64_t{pixels} * words * 4);
         clearUint(bitmap, 0);
-        threshold = fb.make("occupancy", uint64_t{pixels} * 4);
         pass("depth range", [&] {
           glUseProgram(s.progDepthRange);
-          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccRange, range);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
           s.drawScene();
           glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         });
         pass("occupancy fill", [&] {
           glUseProgram(s.progOccFill);
           glProgramUniform1ui(s.progOccFill, loc(s.progOccFill, "uWords"), words);
-          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccRange, range);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
           glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
           s.drawScene();
           glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -524,7 +531,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
           glProgramUniform1ui(p, loc(p, "uWords"), words);
           glProgramUniform1ui(p, loc(p, "uK"), k);
           glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
-          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccThreshold, threshold);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
           dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
           glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         });
@@ -539,11 +546,12 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       glProgramUniform1ui(p, loc(p, "uStore"),
                           method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
       glProgramUniform1ui(p, loc(p, "uOccupancyWords"), words);
+      glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
       pass("capture", [&] {
         glUseProgram(p);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccRange, range);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccThreshold, threshold);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTails, tails);
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCaptureStats, stats);
         fb.bindImage(locks, kBindLocks);
         s.drawScene();
@@ -561,6 +569,8 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       glUseProgram(p);
       glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
       glProgramUniform1ui(p, loc(p, "uK"), k);
+      glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : counts);
       glProgramUniform3f(p, loc(p, "uBackground"), options.background.r, options.background.g,
                          options.background.b);
       glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);

@@ -239,6 +239,23 @@ TEST_P(GlVsCpu, OccupancyCullingEqualsTheCpuEngine) {
   }
 }
 
+// Hybrid compositing (DHOIT sec. 3.3) with k = 4: the culled, rejected and evicted fragments go to
+// each pixel's tail. The tails are float sums in arrival order, and GLSL's pow is not std::pow, so
+// the images agree within 1/255 (not necessarily bit for bit); the cores are the same sets.
+TEST_P(GlVsCpu, HybridK4EqualsTheCpuEngine) {
+  for (const char* preset : {"kplus-array", "kplus-heap+occupancy"}) {
+    MethodDesc method = methodPreset(preset).value();
+    method.k = 4;
+    method.compositing = Compositing::Hybrid;
+    const RenderOutput cpu = cpuRender(method);
+    const GlRenderOutput gl = glRender(method);
+    std::cout << "  " << preset << " hybrid:\n";
+    expectSameNodes(cpu, gl);
+    expectSameImage(cpu.image, gl.image);
+    printPasses(gl);
+  }
+}
+
 TEST_P(GlVsCpu, ThreeRunsAreByteIdentical) {
   for (const char* preset : {"abuffer", "kplus-array"}) {
     MethodDesc method = methodPreset(preset).value();

@@ -59,7 +59,8 @@ struct GlRenderOutput {
 /// Supported methods (this slice): `abuffer` (unbounded, append) and fixed-k max-array or max-heap
 /// k-buffers with an explicit k (`fkb`, `kplus-array`, `kplus-heap`, `zbuffer`; the k+ test runs
 /// for all of them: it changes no captured set), optionally with occupancy culling (`+occupancy`,
-/// d = occupancyWords); anything else is an error naming the method. The
+/// d = occupancyWords), with kbuffer or hybrid compositing; anything else is an error naming the
+/// method. The
 /// engine must be used on the thread where its context is current, and the context must outlive it.
 class GlEngine {
  public:

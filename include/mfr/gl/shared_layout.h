@@ -23,6 +23,10 @@ MFR_GL_CONST(uint, kLockFree, 0u)               // per-pixel spin-lock values
 MFR_GL_CONST(uint, kLockHeld, 1u)
 MFR_GL_CONST(uint, kStoreMaxArray, 0u)  // k-buffer stores (uStore)
 MFR_GL_CONST(uint, kStoreMaxHeap, 1u)
+// occupancy per pixel: zn bits, zf bits, j_k (the k-th occupied bucket)
+MFR_GL_CONST(uint, kOccupancyWords, 3u)
+// hybrid tail per pixel (mfr::HybridTail): sum of a * r, a * g, a * b, sum of a (float bits), t
+MFR_GL_CONST(uint, kTailWords, 5u)
 MFR_GL_CONST(uint, kOccupancyNoCulling, 0xffffffffu)  // mfr::OccupancyMap::kNoCulling
 MFR_GL_CONST(uint, kScanGroupSize, 256u)              // prefix sum: threads per work group
 MFR_GL_CONST(uint, kScanItemsPerThread, 4u)           // consecutive elements per thread
@@ -41,8 +45,9 @@ MFR_GL_CONST(uint, kBindTriMaterial, 5u)   // material index per triangle
 MFR_GL_CONST(uint, kBindColorTables, 6u)   // srgb8ToLinear, coarseSrgb8, lowerBound
 MFR_GL_CONST(uint, kBindTexels, 7u)        // every texture's RGBA8 texels, one uint each
 MFR_GL_CONST(uint, kBindLocks, 1u)         // r32ui imageBuffer unit of the spin-locks
-MFR_GL_CONST(uint, kBindOccRange, 0u)      // occupancy: zn, zf bits per pixel
-MFR_GL_CONST(uint, kBindOccThreshold, 1u)  // occupancy: j_k per pixel
+MFR_GL_CONST(uint, kBindOccupancy, 0u)     // occupancy: kOccupancyWords per pixel
+MFR_GL_CONST(uint, kBindTails, 1u)         // hybrid tails (k-buffer capture)
+MFR_GL_CONST(uint, kBindResolveTails, 4u)  // hybrid tails (resolve)
 MFR_GL_CONST(uint, kBindOccBits, 3u)       // occupancy: bitmaps (fill and count passes)
 MFR_GL_CONST(uint, kBindCaptureStats, 3u)  // k-buffer capture: culled counters
 MFR_GL_CONST(uint, kBindScanIn, 0u)        // prefix sum level: input, output, block sums
