@@ -142,6 +142,7 @@ class GlVsCpu : public testing::TestWithParam<Case> {
     GlRenderOptions options;
     options.background = kBackground;
     options.readNodes = true;
+    options.warmUp = false;  // (pass times printed by these tests are cold)
     auto out = engine_->render(method, options);
     EXPECT_TRUE(out.ok()) << out.error().message;
     return std::move(out.value());
@@ -155,7 +156,7 @@ class GlVsCpu : public testing::TestWithParam<Case> {
   void expectSameImage(const ImageRGB& cpu, const ImageRGB& gl) const { compareImages(cpu, gl); }
 
   static void printPasses(const GlRenderOutput& gl) {
-    std::cout << "  GL passes:";
+    std::cout << "  GL passes (cold):";
     for (const GlPassTime& t : gl.passes)
       std::cout << " " << t.name << " " << t.gpuMs << " ms (wall " << t.wallMs << ")";
     std::cout << "; buffers " << gl.totalBufferBytes() << " B\n";
@@ -354,6 +355,7 @@ TEST(GlEngine, TexturedMaskedQuadsEqualTheCpuEngine) {
     GlRenderOptions glOptions;
     glOptions.background = kBackground;
     glOptions.readNodes = true;
+    glOptions.warmUp = false;
     auto gl = engine->render(method, glOptions);
     ASSERT_TRUE(gl.ok()) << gl.error().message;
     EXPECT_EQ(gl->counts, countFragments(*frame));
