@@ -61,6 +61,7 @@ void main() {
       bool toTail = !store;
       const uvec2 maxNode = nodes[first];
       if (!store) {
+        // culled: to the tail
       } else if (!nodeLess(node, maxNode)) {
         toTail = true;  // rejected in the store
       } else if (uStore == kStoreMaxHeap) {
@@ -69,9 +70,10 @@ void main() {
         for (;;) {
           const uint left = 2u * i + 1u;
           if (left >= uK) break;
-          const uint right = left + 1u;
-          const uint child =
-              (right < uK && nodeLess(nodes[first + left], nodes[first + right])) ? right : left;
+          uint child = left;
+          if (left + 1u < uK) {
+            if (nodeLess(nodes[first + left], nodes[first + left + 1u])) child = left + 1u;
+          }
           const uvec2 c = nodes[first + child];
           if (!nodeLess(node, c)) break;
           nodes[first + i] = c;

@@ -1,5 +1,6 @@
 // Resolve: one invocation per pixel sorts the pixel's captured nodes (insertion sort in a local
-// array when they fit in kResolveLocalNodes, else in place in the node buffer, so any count works),
+// array when they fit in kResolveLocalNodes, else heap sort in place in the node buffer, so any
+// count works),
 // writes them back sorted, and composites them front to back in linear RGB over the
 // background with the CPU engine's kbuffer rule (mfr::compositeKBuffer), operation for operation,
 // or its hybrid rule (mfr::compositeHybrid) with the pixel's tail.
@@ -35,6 +36,25 @@ float srgb8ToLinear(uint code) {
   return uintBitsToFloat(colorTables[kTableLinearBase + code]);
 }
 
+// max-heap sift-down of nodes[first + root] within nodes[first .. first + n)
+void siftDown(uint first, uint root, uint n) {
+  const uvec2 v = nodes[first + root];
+  uint i = root;
+  for (;;) {
+    const uint left = 2u * i + 1u;
+    if (left >= n) break;
+    uint child = left;
+    if (left + 1u < n) {
+      if (nodeLess(nodes[first + left], nodes[first + left + 1u])) child = left + 1u;
+    }
+    const uvec2 c = nodes[first + child];
+    if (!nodeLess(v, c)) break;
+    nodes[first + i] = c;
+    i = child;
+  }
+  nodes[first + i] = v;
+}
+
 void main() {
   const uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
   const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
@@ -64,16 +84,13 @@ void main() {
     }
     for (uint i = 0u; i < slots; ++i) nodes[first + i] = local[i];
   } else {
-    for (uint i = 1u; i < slots; ++i) {
-      const uvec2 v = nodes[first + i];
-      uint j = i;
-      while (j > 0u) {
-        const uvec2 previous = nodes[first + j - 1u];
-        if (!nodeLess(v, previous)) break;
-        nodes[first + j] = previous;
-        --j;
-      }
-      nodes[first + j] = v;
+    // heap sort in place (O(n log n)): build a max-heap, then move its root to the end
+    for (uint start = slots / 2u; start > 0u; --start) siftDown(first, start - 1u, slots);
+    for (uint end = slots - 1u; end > 0u; --end) {
+      const uvec2 top = nodes[first];
+      nodes[first] = nodes[first + end];
+      nodes[first + end] = top;
+      siftDown(first, 0u, end);
     }
   }
   vec3 color = vec3(0.0);
