@@ -177,6 +177,7 @@ struct GlEngine::State {
   GLuint progCount = 0, progABuffer = 0, progKBuffer = 0, progScan = 0, progScanAdd = 0,
          progResolve = 0, progDepthRange = 0, progOccFill = 0, progOccCount = 0;
   GLuint query = 0;
+  uint64_t maxBlockBytes = 0;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
   std::map<std::string, uint64_t> sceneBytes;
 
   ~State() {
@@ -292,6 +293,9 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
                      ", texel buffer " + std::to_string(maxTexelBuffer) + ")");
 
   auto s = std::make_unique<State>();
+  GLint64 maxBlock = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
+  s->maxBlockBytes = static_cast<uint64_t>(maxBlock);
   s->width = width;
   s->height = height;
   // the CPU engine's camera, matrices and view rays (RasterFrame::build)
@@ -399,6 +403,13 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
         0u};
     materialWords.insert(materialWords.end(), words, words + kMaterialWords);
   }
+  for (const auto& [name, bytes] :
+       {std::pair<const char*, uint64_t>{"texels", texelWords.size() * 4},
+        {"triangle materials", scene.triangleMaterial.size() * 4}})
+    if (bytes > s->maxBlockBytes)
+      return makeError("--engine gl: the scene's " + std::string(name) + " need " +
+                       std::to_string(bytes) + " B, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
+                       std::to_string(s->maxBlockBytes) + " B)");
   s->materials = s->upload("materials", materialWords.size() * 4, materialWords.data());
   s->texels = s->upload("texels", texelWords.size() * 4, texelWords.data());
   const ColorTables& tables = ColorTables::get();
@@ -438,6 +449,20 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
                      "k-buffers with an explicit k)");
   const uint32_t k = isKBuffer ? *method.k : 0u;
   const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
+  // every storage buffer must fit one shader storage block (GL clamps the accessible range)
+  auto tooLarge = [&](const std::string& what, uint64_t bytes) {
+    return makeError("--engine gl: " + method.name + " at " + std::to_string(s.width) + "x" +
+                     std::to_string(s.height) + ": the " + what + " buffer needs " +
+                     std::to_string(bytes) + " B, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
+                     std::to_string(s.maxBlockBytes) + " B)");
+  };
+  {
+    const uint64_t perPixel =
+        std::max<uint64_t>({12, hybrid ? kTailWords * 4 : 0, uint64_t{k} * kNodeBytes,
+                            static_cast<uint64_t>(std::max(method.occupancyWords, 0)) * 4});
+    if (uint64_t{pixels} * perPixel > s.maxBlockBytes)
+      return tooLarge("per-pixel", uint64_t{pixels} * perPixel);
+  }
 
   GlRenderOutput out;
   for (int run = options.warmUp ? 0 : 1; run < 2; ++run) {
@@ -475,10 +500,13 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     if (isABuffer) {
       offsets = fb.make("offsets", uint64_t{pixels} * 4);
       pass("prefix sum", [&] { s.scan(fb, counts, offsets, pixels); });
-      uint32_t last[2] = {0, 0};
-      glGetNamedBufferSubData(offsets, (pixels - 1) * 4ll, 4, &last[0]);
-      glGetNamedBufferSubData(counts, (pixels - 1) * 4ll, 4, &last[1]);
-      nodeCount = uint64_t{last[0]} + last[1];
+      // the total in 64 bits from n(p) itself (the 32-bit scan would wrap silently)
+      std::vector<uint32_t> n(pixels);
+      glGetNamedBufferSubData(counts, 0, uint64_t{pixels} * 4ll, n.data());
+      nodeCount = 0;
+      for (uint32_t c : n) nodeCount += c;
+      if (nodeCount * kNodeBytes > s.maxBlockBytes)  // (also keeps the uint offsets exact)
+        return tooLarge("A-buffer node", nodeCount * kNodeBytes);
       nodes = fb.make("nodes", nodeCount * kNodeBytes);
       const GLuint fill = fb.make("fill counters", uint64_t{pixels} * 4);
       clearUint(fill, 0);

@@ -365,6 +365,26 @@ TEST(GlEngine, TexturedMaskedQuadsEqualTheCpuEngine) {
   }
 }
 
+// An A-buffer larger than one shader storage block is an error naming the limit, not a silently
+// clamped buffer (llvmpipe: 128 MiB; procedural:layers at 768x768 needs about 300 MB of nodes).
+TEST(GlEngine, ABufferAboveTheStorageBlockLimitIsAnError) {
+  MFR_REQUIRE_GL();
+  auto scene = loadScene("procedural:layers");
+  ASSERT_TRUE(scene.ok());
+  auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 768, 768);
+  ASSERT_TRUE(engine.ok()) << engine.error().message;
+  GlRenderOptions options;
+  options.warmUp = false;
+  auto out = engine->render(methodPreset("abuffer").value(), options);
+  if (out.ok()) {
+    EXPECT_GT(out->fragments * 8, uint64_t{128} << 20);  // a larger limit: it fits
+  } else {
+    EXPECT_NE(out.error().message.find("GL_MAX_SHADER_STORAGE_BLOCK_SIZE"), std::string::npos)
+        << out.error().message;
+    std::cout << "  " << out.error().message << "\n";
+  }
+}
+
 TEST(GlContext, ReportsRendererAndExtensions) {
   MFR_REQUIRE_GL();
   const GlContext& c = sharedContext().value();
