@@ -33,6 +33,7 @@ if(MFR_BUILD_TESTS)
   file(GLOB MFR_GL_TEST_SOURCES CONFIGURE_DEPENDS tests/gl/*.cpp)
   add_executable(mfr_gl_tests ${MFR_GL_TEST_SOURCES})
   target_compile_options(mfr_gl_tests PRIVATE ${MFR_WARNINGS})
+  target_include_directories(mfr_gl_tests PRIVATE src)  # gl/shader_sources.hpp
   target_link_libraries(mfr_gl_tests PRIVATE mfr_gl GTest::gtest GTest::gtest_main)
   # discovery at test time: a machine without a GL 4.5 context skips (or, with CI=true, fails) the
   # tests instead of failing the build

@@ -65,22 +65,7 @@ std::string composeSource(const std::string& file, bool fragmentCommon) {
 
 Result<GLuint> compileShader(GLenum stage, const std::string& file, bool fragmentCommon) {
   if (embeddedShader(file).empty()) return makeError("GL engine: no embedded shader " + file);
-  const std::string source = composeSource(file, fragmentCommon);
-  const GLuint shader = glCreateShader(stage);
-  const char* text = source.c_str();
-  glShaderSource(shader, 1, &text, nullptr);
-  glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    GLint length = 0;
-    glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
-    std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
-    glGetShaderInfoLog(shader, length, nullptr, log.data());
-    glDeleteShader(shader);
-    return makeError("GL engine: shader " + file + " does not compile: " + oneLine(log.c_str()));
-  }
-  return shader;
+  return compileShaderSource(stage, file, composeSource(file, fragmentCommon));
 }
 
 struct StageFile {
@@ -162,6 +147,26 @@ void dispatchGroups(uint64_t groups) {
 }
 
 }  // namespace
+
+Result<unsigned> compileShaderSource(unsigned stage, const std::string& name,
+                                     const std::string& source) {
+  const GLuint shader = glCreateShader(stage);
+  if (shader == 0) return makeError("GL engine: shader " + name + ": glCreateShader failed");
+  const char* text = source.c_str();
+  glShaderSource(shader, 1, &text, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    GLint length = 0;
+    glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
+    glGetShaderInfoLog(shader, length, nullptr, log.data());
+    glDeleteShader(shader);
+    return makeError("GL engine: shader " + name + " does not compile: " + oneLine(log.c_str()));
+  }
+  return shader;
+}
 
 struct GlEngine::State {
   int width = 0, height = 0;

@@ -2,7 +2,10 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <string_view>
+
+#include "mfr/core/result.hpp"
 
 namespace mfr::gl {
 
@@ -20,5 +23,11 @@ inline std::string_view embeddedShader(std::string_view name) {
     if (name == kEmbeddedShaders[i].name) return kEmbeddedShaders[i].text;
   return {};
 }
+
+/// Compiles one shader stage (a GLenum) from `source` (complete, with its #version) on the current
+/// context; the error names `name` and carries the info log on one line. The caller owns the
+/// returned shader object.
+Result<unsigned> compileShaderSource(unsigned stage, const std::string& name,
+                                     const std::string& source);
 
 }  // namespace mfr::gl

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "gl/shader_sources.hpp"
 #include "mfr/gl/gl_context.hpp"
 #include "mfr/gl/gl_engine.hpp"
 #include "mfr/method/method.hpp"
@@ -383,6 +384,24 @@ TEST(GlEngine, ABufferAboveTheStorageBlockLimitIsAnError) {
         << out.error().message;
     std::cout << "  " << out.error().message << "\n";
   }
+}
+
+TEST(GlEngine, ShaderCompileErrorNamesTheShaderAndCarriesItsLog) {
+  MFR_REQUIRE_GL();
+  auto shader = compileShaderSource(0x8B30 /* GL_FRAGMENT_SHADER */, "broken.frag",
+                                    "#version 450 core\nvoid main() { undeclaredThing = 1.0; }\n");
+  ASSERT_FALSE(shader.ok());
+  const std::string& message = shader.error().message;
+  EXPECT_NE(message.find("broken.frag"), std::string::npos) << message;
+  EXPECT_NE(message.find("undeclaredThing"), std::string::npos) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  std::cout << "  " << message << "\n";
+  // every embedded shader is there and the shared layout with it
+  for (const char* name :
+       {"raster.vert", "raster.geom", "raster_common.glsl", "count.frag", "capture_abuffer.frag",
+        "capture_kbuffer.frag", "prefix_sum.comp", "prefix_sum_add.comp", "resolve.comp",
+        "depth_range.frag", "occupancy_fill.frag", "occupancy_count.comp", "shared_layout.h"})
+    EXPECT_FALSE(embeddedShader(name).empty()) << name;
 }
 
 TEST(GlContext, ReportsRendererAndExtensions) {
