@@ -20,6 +20,7 @@ packages=(
   python3               # evaluation tables (scripts/eval_tables.py)
   pybind11-dev python3-pybind11 python3-dev python3-numpy  # the Python module mfr (python/)
   python3-pytest        # its tests (python/tests, run by ctest)
+  libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri  # the OpenGL 4.5 engine (headless EGL)
   chromium              # the mfr compare report in headless Chromium (tests/report_chromium_test.sh)
 )
 

@@ -1,0 +1,42 @@
+# --- OpenGL 4.5 engine (issue 10) ---
+# libmfr_gl: headless GL 4.5 core context through EGL + libepoxy, the shaders of shaders/ embedded
+# at build time (cmake/mfr_shaders.cmake), and the GL engine (src/gl/). Kept out of libmfr so the
+# CPU library has no GL dependency; tests/gl/ is its own test executable (mfr_gl_tests).
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(EPOXY REQUIRED IMPORTED_TARGET epoxy)
+find_package(OpenGL REQUIRED COMPONENTS EGL)
+
+file(GLOB MFR_SHADER_FILES CONFIGURE_DEPENDS
+     ${CMAKE_CURRENT_SOURCE_DIR}/shaders/*.vert ${CMAKE_CURRENT_SOURCE_DIR}/shaders/*.geom
+     ${CMAKE_CURRENT_SOURCE_DIR}/shaders/*.frag ${CMAKE_CURRENT_SOURCE_DIR}/shaders/*.comp
+     ${CMAKE_CURRENT_SOURCE_DIR}/shaders/*.glsl)
+list(SORT MFR_SHADER_FILES)
+set(MFR_SHADER_INPUTS ${MFR_SHADER_FILES}
+    ${CMAKE_CURRENT_SOURCE_DIR}/include/mfr/gl/shared_layout.h)
+string(REPLACE ";" "|" MFR_SHADER_ARG "${MFR_SHADER_INPUTS}")
+set(MFR_SHADERS_CPP "${CMAKE_CURRENT_BINARY_DIR}/generated/gl_shaders.cpp")
+add_custom_command(OUTPUT "${MFR_SHADERS_CPP}"
+  COMMAND ${CMAKE_COMMAND} "-DFILES=${MFR_SHADER_ARG}" -DOUT=${MFR_SHADERS_CPP}
+          -P "${CMAKE_CURRENT_SOURCE_DIR}/cmake/mfr_shaders.cmake"
+  DEPENDS ${MFR_SHADER_INPUTS} "${CMAKE_CURRENT_SOURCE_DIR}/cmake/mfr_shaders.cmake"
+  COMMENT "Embedding shaders/" VERBATIM)
+
+file(GLOB MFR_GL_SOURCES CONFIGURE_DEPENDS src/gl/*.cpp)
+add_library(mfr_gl STATIC ${MFR_GL_SOURCES} "${MFR_SHADERS_CPP}")
+target_include_directories(mfr_gl PRIVATE src)
+target_compile_options(mfr_gl PRIVATE ${MFR_WARNINGS})
+target_link_libraries(mfr_gl PUBLIC mfr PRIVATE PkgConfig::EPOXY OpenGL::EGL)
+set_target_properties(mfr_gl PROPERTIES POSITION_INDEPENDENT_CODE ON)
+add_library(mfr::gl ALIAS mfr_gl)
+
+if(MFR_BUILD_TESTS)
+  file(GLOB MFR_GL_TEST_SOURCES CONFIGURE_DEPENDS tests/gl/*.cpp)
+  add_executable(mfr_gl_tests ${MFR_GL_TEST_SOURCES})
+  target_compile_options(mfr_gl_tests PRIVATE ${MFR_WARNINGS})
+  target_include_directories(mfr_gl_tests PRIVATE src)  # gl/shader_sources.hpp
+  target_link_libraries(mfr_gl_tests PRIVATE mfr_gl GTest::gtest GTest::gtest_main)
+  # discovery at test time: a machine without a GL 4.5 context skips (or, with CI=true, fails) the
+  # tests instead of failing the build
+  gtest_discover_tests(mfr_gl_tests DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
+    PROPERTIES TIMEOUT 600)
+endif()

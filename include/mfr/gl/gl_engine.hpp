@@ -1,0 +1,89 @@
+// The OpenGL 4.5 engine, first slice: count -> prefix sum -> capture (A-buffer, or the fixed-k
+// max-array k-buffer with the k+ test and per-pixel spin-locks) -> resolve, on a GlContext.
+//
+// Both engines produce the same fragments: the vertex shader transforms with the CPU engine's
+// matrices (viewMatrix / projectionMatrix of the camera with fitClipPlanes), the geometry shader
+// repeats the CPU engine's clipping and fixed-point set-up, and the fragment shader its integer
+// edge functions, barycentrics, alpha test, depth and shading (shaders/). GL's rasterizer decides
+// which fragment shaders run (the triangles are drawn at their snapped positions); the fragment
+// shader keeps exactly the fragments the CPU engine emits among them.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "mfr/core/image.hpp"
+#include "mfr/core/result.hpp"
+#include "mfr/gl/gl_context.hpp"
+#include "mfr/method/method.hpp"
+#include "mfr/raster/fragment.hpp"
+#include "mfr/scene/camera.hpp"
+#include "mfr/scene/scene.hpp"
+
+namespace mfr::gl {
+
+struct GlPassTime {
+  std::string name;
+  double gpuMs = 0.0;   // GL_TIME_ELAPSED
+  double wallMs = 0.0;  // host time around the pass, glFinish included
+};
+
+struct GlRenderOptions {
+  glm::vec3 background{1.0f};  // linear RGB
+  bool warmUp = true;          // run the passes once untimed first (shader compilation, caches)
+  bool readNodes = false;      // read the captured nodes back (tests, tools)
+};
+
+struct GlRenderOutput {
+  ImageRGB image;                // linear RGB, rows top to bottom
+  std::vector<uint32_t> counts;  // n(p), rows top to bottom
+  uint64_t fragments = 0;        // sum of n(p)
+  // with readNodes: pixel p's captured nodes nodes[nodeOffsets[p] .. + nodeCounts[p]), sorted
+  // nearest first (the resolve sorts them in place)
+  std::vector<FragmentNode> nodes;
+  std::vector<uint64_t> nodeOffsets;
+  std::vector<uint32_t> nodeCounts;
+  std::map<std::string, uint64_t> bufferBytes;  // every GL buffer the frame allocated, by name
+  uint64_t totalBufferBytes() const;
+  uint64_t culledOccupancy = 0;    // k-buffers: rejected by the occupancy test (order-independent)
+  uint64_t culledKPlus = 0;        // k-buffers: rejected by the k+ test (depends on arrival order)
+  std::vector<GlPassTime> passes;  // count, prefix sum, capture, resolve (timed run)
+};
+
+/// One scene and view uploaded to GL once; render() runs a method on it any number of times.
+/// Supported methods (this slice): `abuffer` (unbounded, append) and fixed-k max-array or max-heap
+/// k-buffers with an explicit k (`fkb`, `kplus-array`, `kplus-heap`, `zbuffer`; the k+ test runs
+/// for all of them: it changes no captured set), optionally with occupancy culling (`+occupancy`,
+/// d = occupancyWords), with kbuffer or hybrid compositing; anything else is an error naming the
+/// method. The
+/// engine must be used on the thread where its context is current, and the context must outlive it.
+class GlEngine {
+ public:
+  /// Errors (one line): the size outside [1, 16384] or above GL's limits, a scene failing
+  /// validateScene, a shader that does not compile or link (its name and info log).
+  static Result<GlEngine> create(const GlContext& context, const Scene& scene, const Camera& camera,
+                                 int width, int height);
+
+  GlEngine(GlEngine&&) noexcept;
+  GlEngine& operator=(GlEngine&&) noexcept;
+  ~GlEngine();
+
+  Result<GlRenderOutput> render(const MethodDesc& method, const GlRenderOptions& options = {});
+
+  int width() const;
+  int height() const;
+  /// The camera with the fitted clip planes (what RasterFrame::build uses).
+  const Camera& camera() const;
+
+ private:
+  struct State;
+  explicit GlEngine(std::unique_ptr<State> state);
+  std::unique_ptr<State> state_;
+};
+
+}  // namespace mfr::gl

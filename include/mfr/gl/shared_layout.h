@@ -1,0 +1,78 @@
+// Layout shared by the C++ side of the OpenGL engine and its GLSL shaders (the shader embedding
+// step prepends this file to every shader, after the #version line), so the engines cannot drift:
+// the 8-byte fragment node, the lock values, the binding points and the work-group sizes.
+//
+// Node: two uints in GLSL (uvec2), x = hi = floatBitsToUint(depth), y = lo = RGBA8 colour word
+// (mfr::packFragmentColor). Depths are in [0, 1], so comparing (hi, lo) lexicographically as
+// unsigned integers is the unsigned 64-bit order of mfr::FragmentNode: (depth, colour).
+#ifdef __cplusplus
+#pragma once
+#include <cstdint>
+namespace mfr::gl {
+using uint = uint32_t;
+#define MFR_GL_CONST(type, name, value) inline constexpr type name = value;
+#else
+#define MFR_GL_CONST(type, name, value) const type name = value;
+#endif
+
+MFR_GL_CONST(uint, kNodeWords, 2u)              // uints per node
+MFR_GL_CONST(uint, kNodeBytes, 8u)              // bytes per node
+MFR_GL_CONST(uint, kNodeHiIndex, 0u)            // uvec2 component holding the depth bits
+MFR_GL_CONST(uint, kFarDepthBits, 0x7f800000u)  // +inf: the empty node (mfr::kFarNode)
+MFR_GL_CONST(uint, kLockFree, 0u)               // per-pixel spin-lock values
+MFR_GL_CONST(uint, kLockHeld, 1u)
+MFR_GL_CONST(uint, kStoreMaxArray, 0u)  // k-buffer stores (uStore)
+MFR_GL_CONST(uint, kStoreMaxHeap, 1u)
+// occupancy per pixel: zn bits, zf bits, j_k (the k-th occupied bucket)
+MFR_GL_CONST(uint, kOccupancyWords, 3u)
+// hybrid tail per pixel (mfr::HybridTail): sum of a * r, a * g, a * b, sum of a (float bits), t
+MFR_GL_CONST(uint, kTailWords, 5u)
+MFR_GL_CONST(uint, kOccupancyNoCulling, 0xffffffffu)  // mfr::OccupancyMap::kNoCulling
+MFR_GL_CONST(uint, kScanGroupSize, 256u)              // prefix sum: threads per work group
+MFR_GL_CONST(uint, kScanItemsPerThread, 4u)           // consecutive elements per thread
+MFR_GL_CONST(uint, kResolveGroupSize, 64u)            // resolve: pixels per work group
+MFR_GL_CONST(uint, kResolveLocalNodes, 128u)          // resolve: nodes sorted in a local array
+MFR_GL_CONST(uint, kMaxClipVertices, 12u)             // Sutherland-Hodgman polygon capacity
+
+// binding points: SSBOs (at most 8, GL 4.3's minimum of bindings) and image units (2)
+MFR_GL_CONST(uint, kBindCounts, 0u)        // n(p): r32ui imageBuffer unit (count), SSBO (resolve)
+MFR_GL_CONST(uint, kBindOffsets, 1u)       // exclusive prefix sum of n(p)
+MFR_GL_CONST(uint, kBindNodes, 2u)         // uvec2 nodes
+MFR_GL_CONST(uint, kBindFill, 3u)          // A-buffer per-pixel fill counters
+MFR_GL_CONST(uint, kBindImage, 3u)         // resolve output: linear RGB floats (resolve only)
+MFR_GL_CONST(uint, kBindMaterials, 4u)     // materials
+MFR_GL_CONST(uint, kBindTriMaterial, 5u)   // material index per triangle
+MFR_GL_CONST(uint, kBindColorTables, 6u)   // srgb8ToLinear, coarseSrgb8, lowerBound
+MFR_GL_CONST(uint, kBindTexels, 7u)        // every texture's RGBA8 texels, one uint each
+MFR_GL_CONST(uint, kBindLocks, 1u)         // r32ui imageBuffer unit of the spin-locks
+MFR_GL_CONST(uint, kBindOccupancy, 0u)     // occupancy: kOccupancyWords per pixel
+MFR_GL_CONST(uint, kBindTails, 1u)         // hybrid tails (k-buffer capture)
+MFR_GL_CONST(uint, kBindResolveTails, 4u)  // hybrid tails (resolve)
+MFR_GL_CONST(uint, kBindOccBits, 3u)       // occupancy: bitmaps (fill and count passes)
+MFR_GL_CONST(uint, kBindCaptureStats, 3u)  // k-buffer capture: culled counters
+MFR_GL_CONST(uint, kBindScanIn, 0u)        // prefix sum level: input, output, block sums
+MFR_GL_CONST(uint, kBindScanOut, 1u)
+MFR_GL_CONST(uint, kBindScanSums, 2u)
+
+// material record (12 uint words; floats as their bits): base colour R, G, B, A; the texture's
+// first texel in the texel buffer (kNoTexture: none), its width, height; alpha mode
+// (mfr::AlphaMode); cutoff; alpha override flag, override value; padding
+MFR_GL_CONST(uint, kMaterialWords, 12u)
+MFR_GL_CONST(uint, kNoTexture, 0xffffffffu)
+MFR_GL_CONST(uint, kAlphaOpaque, 0u)  // mfr::AlphaMode values
+MFR_GL_CONST(uint, kAlphaMask, 1u)
+// colour tables (std430 uint words): 256 floats (bits) of srgb8ToLinear, 4096 coarse codes,
+// 257 floats (bits) of lowerBound
+MFR_GL_CONST(uint, kTableLinearBase, 0u)
+MFR_GL_CONST(uint, kTableCoarseBase, 256u)
+MFR_GL_CONST(uint, kTableBoundBase, 4352u)
+MFR_GL_CONST(uint, kTableWords, 4609u)
+
+#ifdef __cplusplus
+}  // namespace mfr::gl
+#else
+// a < b in the node order (unsigned 64-bit (hi, lo))
+bool nodeLess(uvec2 a, uvec2 b) {
+  return a.x < b.x || (a.x == b.x && a.y < b.y);
+}
+#endif

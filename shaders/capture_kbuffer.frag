@@ -1,0 +1,121 @@
+// Fixed-k k-buffer capture with the k+ culling test (Vasilakis and Fudos, k+-buffer), max-array or
+// max-heap store (uStore): pixel p owns the k nodes nodes[p * k .. p * k + k), initialised to the
+// far node (so the store is always full), with the maximum always in slot 0. Max-array: the
+// maximum is replaced and the new maximum found by a linear scan (O(k)); max-heap: the root is
+// replaced and sifted down (O(log k)), as mfr::maxArrayInsert / maxHeapInsert do once full.
+// Hybrid compositing (uHybrid): fragments culled by the occupancy or k+ test, rejected by the
+// store or evicted from it are added to the pixel's tail under the lock (mfr::HybridTail, in
+// arrival order). A fragment not nearer than that maximum is culled before the critical section
+// (its depth word alone is compared there: slot 0's depth word only decreases, so a stale read is
+// conservative). Otherwise it takes the pixel's spin-lock (imageAtomicExchange); the loop is around
+// the critical section, not a spin inside it, so lanes of one SIMD group cannot deadlock.
+layout(std430, binding = kBindNodes) coherent buffer Nodes {
+  uvec2 nodes[];
+};
+layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
+uniform uint uK;
+uniform uint uStore;  // kStoreMaxArray or kStoreMaxHeap
+uniform uint uOccupancyWords;  // 0: no occupancy culling
+uniform uint uHybrid;  // 1: rejected, culled and evicted fragments go to the pixel's tail
+layout(std430, binding = kBindOccupancy) readonly buffer Occupancy {
+  uint occupancy[];  // kOccupancyWords per pixel: zn, zf, j_k
+};
+layout(std430, binding = kBindTails) coherent buffer Tails {
+  uint tails[];  // kTailWords per pixel
+};
+layout(std430, binding = kBindCaptureStats) buffer CaptureStats {
+  uint culledOccupancy;
+  uint culledKPlus;
+};
+
+void main() {
+  FragmentData f;
+  if (!exactCoverage(f)) discard;
+  vec4 base;
+  if (!surface(f, false, base)) discard;
+  const float depth = fragmentDepth(f);
+  const uint p = uint(f.pixel);
+  bool store = true;  // false: culled, to the tail (hybrid) or dropped
+  if (uOccupancyWords > 0u) {  // occupancy test: behind the pixel's k-th occupied bucket
+    const uint t = occupancy[kOccupancyWords * p + 2u];
+    if (t != kOccupancyNoCulling &&
+        occupancyBucket(depth, uintBitsToFloat(occupancy[kOccupancyWords * p]),
+                        uintBitsToFloat(occupancy[kOccupancyWords * p + 1u]),
+                        32u * uOccupancyWords) > t) {
+      atomicAdd(culledOccupancy, 1u);
+      if (uHybrid == 0u) return;
+      store = false;
+    }
+  }
+  const uvec2 node = uvec2(floatBitsToUint(depth), shade(f, base));
+  const uint first = p * uK;
+  if (store && node.x > nodes[first].x) {  // k+ test
+    atomicAdd(culledKPlus, 1u);
+    if (uHybrid == 0u) return;
+    store = false;
+  }
+  bool done = false;
+  while (!done) {
+    if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
+      uint tailColor = node.y;
+      bool toTail = !store;
+      const uvec2 maxNode = nodes[first];
+      if (!store) {
+        // culled: to the tail
+      } else if (!nodeLess(node, maxNode)) {
+        toTail = true;  // rejected in the store
+      } else if (uStore == kStoreMaxHeap) {
+        // down-heap: move the larger child up into the hole
+        uint i = 0u;
+        for (;;) {
+          const uint left = 2u * i + 1u;
+          if (left >= uK) break;
+          uint child = left;
+          if (left + 1u < uK) {
+            if (nodeLess(nodes[first + left], nodes[first + left + 1u])) child = left + 1u;
+          }
+          const uvec2 c = nodes[first + child];
+          if (!nodeLess(node, c)) break;
+          nodes[first + i] = c;
+          i = child;
+        }
+        nodes[first + i] = node;
+      } else {
+        // replace the maximum; the new maximum of the k moves to slot 0
+        uint maxIndex = 0u;
+        uvec2 m = node;
+        for (uint i = 1u; i < uK; ++i) {
+          const uvec2 s = nodes[first + i];
+          if (nodeLess(m, s)) {
+            m = s;
+            maxIndex = i;
+          }
+        }
+        if (maxIndex != 0u) nodes[first + maxIndex] = node;
+        nodes[first] = m;
+      }
+      if (store && nodeLess(node, maxNode) && maxNode.x != kFarDepthBits) {
+        toTail = true;  // evicted (an empty slot's far node is not a fragment)
+        tailColor = maxNode.y;
+      }
+      if (toTail && uHybrid != 0u) {  // mfr::HybridTail::add
+        const uint t = kTailWords * p;
+        precise float a = float(tailColor >> 24) * uInv255;
+        precise float r = uintBitsToFloat(tails[t]) + a * srgb8ToLinear(tailColor & 0xffu);
+        precise float g =
+            uintBitsToFloat(tails[t + 1u]) + a * srgb8ToLinear((tailColor >> 8) & 0xffu);
+        precise float b =
+            uintBitsToFloat(tails[t + 2u]) + a * srgb8ToLinear((tailColor >> 16) & 0xffu);
+        precise float sumA = uintBitsToFloat(tails[t + 3u]) + a;
+        tails[t] = floatBitsToUint(r);
+        tails[t + 1u] = floatBitsToUint(g);
+        tails[t + 2u] = floatBitsToUint(b);
+        tails[t + 3u] = floatBitsToUint(sumA);
+        tails[t + 4u] += 1u;
+      }
+      memoryBarrierBuffer();
+      imageAtomicExchange(uLocks, f.pixel, kLockFree);
+      done = true;
+    }
+  }
+}

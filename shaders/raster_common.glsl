@@ -1,0 +1,192 @@
+// Shared part of the fragment shaders of the geometry passes (prepended to count.frag,
+// capture_abuffer.frag and capture_kbuffer.frag): the CPU engine's exact coverage test,
+// barycentrics, alpha test, depth and shading (include/mfr/raster/raster_frame_impl.hpp), operation
+// for operation and `precise`, so that both engines produce the same fragments bit for bit.
+flat in ivec3 gX;
+flat in ivec3 gY;
+flat in vec3 gZ;
+flat in vec3 gInvW;
+flat in vec3 gN0;
+flat in vec3 gN1;
+flat in vec3 gN2;
+flat in vec3 gU;
+flat in vec3 gV;
+flat in float gInvArea;
+flat in uint gTopLeft;
+flat in uint gMaterial;
+
+uniform ivec2 uSize;
+uniform vec4 uRay;       // view ray of pixel (x, y): (x * ray.x + ray.y, y * ray.z + ray.w, -1)
+uniform float uAmbient;  // kAmbient
+uniform float uDiffuse;  // 1 - kAmbient
+uniform float uInv255;   // 1.0f / 255.0f
+
+layout(std430, binding = kBindMaterials) readonly buffer Materials {
+  uint materials[];
+};
+layout(std430, binding = kBindColorTables) readonly buffer ColorTables {
+  uint colorTables[];
+};
+layout(std430, binding = kBindTexels) readonly buffer Texels {
+  uint texels[];
+};
+
+struct FragmentData {
+  ivec2 px;
+  int pixel;
+  float l0, l1, l2;
+};
+
+// The CPU engine's edge functions at the pixel centre, in double (exact: products below 2^51):
+// false when the centre is not covered under its fill rule.
+bool exactCoverage(out FragmentData f) {
+  f.px = ivec2(gl_FragCoord.xy);
+  f.pixel = f.px.y * uSize.x + f.px.x;
+  const double px0 = double(f.px.x * 256 + 128);
+  const double py0 = double(f.px.y * 256 + 128);
+  double w[3];
+  bool covered = true;
+  for (int i = 0; i < 3; ++i) {
+    const int a = (i + 1) % 3, b = (i + 2) % 3;
+    const double A = double(gY[a] - gY[b]);
+    const double B = double(gX[b] - gX[a]);
+    precise double wi = B * (py0 - double(gY[a])) + A * (px0 - double(gX[a]));
+    const double bias = ((gTopLeft >> uint(i)) & 1u) != 0u ? 0.0lf : -1.0lf;
+    covered = covered && wi + bias >= 0.0lf;
+    w[i] = wi;
+  }
+  precise float l1 = float(w[1]) * gInvArea;
+  precise float l2 = float(w[2]) * gInvArea;
+  precise float l0 = 1.0 - l1 - l2;
+  f.l0 = l0;
+  f.l1 = l1;
+  f.l2 = l2;
+  return covered;
+}
+
+float srgb8ToLinear(uint code) {
+  return uintBitsToFloat(colorTables[kTableLinearBase + code]);
+}
+
+int wrapIndex(int v, int n) {
+  return v >= 0 ? v % n : n - 1 - ((-v - 1) % n);
+}
+
+int texelIndex(float f, int n) {
+  if (isnan(f) || isinf(f)) return 0;
+  if (abs(f) < 1e9) return int(f);
+  precise float r = f - float(n) * trunc(f / float(n));  // fmod (approximately)
+  return int(r);
+}
+
+vec4 texel(uint first, int width, int x, int y) {
+  const uint t = texels[first + uint(y * width + x)];
+  precise float a = float(t >> 24) * uInv255;
+  return vec4(srgb8ToLinear(t & 0xffu), srgb8ToLinear((t >> 8) & 0xffu),
+              srgb8ToLinear((t >> 16) & 0xffu), a);
+}
+
+// bilinear, repeat (detail::sampleTexture)
+vec4 sampleTexture(uint first, int width, int height, vec2 uv) {
+  precise float fx = uv.x * float(width) - 0.5;
+  precise float fy = uv.y * float(height) - 0.5;
+  const float flx = floor(fx), fly = floor(fy);
+  precise float ax = fx - flx;
+  precise float ay = fy - fly;
+  const int ix = texelIndex(flx, width), iy = texelIndex(fly, height);
+  const int x0 = wrapIndex(ix, width), x1 = wrapIndex(ix + 1, width);
+  const int y0 = wrapIndex(iy, height), y1 = wrapIndex(iy + 1, height);
+  precise float oax = 1.0 - ax;
+  precise float oay = 1.0 - ay;
+  precise vec4 top = texel(first, width, x0, y0) * oax + texel(first, width, x1, y0) * ax;
+  precise vec4 bottom = texel(first, width, x0, y1) * oax + texel(first, width, x1, y1) * ax;
+  precise vec4 s = top * oay + bottom * ay;
+  return s;
+}
+
+// alpha test and base colour (RasterFrame::surface); false when the fragment is discarded
+bool surface(FragmentData f, bool coverageOnly, out vec4 base) {
+  const uint m = gMaterial * kMaterialWords;
+  const uint mode = materials[m + 7u];
+  const bool needsAlphaTest = mode == kAlphaMask;
+  base = vec4(0.0);
+  if (coverageOnly && !needsAlphaTest) return true;
+  base = vec4(uintBitsToFloat(materials[m + 0u]), uintBitsToFloat(materials[m + 1u]),
+              uintBitsToFloat(materials[m + 2u]), uintBitsToFloat(materials[m + 3u]));
+  const uint texture = materials[m + 4u];
+  if (texture != kNoTexture) {
+    precise float q = gInvW.x * f.l0 + gInvW.y * f.l1 + gInvW.z * f.l2;
+    precise float invQ = 1.0 / q;
+    precise vec2 uvq = vec2(gU.x, gV.x) * f.l0 + vec2(gU.y, gV.y) * f.l1 + vec2(gU.z, gV.z) * f.l2;
+    precise vec2 uv = uvq * invQ;
+    precise vec4 b = base * sampleTexture(texture, int(materials[m + 5u]),
+                                          int(materials[m + 6u]), uv);
+    base = b;
+  }
+  if (needsAlphaTest) {
+    if (base.a < uintBitsToFloat(materials[m + 8u])) return false;
+    base.a = 1.0;
+  } else if (mode == kAlphaOpaque) {
+    base.a = 1.0;
+  }
+  if (materials[m + 9u] != 0u) base.a = uintBitsToFloat(materials[m + 10u]);
+  return true;
+}
+
+float fragmentDepth(FragmentData f) {
+  precise float dz1 = gZ.y - gZ.x;
+  precise float dz2 = gZ.z - gZ.x;
+  precise float z = gZ.x + f.l1 * dz1 + f.l2 * dz2;
+  return z > 0.0 ? (z < 1.0 ? z : 1.0) : 0.0;
+}
+
+float clampUnit(float v) {  // min(max(v, 0), 1) with NaN -> 0
+  const float c = v > 0.0 ? v : 0.0;
+  return c < 1.0 ? c : 1.0;
+}
+
+// encodeSrgb8 by the CPU engine's tables
+uint encodeSrgb8(float c) {
+  precise float scaled = c * 4095.0 + 0.5;
+  int code = int(colorTables[kTableCoarseBase + uint(int(scaled))]);
+  if (c >= uintBitsToFloat(colorTables[kTableBoundBase + uint(code + 1)])) ++code;
+  if (c < uintBitsToFloat(colorTables[kTableBoundBase + uint(code)])) --code;
+  return uint(code);
+}
+
+// packFragmentColor
+uint packColor(vec3 rgb, float alpha) {
+  const float a = clampUnit(alpha);
+  precise float scaledA = a * 255.0 + 0.5;
+  return encodeSrgb8(clampUnit(rgb.r)) | (encodeSrgb8(clampUnit(rgb.g)) << 8) |
+         (encodeSrgb8(clampUnit(rgb.b)) << 16) | (uint(int(scaledA)) << 24);
+}
+
+// headlight shading (RasterFrame::shade): the colour word
+uint shade(FragmentData f, vec4 base) {
+  precise float nx = gN0.x * f.l0 + gN1.x * f.l1 + gN2.x * f.l2;
+  precise float ny = gN0.y * f.l0 + gN1.y * f.l1 + gN2.y * f.l2;
+  precise float nz = gN0.z * f.l0 + gN1.z * f.l1 + gN2.z * f.l2;
+  precise float dx = float(f.px.x) * uRay.x + uRay.y;
+  precise float dy = float(f.px.y) * uRay.z + uRay.w;
+  precise float nn = (nx * nx + ny * ny + nz * nz) * (dx * dx + dy * dy + 1.0);
+  precise float num = nz - nx * dx - ny * dy;
+  precise float root = sqrt(nn);
+  precise float q = num / root;
+  const float ndotv = nn > 0.0 ? (q < -1.0 ? -1.0 : (1.0 < q ? 1.0 : q)) : 1.0;
+  precise float light = uAmbient + uDiffuse * abs(ndotv);
+  precise vec3 rgb = base.rgb * light;
+  return packColor(rgb, base.a);
+}
+
+// occupancy map bucket of depth z (mfr::OccupancyMap::bucket): monotone in z, shared by the fill
+// pass and the capture's test
+uint occupancyBucket(float z, float zn, float zf, uint buckets) {
+  if (!(zf > zn)) return 0u;
+  precise float num = z - zn;
+  precise float den = zf - zn;
+  precise float q = num / den;
+  precise float t = q * float(buckets);
+  const uint b = t > 0.0 ? uint(t) : 0u;
+  return b < buckets ? b : buckets - 1u;
+}

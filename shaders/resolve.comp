@@ -1,0 +1,129 @@
+// Resolve: one invocation per pixel sorts the pixel's captured nodes (insertion sort in a local
+// array when they fit in kResolveLocalNodes, else heap sort in place in the node buffer, so any
+// count works),
+// writes them back sorted, and composites them front to back in linear RGB over the
+// background with the CPU engine's kbuffer rule (mfr::compositeKBuffer), operation for operation,
+// or its hybrid rule (mfr::compositeHybrid) with the pixel's tail.
+layout(local_size_x = kResolveGroupSize) in;
+
+layout(std430, binding = kBindCounts) readonly buffer Counts {
+  uint counts[];
+};
+layout(std430, binding = kBindOffsets) readonly buffer Offsets {
+  uint offsets[];
+};
+layout(std430, binding = kBindNodes) buffer Nodes {
+  uvec2 nodes[];
+};
+layout(std430, binding = kBindImage) writeonly buffer Image {
+  float image[];  // linear RGB, 3 floats per pixel, rows top to bottom
+};
+layout(std430, binding = kBindColorTables) readonly buffer ColorTables {
+  uint colorTables[];
+};
+
+layout(std430, binding = kBindResolveTails) readonly buffer Tails {
+  uint tails[];  // kTailWords per pixel
+};
+
+uniform uint uHybrid;  // 1: mfr::compositeHybrid with the pixel's tail
+uniform uint uPixels;
+uniform uint uK;  // 0: A-buffer (n(p) nodes at offsets[p]); k > 0: k slots at p * k
+uniform vec3 uBackground;
+uniform float uInv255;
+
+float srgb8ToLinear(uint code) {
+  return uintBitsToFloat(colorTables[kTableLinearBase + code]);
+}
+
+// max-heap sift-down of nodes[first + root] within nodes[first .. first + n)
+void siftDown(uint first, uint root, uint n) {
+  const uvec2 v = nodes[first + root];
+  uint i = root;
+  for (;;) {
+    const uint left = 2u * i + 1u;
+    if (left >= n) break;
+    uint child = left;
+    if (left + 1u < n) {
+      if (nodeLess(nodes[first + left], nodes[first + left + 1u])) child = left + 1u;
+    }
+    const uvec2 c = nodes[first + child];
+    if (!nodeLess(v, c)) break;
+    nodes[first + i] = c;
+    i = child;
+  }
+  nodes[first + i] = v;
+}
+
+void main() {
+  const uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
+  const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
+  if (p >= uPixels) return;
+  uint first, slots, n;
+  if (uK == 0u) {
+    first = offsets[p];
+    slots = counts[p];
+    n = slots;
+  } else {
+    first = p * uK;
+    slots = uK;  // empty slots hold the far node and sort last
+    n = min(counts[p], uK);
+  }
+  if (slots <= kResolveLocalNodes) {
+    uvec2 local[kResolveLocalNodes];
+    for (uint i = 0u; i < slots; ++i) {
+      const uvec2 v = nodes[first + i];
+      uint j = i;
+      while (j > 0u) {  // (no local[j - 1] read at j == 0, not even short-circuited)
+        const uvec2 previous = local[j - 1u];
+        if (!nodeLess(v, previous)) break;
+        local[j] = previous;
+        --j;
+      }
+      local[j] = v;
+    }
+    for (uint i = 0u; i < slots; ++i) nodes[first + i] = local[i];
+  } else {
+    // heap sort in place (O(n log n)): build a max-heap, then move its root to the end
+    for (uint start = slots / 2u; start > 0u; --start) siftDown(first, start - 1u, slots);
+    for (uint end = slots - 1u; end > 0u; --end) {
+      const uvec2 top = nodes[first];
+      nodes[first] = nodes[first + end];
+      nodes[first + end] = top;
+      siftDown(first, 0u, end);
+    }
+  }
+  vec3 color = vec3(0.0);
+  float T = 1.0;
+  for (uint i = 0u; i < n; ++i) {
+    const uint rgba = nodes[first + i].y;
+    precise float a = float(rgba >> 24) * uInv255;
+    const vec3 c = vec3(srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
+                        srgb8ToLinear((rgba >> 16) & 0xffu));
+    precise float w = a * T;
+    precise vec3 sum = color + c * w;
+    color = sum;
+    precise float nextT = T * (1.0 - a);
+    T = nextT;
+  }
+  vec3 behind = uBackground;
+  if (uHybrid != 0u) {
+    const uint t = kTailWords * p;
+    const float tailAlphaSum = uintBitsToFloat(tails[t + 3u]);
+    const uint tailCount = tails[t + 4u];
+    if (tailCount != 0u && tailAlphaSum > 0.0) {
+      const vec3 sum = vec3(uintBitsToFloat(tails[t]), uintBitsToFloat(tails[t + 1u]),
+                            uintBitsToFloat(tails[t + 2u]));
+      precise vec3 tailColor = sum / tailAlphaSum;
+      precise float avgAlpha = tailAlphaSum / float(tailCount);
+      // GLSL pow is exp2(y log2 x), not std::pow: last bits differ from the CPU engine
+      precise float tailAlpha = 1.0 - pow(max(0.0, 1.0 - avgAlpha), float(tailCount));
+      precise vec3 mixed = tailAlpha * tailColor + (1.0 - tailAlpha) * uBackground;
+      behind = mixed;
+    }
+  }
+  precise vec3 result = color + T * behind;
+  image[3u * p + 0u] = result.r;
+  image[3u * p + 1u] = result.g;
+  image[3u * p + 2u] = result.b;
+}

@@ -1,0 +1,660 @@
+// The OpenGL 4.5 engine: scene upload, the count / prefix sum / capture / resolve passes, timing
+// and read-back (see include/mfr/gl/gl_engine.hpp and shaders/).
+#include "mfr/gl/gl_engine.hpp"
+
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <utility>
+
+#include "gl/shader_sources.hpp"
+#include "mfr/core/color.hpp"
+#include "mfr/gl/shared_layout.h"
+#include "mfr/raster/raster_frame.hpp"
+
+namespace mfr::gl {
+
+// the node layout the shaders use is mfr::FragmentNode's
+static_assert(kNodeBytes == sizeof(FragmentNode));
+static_assert(kNodeWords * sizeof(uint32_t) == kNodeBytes);
+static_assert(kNodeHiIndex == 0u);
+static_assert((static_cast<uint64_t>(kFarDepthBits) << 32) == kFarNode);
+static_assert(static_cast<uint32_t>(AlphaMode::Opaque) == kAlphaOpaque);
+static_assert(static_cast<uint32_t>(AlphaMode::Mask) == kAlphaMask);
+static_assert(kTableWords == kTableBoundBase + 257u && kTableBoundBase == kTableCoarseBase + 4096u);
+
+uint64_t GlRenderOutput::totalBufferBytes() const {
+  uint64_t total = 0;
+  for (const auto& [name, bytes] : bufferBytes) total += bytes;
+  return total;
+}
+
+namespace {
+
+// Guard band clamp of the CPU set-up (src/raster/raster_frame.cpp: kGuardBand * 1.001).
+constexpr double kMaxNdc = 8.0f * 1.001;
+
+std::string oneLine(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
+  std::string out;
+  for (char c : text) {
+    if (c == '\n')
+      out += " | ";
+    else
+      out += c;
+  }
+  return out;
+}
+
+// "#version", the shared layout, [the fragment shaders' common part,] the shader's own text
+std::string composeSource(const std::string& file, bool fragmentCommon) {
+  std::string s = "#version 450 core\n";
+  s += embeddedShader("shared_layout.h");
+  s += "\n";
+  if (fragmentCommon) {
+    s += embeddedShader("raster_common.glsl");
+    s += "\n";
+  }
+  s += "#line 1\n";
+  s += embeddedShader(file);
+  return s;
+}
+
+Result<GLuint> compileShader(GLenum stage, const std::string& file, bool fragmentCommon) {
+  if (embeddedShader(file).empty()) return makeError("GL engine: no embedded shader " + file);
+  return compileShaderSource(stage, file, composeSource(file, fragmentCommon));
+}
+
+struct StageFile {
+  GLenum stage;
+  std::string file;
+};
+
+Result<GLuint> linkProgram(const std::string& name, const std::vector<StageFile>& stages) {
+  std::vector<GLuint> shaders;
+  auto cleanup = [&] {
+    for (GLuint s : shaders) glDeleteShader(s);
+  };
+  for (const StageFile& sf : stages) {
+    auto shader = compileShader(sf.stage, sf.file, sf.stage == GL_FRAGMENT_SHADER);
+    if (!shader) {
+      cleanup();
+      return shader.error();
+    }
+    shaders.push_back(*shader);
+  }
+  const GLuint program = glCreateProgram();
+  for (GLuint s : shaders) glAttachShader(program, s);
+  glLinkProgram(program);
+  cleanup();
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    GLint length = 0;
+    glGetProgramiv(program, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
+    glGetProgramInfoLog(program, length, nullptr, log.data());
+    glDeleteProgram(program);
+    return makeError("GL engine: program " + name + " does not link: " + oneLine(log.c_str()));
+  }
+  return program;
+}
+
+GLint loc(GLuint program, const char* name) {
+  return glGetUniformLocation(program, name);
+}
+
+// Buffers of one frame, deleted with it; their sizes go to the ledger.
+struct FrameBuffers {
+  std::vector<GLuint> buffers, textures;
+  std::map<std::string, uint64_t>* ledger = nullptr;
+  ~FrameBuffers() {
+    if (!buffers.empty()) glDeleteBuffers(static_cast<GLsizei>(buffers.size()), buffers.data());
+    if (!textures.empty()) glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
+  }
+  GLuint make(const std::string& name, uint64_t bytes, const void* data = nullptr) {
+    GLuint b = 0;
+    glCreateBuffers(1, &b);
+    glNamedBufferData(b, static_cast<GLsizeiptr>(std::max<uint64_t>(bytes, 16)), data,
+                      GL_DYNAMIC_COPY);
+    buffers.push_back(b);
+    (*ledger)[name] += bytes;
+    return b;
+  }
+  // an r32ui imageBuffer view of a buffer, bound to an image unit
+  void bindImage(GLuint buffer, GLuint unit) {
+    GLuint t = 0;
+    glCreateTextures(GL_TEXTURE_BUFFER, 1, &t);
+    glTextureBuffer(t, GL_R32UI, buffer);
+    textures.push_back(t);
+    glBindImageTexture(unit, t, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+  }
+};
+
+void clearUint(GLuint buffer, uint32_t value) {
+  glClearNamedBufferData(buffer, GL_R32UI, GL_RED_INTEGER, GL_UNSIGNED_INT, &value);
+}
+
+// work groups as a 2D grid (each dimension at most 65535); shaders linearise the group id
+void dispatchGroups(uint64_t groups) {
+  if (groups == 0) return;
+  const uint64_t x = std::min<uint64_t>(groups, 65535);
+  const uint64_t y = (groups + x - 1) / x;
+  glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>(y), 1);
+}
+
+}  // namespace
+
+Result<unsigned> compileShaderSource(unsigned stage, const std::string& name,
+                                     const std::string& source) {
+  const GLuint shader = glCreateShader(stage);
+  if (shader == 0) return makeError("GL engine: shader " + name + ": glCreateShader failed");
+  const char* text = source.c_str();
+  glShaderSource(shader, 1, &text, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    GLint length = 0;
+    glGetShaderiv(shader, GL_INFO_LOG_LENGTH, &length);
+    std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
+    glGetShaderInfoLog(shader, length, nullptr, log.data());
+    glDeleteShader(shader);
+    return makeError("GL engine: shader " + name + " does not compile: " + oneLine(log.c_str()));
+  }
+  return shader;
+}
+
+struct GlEngine::State {
+  int width = 0, height = 0;
+  Camera camera;
+  glm::mat4 viewProj{1.0f};
+  glm::mat3 viewRot{1.0f};
+  glm::vec4 ray{0.0f};
+  GLuint vao = 0;
+  std::vector<GLuint> sceneBuffers;
+  GLuint triMaterial = 0, materials = 0, colorTables = 0, texels = 0;
+  GLsizei indexCount = 0;
+  GLuint fbo = 0;
+  GLuint progCount = 0, progABuffer = 0, progKBuffer = 0, progScan = 0, progScanAdd = 0,
+         progResolve = 0, progDepthRange = 0, progOccFill = 0, progOccCount = 0;
+  GLuint query = 0;
+  uint64_t maxBlockBytes = 0;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
+  std::map<std::string, uint64_t> sceneBytes;
+
+  ~State() {
+    for (GLuint p : {progCount, progABuffer, progKBuffer, progScan, progScanAdd, progResolve,
+                     progDepthRange, progOccFill, progOccCount})
+      if (p) glDeleteProgram(p);
+    if (!sceneBuffers.empty())
+      glDeleteBuffers(static_cast<GLsizei>(sceneBuffers.size()), sceneBuffers.data());
+    if (vao) glDeleteVertexArrays(1, &vao);
+    if (fbo) glDeleteFramebuffers(1, &fbo);
+    if (query) glDeleteQueries(1, &query);
+  }
+
+  GLuint upload(const std::string& name, uint64_t bytes, const void* data) {
+    GLuint b = 0;
+    glCreateBuffers(1, &b);
+    glNamedBufferData(b, static_cast<GLsizeiptr>(std::max<uint64_t>(bytes, 16)), data,
+                      GL_STATIC_DRAW);
+    sceneBuffers.push_back(b);
+    sceneBytes[name] += bytes;
+    return b;
+  }
+
+  void setRasterUniforms(GLuint p) const {
+    glProgramUniformMatrix4fv(p, loc(p, "uViewProj"), 1, GL_FALSE, &viewProj[0][0]);
+    glProgramUniformMatrix3fv(p, loc(p, "uViewRot"), 1, GL_FALSE, &viewRot[0][0]);
+    glProgramUniform2i(p, loc(p, "uSize"), width, height);
+    glProgramUniform1d(p, loc(p, "uMaxNdc"), kMaxNdc);
+    glProgramUniform4f(p, loc(p, "uRay"), ray.x, ray.y, ray.z, ray.w);
+    glProgramUniform1f(p, loc(p, "uAmbient"), kAmbient);
+    glProgramUniform1f(p, loc(p, "uDiffuse"), 1.0f - kAmbient);
+    glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
+  }
+
+  void drawScene() const {
+    glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+    glViewport(0, 0, width, height);
+    glDisable(GL_DEPTH_TEST);
+    glDisable(GL_CULL_FACE);
+    glDisable(GL_BLEND);
+    glDisable(GL_STENCIL_TEST);
+    glBindVertexArray(vao);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindMaterials, materials);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTriMaterial, triMaterial);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, colorTables);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTexels, texels);
+    glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
+  }
+
+  // exclusive prefix sum of `count` uints of `in` into `out`
+  void scan(FrameBuffers& fb, GLuint in, GLuint out, uint32_t count) const {
+    constexpr uint32_t perBlock = kScanGroupSize * kScanItemsPerThread;
+    const uint32_t blocks = (count + perBlock - 1) / perBlock;
+    const GLuint sums = fb.make("prefix sum block sums", uint64_t{blocks} * 4);
+    glUseProgram(progScan);
+    glProgramUniform1ui(progScan, loc(progScan, "uCount"), count);
+    glProgramUniform1ui(progScan, loc(progScan, "uBlocks"), blocks);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindScanIn, in);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindScanOut, out);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindScanSums, sums);
+    dispatchGroups(blocks);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    if (blocks <= 1) return;
+    const GLuint scanned = fb.make("prefix sum block sums", uint64_t{blocks} * 4);
+    scan(fb, sums, scanned, blocks);
+    glUseProgram(progScanAdd);
+    glProgramUniform1ui(progScanAdd, loc(progScanAdd, "uCount"), count);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindScanOut, out);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindScanSums, scanned);
+    dispatchGroups((count + kScanGroupSize - 1) / kScanGroupSize);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  }
+};
+
+GlEngine::GlEngine(std::unique_ptr<State> state) : state_(std::move(state)) {}
+GlEngine::GlEngine(GlEngine&&) noexcept = default;
+GlEngine& GlEngine::operator=(GlEngine&&) noexcept = default;
+GlEngine::~GlEngine() = default;
+
+int GlEngine::width() const {
+  return state_->width;
+}
+int GlEngine::height() const {
+  return state_->height;
+}
+const Camera& GlEngine::camera() const {
+  return state_->camera;
+}
+
+Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
+                                  const Camera& cameraIn, int width, int height) {
+  if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize)
+    return makeError("image size " + std::to_string(width) + "x" + std::to_string(height) +
+                     ": width and height must be in [1, " + std::to_string(kMaxImageSize) + "]");
+  MFR_TRY(validateScene(scene));
+  const Camera& c = cameraIn;
+  if (glm::length(c.target - c.eye) <= 0.0f ||
+      glm::length(glm::cross(c.target - c.eye, c.up)) <= 0.0f ||
+      !(c.fovYDegrees > 0.0f && c.fovYDegrees < 180.0f))
+    return makeError(
+        "camera: eye != target, up not parallel to the view direction and a field "
+        "of view in (0, 180) degrees needed");
+  context.makeCurrent();
+  GLint maxFbWidth = 0, maxFbHeight = 0, maxTexelBuffer = 0;
+  glGetIntegerv(GL_MAX_FRAMEBUFFER_WIDTH, &maxFbWidth);
+  glGetIntegerv(GL_MAX_FRAMEBUFFER_HEIGHT, &maxFbHeight);
+  glGetIntegerv(GL_MAX_TEXTURE_BUFFER_SIZE, &maxTexelBuffer);
+  const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
+  if (width > maxFbWidth || height > maxFbHeight || pixels > static_cast<uint64_t>(maxTexelBuffer))
+    return makeError("--engine gl: image size " + std::to_string(width) + "x" +
+                     std::to_string(height) + " above this GL's limits (framebuffer " +
+                     std::to_string(maxFbWidth) + "x" + std::to_string(maxFbHeight) +
+                     ", texel buffer " + std::to_string(maxTexelBuffer) + ")");
+
+  auto s = std::make_unique<State>();
+  GLint64 maxBlock = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
+  s->maxBlockBytes = static_cast<uint64_t>(maxBlock);
+  s->width = width;
+  s->height = height;
+  // the CPU engine's camera, matrices and view rays (RasterFrame::build)
+  s->camera = fitClipPlanes(cameraIn, sceneBounds(scene));
+  const glm::mat4 view = viewMatrix(s->camera);
+  s->viewProj = projectionMatrix(s->camera, width, height) * view;
+  s->viewRot = glm::mat3(view);
+  const float tanHalf = std::tan(glm::radians(s->camera.fovYDegrees) * 0.5f);
+  const float aspect = static_cast<float>(width) / static_cast<float>(height);
+  s->ray.x = 2.0f * tanHalf * aspect / static_cast<float>(width);
+  s->ray.y = (1.0f / static_cast<float>(width) - 1.0f) * tanHalf * aspect;
+  s->ray.z = -2.0f * tanHalf / static_cast<float>(height);
+  s->ray.w = (1.0f - 1.0f / static_cast<float>(height)) * tanHalf;
+
+  // programs
+  auto raster = [&](const std::string& frag) {
+    return linkProgram(frag, {{GL_VERTEX_SHADER, "raster.vert"},
+                              {GL_GEOMETRY_SHADER, "raster.geom"},
+                              {GL_FRAGMENT_SHADER, frag}});
+  };
+  auto count = raster("count.frag");
+  if (!count) return count.error();
+  s->progCount = *count;
+  auto abuffer = raster("capture_abuffer.frag");
+  if (!abuffer) return abuffer.error();
+  s->progABuffer = *abuffer;
+  auto kbuffer = raster("capture_kbuffer.frag");
+  if (!kbuffer) return kbuffer.error();
+  s->progKBuffer = *kbuffer;
+  auto depthRange = raster("depth_range.frag");
+  if (!depthRange) return depthRange.error();
+  s->progDepthRange = *depthRange;
+  auto occFill = raster("occupancy_fill.frag");
+  if (!occFill) return occFill.error();
+  s->progOccFill = *occFill;
+  auto occCount =
+      linkProgram("occupancy_count.comp", {{GL_COMPUTE_SHADER, "occupancy_count.comp"}});
+  if (!occCount) return occCount.error();
+  s->progOccCount = *occCount;
+  auto scanProgram = linkProgram("prefix_sum.comp", {{GL_COMPUTE_SHADER, "prefix_sum.comp"}});
+  if (!scanProgram) return scanProgram.error();
+  s->progScan = *scanProgram;
+  auto scanAdd = linkProgram("prefix_sum_add.comp", {{GL_COMPUTE_SHADER, "prefix_sum_add.comp"}});
+  if (!scanAdd) return scanAdd.error();
+  s->progScanAdd = *scanAdd;
+  auto resolve = linkProgram("resolve.comp", {{GL_COMPUTE_SHADER, "resolve.comp"}});
+  if (!resolve) return resolve.error();
+  s->progResolve = *resolve;
+  for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill})
+    s->setRasterUniforms(p);
+
+  // geometry, once
+  const size_t vertices = scene.positions.size();
+  const GLuint positions =
+      s->upload("positions", vertices * sizeof(glm::vec3), scene.positions.data());
+  const GLuint normals = s->upload("normals", vertices * sizeof(glm::vec3), scene.normals.data());
+  std::vector<glm::vec2> zeroUvs;
+  if (scene.uvs.empty()) zeroUvs.assign(vertices, glm::vec2(0.0f));
+  const GLuint uvs = s->upload("uvs", vertices * sizeof(glm::vec2),
+                               scene.uvs.empty() ? zeroUvs.data() : scene.uvs.data());
+  const GLuint indices =
+      s->upload("indices", scene.indices.size() * sizeof(uint32_t), scene.indices.data());
+  s->indexCount = static_cast<GLsizei>(scene.indices.size());
+  glCreateVertexArrays(1, &s->vao);
+  const GLuint vbos[3] = {positions, normals, uvs};
+  const GLint sizes[3] = {3, 3, 2};
+  for (GLuint i = 0; i < 3; ++i) {
+    glVertexArrayVertexBuffer(s->vao, i, vbos[i], 0,
+                              static_cast<GLsizei>(sizes[i] * sizeof(float)));
+    glVertexArrayAttribFormat(s->vao, i, sizes[i], GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(s->vao, i, i);
+    glEnableVertexArrayAttrib(s->vao, i);
+  }
+  glVertexArrayElementBuffer(s->vao, indices);
+  s->triMaterial = s->upload("triangle materials", scene.triangleMaterial.size() * 4,
+                             scene.triangleMaterial.data());
+
+  // materials and textures
+  std::vector<uint32_t> texelWords;
+  std::vector<uint32_t> textureFirst;
+  for (const Texture& t : scene.textures) {
+    textureFirst.push_back(static_cast<uint32_t>(texelWords.size()));
+    const size_t n = static_cast<size_t>(t.width) * t.height;
+    const size_t at = texelWords.size();
+    texelWords.resize(at + n);
+    std::memcpy(texelWords.data() + at, t.rgba.data(), n * 4);  // R | G << 8 | B << 16 | A << 24
+  }
+  std::vector<uint32_t> materialWords;
+  auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+  for (const Material& m : scene.materials) {
+    const bool textured = m.baseColorTexture >= 0;
+    const Texture* t = textured ? &scene.textures[m.baseColorTexture] : nullptr;
+    const uint32_t words[kMaterialWords] = {
+        bits(m.baseColor.r),
+        bits(m.baseColor.g),
+        bits(m.baseColor.b),
+        bits(m.baseColor.a),
+        textured ? textureFirst[m.baseColorTexture] : kNoTexture,
+        t ? static_cast<uint32_t>(t->width) : 0u,
+        t ? static_cast<uint32_t>(t->height) : 0u,
+        static_cast<uint32_t>(m.alphaMode),
+        bits(m.alphaCutoff),
+        scene.alphaOverride ? 1u : 0u,
+        bits(scene.alphaOverride ? *scene.alphaOverride : 1.0f),
+        0u};
+    materialWords.insert(materialWords.end(), words, words + kMaterialWords);
+  }
+  for (const auto& [name, bytes] :
+       {std::pair<const char*, uint64_t>{"texels", texelWords.size() * 4},
+        {"triangle materials", scene.triangleMaterial.size() * 4}})
+    if (bytes > s->maxBlockBytes)
+      return makeError("--engine gl: the scene's " + std::string(name) + " need " +
+                       std::to_string(bytes) + " B, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
+                       std::to_string(s->maxBlockBytes) + " B)");
+  s->materials = s->upload("materials", materialWords.size() * 4, materialWords.data());
+  s->texels = s->upload("texels", texelWords.size() * 4, texelWords.data());
+  const ColorTables& tables = ColorTables::get();
+  std::vector<uint32_t> tableWords(kTableWords);
+  for (int i = 0; i < 256; ++i) tableWords[kTableLinearBase + i] = bits(tables.srgb8ToLinear[i]);
+  for (int i = 0; i < 4096; ++i) tableWords[kTableCoarseBase + i] = tables.coarseSrgb8[i];
+  for (int i = 0; i < 257; ++i) tableWords[kTableBoundBase + i] = bits(tables.lowerBound[i]);
+  s->colorTables = s->upload("colour tables", tableWords.size() * 4, tableWords.data());
+
+  glCreateFramebuffers(1, &s->fbo);
+  glNamedFramebufferParameteri(s->fbo, GL_FRAMEBUFFER_DEFAULT_WIDTH, width);
+  glNamedFramebufferParameteri(s->fbo, GL_FRAMEBUFFER_DEFAULT_HEIGHT, height);
+  glCreateQueries(GL_TIME_ELAPSED, 1, &s->query);
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+    return makeError("GL engine: scene upload failed (GL error 0x" + [&] {
+      char buf[16];
+      std::snprintf(buf, sizeof buf, "%x", e);
+      return std::string(buf);
+    }() + ")");
+  return GlEngine(std::move(s));
+}
+
+Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRenderOptions& options) {
+  State& s = *state_;
+  const bool isABuffer =
+      method.allocation == AllocationPolicy::Unbounded && method.store == StoreChoice::Append;
+  const bool isKBuffer =
+      method.allocation == AllocationPolicy::FixedK &&
+      (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap) && method.k &&
+      *method.k > 0;
+  const bool hybrid = isKBuffer && method.compositing == Compositing::Hybrid;
+  if ((!isABuffer && !isKBuffer) || (isABuffer && method.occupancyWords != 0) ||
+      method.occupancyWords < 0 || method.occupancyWords > 64 ||
+      (method.compositing != Compositing::KBuffer && !hybrid))
+    return makeError("--engine gl: method " + method.name +
+                     " is not in the GL engine yet (abuffer and fixed-k max-array or max-heap "
+                     "k-buffers with an explicit k)");
+  const uint32_t k = isKBuffer ? *method.k : 0u;
+  const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
+  // every storage buffer must fit one shader storage block (GL clamps the accessible range)
+  auto tooLarge = [&](const std::string& what, uint64_t bytes) {
+    return makeError("--engine gl: " + method.name + " at " + std::to_string(s.width) + "x" +
+                     std::to_string(s.height) + ": the " + what + " buffer needs " +
+                     std::to_string(bytes) + " B, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
+                     std::to_string(s.maxBlockBytes) + " B)");
+  };
+  {
+    const uint64_t perPixel =
+        std::max<uint64_t>({12, hybrid ? kTailWords * 4 : 0, uint64_t{k} * kNodeBytes,
+                            static_cast<uint64_t>(std::max(method.occupancyWords, 0)) * 4});
+    if (uint64_t{pixels} * perPixel > s.maxBlockBytes)
+      return tooLarge("per-pixel", uint64_t{pixels} * perPixel);
+  }
+
+  GlRenderOutput out;
+  for (int run = options.warmUp ? 0 : 1; run < 2; ++run) {
+    const bool timed = run == 1;
+    out.bufferBytes = s.sceneBytes;
+    out.passes.clear();
+    FrameBuffers fb;
+    fb.ledger = &out.bufferBytes;
+    auto pass = [&](const char* name, auto&& body) {
+      const auto t0 = std::chrono::steady_clock::now();
+      glBeginQuery(GL_TIME_ELAPSED, s.query);
+      body();
+      glEndQuery(GL_TIME_ELAPSED);
+      glFinish();
+      const auto t1 = std::chrono::steady_clock::now();
+      GLuint64 ns = 0;
+      glGetQueryObjectui64v(s.query, GL_QUERY_RESULT, &ns);
+      out.passes.push_back({name, static_cast<double>(ns) * 1e-6,
+                            std::chrono::duration<double, std::milli>(t1 - t0).count()});
+    };
+
+    // count: n(p) by imageAtomicAdd
+    const GLuint counts = fb.make("counts", uint64_t{pixels} * 4);
+    clearUint(counts, 0);
+    pass("count", [&] {
+      glUseProgram(s.progCount);
+      fb.bindImage(counts, kBindCounts);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                      GL_BUFFER_UPDATE_BARRIER_BIT);
+    });
+
+    GLuint offsets = 0, nodes = 0, tails = 0;
+    uint64_t nodeCount = 0;
+    if (isABuffer) {
+      offsets = fb.make("offsets", uint64_t{pixels} * 4);
+      pass("prefix sum", [&] { s.scan(fb, counts, offsets, pixels); });
+      // the total in 64 bits from n(p) itself (the 32-bit scan would wrap silently)
+      std::vector<uint32_t> n(pixels);
+      glGetNamedBufferSubData(counts, 0, uint64_t{pixels} * 4ll, n.data());
+      nodeCount = 0;
+      for (uint32_t c : n) nodeCount += c;
+      if (nodeCount * kNodeBytes > s.maxBlockBytes)  // (also keeps the uint offsets exact)
+        return tooLarge("A-buffer node", nodeCount * kNodeBytes);
+      nodes = fb.make("nodes", nodeCount * kNodeBytes);
+      const GLuint fill = fb.make("fill counters", uint64_t{pixels} * 4);
+      clearUint(fill, 0);
+      pass("capture", [&] {
+        glUseProgram(s.progABuffer);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, offsets);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, fill);
+        s.drawScene();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      });
+    } else {
+      nodeCount = uint64_t{pixels} * k;
+      const uint32_t words = static_cast<uint32_t>(method.occupancyWords);
+      const GLuint stats = fb.make("capture counters", 8);
+      clearUint(stats, 0);
+      if (hybrid) {
+        tails = fb.make("tails", uint64_t{pixels} * kTailWords * 4);
+        clearUint(tails, 0);
+      } else {
+        tails = stats;  // not read
+      }
+      GLuint range = stats;
+      if (words > 0) {
+        // occupancy culling: depth range, bitmap fill, k-th occupied bucket
+        range = fb.make("occupancy", uint64_t{pixels} * kOccupancyWords * 4);
+        static_assert(kOccupancyWords == 3);
+        const uint32_t init[3] = {kFarDepthBits, 0u, kOccupancyNoCulling};
+        glClearNamedBufferData(range, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
+        const GLuint bitmap = fb.make("occupancy", uint64_t{pixels} * words * 4);
+        clearUint(bitmap, 0);
+        pass("depth range", [&] {
+          glUseProgram(s.progDepthRange);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+          s.drawScene();
+          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        });
+        pass("occupancy fill", [&] {
+          glUseProgram(s.progOccFill);
+          glProgramUniform1ui(s.progOccFill, loc(s.progOccFill, "uWords"), words);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
+          s.drawScene();
+          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        });
+        pass("occupancy count", [&] {
+          const GLuint p = s.progOccCount;
+          glUseProgram(p);
+          glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+          glProgramUniform1ui(p, loc(p, "uWords"), words);
+          glProgramUniform1ui(p, loc(p, "uK"), k);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+          dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+        });
+      }
+      nodes = fb.make("nodes", nodeCount * kNodeBytes);
+      const uint32_t far[2] = {kFarDepthBits, 0u};
+      glClearNamedBufferData(nodes, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT, far);
+      const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+      clearUint(locks, kLockFree);
+      const GLuint p = s.progKBuffer;
+      glProgramUniform1ui(p, loc(p, "uK"), k);
+      glProgramUniform1ui(p, loc(p, "uStore"),
+                          method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
+      glProgramUniform1ui(p, loc(p, "uOccupancyWords"), words);
+      glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
+      pass("capture", [&] {
+        glUseProgram(p);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTails, tails);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCaptureStats, stats);
+        fb.bindImage(locks, kBindLocks);
+        s.drawScene();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+      uint32_t culled[2] = {0, 0};
+      glGetNamedBufferSubData(stats, 0, 8, culled);
+      out.culledOccupancy = culled[0];
+      out.culledKPlus = culled[1];
+    }
+
+    const GLuint image = fb.make("image", uint64_t{pixels} * 12);
+    pass("resolve", [&] {
+      const GLuint p = s.progResolve;
+      glUseProgram(p);
+      glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+      glProgramUniform1ui(p, loc(p, "uK"), k);
+      glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : counts);
+      glProgramUniform3f(p, loc(p, "uBackground"), options.background.r, options.background.g,
+                         options.background.b);
+      glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCounts, counts);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, offsets ? offsets : counts);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
+      dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    });
+    if (const GLenum e = glGetError(); e != GL_NO_ERROR) {
+      char buf[16];
+      std::snprintf(buf, sizeof buf, "%x", e);
+      return makeError("--engine gl: " + method.name + " failed (GL error 0x" + buf + ")");
+    }
+    if (!timed) continue;
+
+    // read back
+    out.counts.resize(pixels);
+    glGetNamedBufferSubData(counts, 0, uint64_t{pixels} * 4ll, out.counts.data());
+    for (uint32_t n : out.counts) out.fragments += n;
+    out.image = ImageRGB(s.width, s.height);
+    glGetNamedBufferSubData(image, 0, uint64_t{pixels} * 12ll, out.image.pixels.data());
+    if (options.readNodes) {
+      std::vector<uint32_t> words(nodeCount * 2);
+      if (nodeCount > 0)
+        glGetNamedBufferSubData(nodes, 0, static_cast<GLsizeiptr>(nodeCount * kNodeBytes),
+                                words.data());
+      out.nodes.resize(nodeCount);
+      for (uint64_t i = 0; i < nodeCount; ++i)
+        out.nodes[i] = (static_cast<uint64_t>(words[2 * i + kNodeHiIndex]) << 32) |
+                       words[2 * i + 1 - kNodeHiIndex];
+      out.nodeOffsets.resize(pixels);
+      out.nodeCounts.resize(pixels);
+      if (isABuffer) {
+        std::vector<uint32_t> off(pixels);
+        glGetNamedBufferSubData(offsets, 0, uint64_t{pixels} * 4ll, off.data());
+        for (uint32_t p = 0; p < pixels; ++p) {
+          out.nodeOffsets[p] = off[p];
+          out.nodeCounts[p] = out.counts[p];
+        }
+      } else {
+        for (uint32_t p = 0; p < pixels; ++p) {
+          out.nodeOffsets[p] = uint64_t{p} * k;
+          out.nodeCounts[p] = std::min(out.counts[p], k);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace mfr::gl
