@@ -35,8 +35,14 @@ if(MFR_BUILD_TESTS)
   target_compile_options(mfr_gl_tests PRIVATE ${MFR_WARNINGS})
   target_include_directories(mfr_gl_tests PRIVATE src)  # gl/shader_sources.hpp
   target_link_libraries(mfr_gl_tests PRIVATE mfr_gl GTest::gtest GTest::gtest_main)
+  target_compile_definitions(mfr_gl_tests PRIVATE MFR_CLI_PATH="$<TARGET_FILE:mfr_cli>")
+  add_dependencies(mfr_gl_tests mfr_cli)
   # discovery at test time: a machine without a GL 4.5 context skips (or, with CI=true, fails) the
   # tests instead of failing the build
   gtest_discover_tests(mfr_gl_tests DISCOVERY_MODE PRE_TEST DISCOVERY_TIMEOUT 60
     PROPERTIES TIMEOUT 600)
 endif()
+
+# the command line runs either engine (--engine gl registers it at start-up)
+target_link_libraries(mfr_cli PRIVATE mfr_gl)
+target_compile_definitions(mfr_cli PRIVATE MFR_HAS_GL=1)

@@ -5,8 +5,14 @@
 #include <new>
 
 #include "commands.hpp"
+#ifdef MFR_HAS_GL
+#include "mfr/gl/gl_render_engine.hpp"
+#endif
 
 int main(int argc, char** argv) {
+#ifdef MFR_HAS_GL
+  mfr::gl::registerGlEngine();  // --engine gl
+#endif
   CLI::App app{"mfr: bounded-memory multi-fragment rendering and order-independent transparency"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "mfr 0.1.0");

@@ -13,12 +13,34 @@ Result<RenderOutput> Engine::render(const View& view, const MethodDesc& method,
   return render(**prepared, method, options);
 }
 
+namespace {
+
+Result<std::unique_ptr<Engine>> makeCpuEngine(const EngineOptions& options) {
+  return std::unique_ptr<Engine>(std::make_unique<CpuEngine>(options));
+}
+
+std::vector<std::pair<std::string, EngineFactory>>& registry() {
+  static std::vector<std::pair<std::string, EngineFactory>> engines = {{"cpu", makeCpuEngine}};
+  return engines;
+}
+
+}  // namespace
+
+void registerEngine(const std::string& name, EngineFactory factory) {
+  for (const auto& [known, f] : registry())
+    if (known == name) return;
+  registry().emplace_back(name, factory);
+}
+
 std::vector<std::string> engineNames() {
-  return {"cpu"};
+  std::vector<std::string> names;
+  for (const auto& [name, factory] : registry()) names.push_back(name);
+  return names;
 }
 
 Result<std::unique_ptr<Engine>> makeEngine(std::string_view name, const EngineOptions& options) {
-  if (name == "cpu") return std::unique_ptr<Engine>(std::make_unique<CpuEngine>(options));
+  for (const auto& [known, factory] : registry())
+    if (known == name) return factory(options);
   std::string known;
   for (const std::string& n : engineNames()) known += (known.empty() ? "" : ", ") + n;
   return makeError("--engine " + quoteInput(name) + ": unknown engine (known: " + known + ")");

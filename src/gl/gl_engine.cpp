@@ -13,7 +13,7 @@
 #include "gl/shader_sources.hpp"
 #include "mfr/core/color.hpp"
 #include "mfr/gl/shared_layout.h"
-#include "mfr/raster/raster_frame.hpp"
+#include "mfr/cpu/raster_frame.hpp"
 
 namespace mfr::gl {
 

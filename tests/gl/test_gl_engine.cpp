@@ -18,8 +18,8 @@
 #include "mfr/gl/gl_context.hpp"
 #include "mfr/gl/gl_engine.hpp"
 #include "mfr/method/method.hpp"
-#include "mfr/method/render.hpp"
-#include "mfr/raster/raster_frame.hpp"
+#include "mfr/cpu/render.hpp"
+#include "mfr/cpu/raster_frame.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr::gl {

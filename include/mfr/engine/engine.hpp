@@ -70,11 +70,19 @@ class Engine {
                               const RenderOptions& options);
 };
 
-/// The names makeEngine accepts, in order.
+/// Makes an engine; its errors are one line (e.g. no device).
+using EngineFactory = Result<std::unique_ptr<Engine>> (*)(const EngineOptions& options);
+
+/// Makes `name` known to makeEngine (libmfr_gl: mfr::gl::registerGlEngine() adds "gl"). A name
+/// registered again keeps its first factory. Not thread-safe: register before making engines.
+void registerEngine(const std::string& name, EngineFactory factory);
+
+/// The names makeEngine accepts, in order ("cpu" first, then the registered ones).
 std::vector<std::string> engineNames();
 
-/// An engine by name ("cpu"; "gl" when the build has the OpenGL engine). Errors (one line): an
-/// unknown name, listing the known ones; an engine that cannot start on this machine.
-Result<std::unique_ptr<Engine>> makeEngine(std::string_view name, const EngineOptions& options = {});
+/// An engine by name. Errors (one line): an unknown name, listing the known ones; an engine that
+/// cannot start on this machine.
+Result<std::unique_ptr<Engine>> makeEngine(std::string_view name,
+                                           const EngineOptions& options = {});
 
 }  // namespace mfr

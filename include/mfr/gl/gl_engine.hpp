@@ -21,7 +21,7 @@
 #include "mfr/core/result.hpp"
 #include "mfr/gl/gl_context.hpp"
 #include "mfr/method/method.hpp"
-#include "mfr/raster/fragment.hpp"
+#include "mfr/method/fragment_node.hpp"
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/scene.hpp"
 
