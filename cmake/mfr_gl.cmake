@@ -46,3 +46,11 @@ endif()
 # the command line runs either engine (--engine gl registers it at start-up)
 target_link_libraries(mfr_cli PRIVATE mfr_gl)
 target_compile_definitions(mfr_cli PRIVATE MFR_HAS_GL=1)
+
+# bench_engines: the same frames on the CPU and the GL engine, in one run
+if(MFR_BUILD_BENCH)
+  add_executable(bench_engines bench/bench_engines.cpp)
+  target_compile_options(bench_engines PRIVATE ${MFR_WARNINGS})
+  target_compile_definitions(bench_engines PRIVATE MFR_SCENES_DIR="${MFR_SCENES_DIR}")
+  target_link_libraries(bench_engines PRIVATE mfr_gl)
+endif()

@@ -5,6 +5,7 @@
 #include "mfr/gl/gl_render_engine.hpp"
 
 #include <algorithm>
+#include <utility>
 
 #include "mfr/gl/gl_context.hpp"
 #include "mfr/gl/gl_engine.hpp"
@@ -20,9 +21,13 @@ class GlView final : public PreparedView {
   int width() const override { return engine_.width(); }
   int height() const override { return engine_.height(); }
   GlEngine& engine() const { return engine_; }
+  /// True the first time: the first render of a view warms up (shader compilation, llvmpipe's
+  /// first-frame timer values), later ones are timed as they run.
+  bool firstRender() const { return std::exchange(first_, false); }
 
  private:
   mutable GlEngine engine_;  // rendering changes GL state, not the view
+  mutable bool first_ = true;
 };
 
 class GlRenderEngine final : public Engine {
@@ -71,6 +76,7 @@ class GlRenderEngine final : public Engine {
     GlRenderOptions go;
     go.background = options.background;
     go.readNodes = options.keepStores;
+    go.warmUp = gv->firstRender();
     auto gl = gv->engine().render(method, go);
     if (!gl) return gl.error();
     GlRenderOutput& g = gl.value();
