@@ -168,9 +168,10 @@ inline InsertOutcome storeInsert(StoreKind kind, FragmentNode* slots, uint32_t& 
       return appendInsert(slots, count, node);
     case StoreKind::MaxArray:
       return maxArrayInsert<Access>(slots, count, capacity, node, evicted);
-    default:
+    case StoreKind::MaxHeap:
       return maxHeapInsert<Access>(slots, count, capacity, node, evicted);
   }
+  return InsertOutcome::Rejected;  // not reached: every StoreKind is a case (-Wswitch)
 }
 
 }  // namespace mfr
