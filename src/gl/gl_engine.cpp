@@ -12,8 +12,8 @@
 
 #include "gl/shader_sources.hpp"
 #include "mfr/core/color.hpp"
-#include "mfr/gl/shared_layout.h"
 #include "mfr/cpu/raster_frame.hpp"
+#include "mfr/gl/shared_layout.h"
 
 namespace mfr::gl {
 
@@ -180,14 +180,17 @@ struct GlEngine::State {
   GLsizei indexCount = 0;
   GLuint fbo = 0;
   GLuint progCount = 0, progABuffer = 0, progKBuffer = 0, progScan = 0, progScanAdd = 0,
-         progResolve = 0, progDepthRange = 0, progOccFill = 0, progOccCount = 0;
+         progResolve = 0, progDepthRange = 0, progOccFill = 0, progOccCount = 0, progNearest = 0,
+         progWboit = 0, progWboitResolve = 0, progMboitMoments = 0, progMboitColor = 0,
+         progMboitResolve = 0;
   GLuint query = 0;
   uint64_t maxBlockBytes = 0;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
   std::map<std::string, uint64_t> sceneBytes;
 
   ~State() {
     for (GLuint p : {progCount, progABuffer, progKBuffer, progScan, progScanAdd, progResolve,
-                     progDepthRange, progOccFill, progOccCount})
+                     progDepthRange, progOccFill, progOccCount, progNearest, progWboit,
+                     progWboitResolve, progMboitMoments, progMboitColor, progMboitResolve})
       if (p) glDeleteProgram(p);
     if (!sceneBuffers.empty())
       glDeleteBuffers(static_cast<GLsizei>(sceneBuffers.size()), sceneBuffers.data());
@@ -336,6 +339,26 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto occFill = raster("occupancy_fill.frag");
   if (!occFill) return occFill.error();
   s->progOccFill = *occFill;
+  auto nearest = raster("nearest_cosine.frag");
+  if (!nearest) return nearest.error();
+  s->progNearest = *nearest;
+  auto wboit = raster("wboit.frag");
+  if (!wboit) return wboit.error();
+  s->progWboit = *wboit;
+  auto wboitResolve =
+      linkProgram("wboit_resolve.comp", {{GL_COMPUTE_SHADER, "wboit_resolve.comp"}});
+  if (!wboitResolve) return wboitResolve.error();
+  s->progWboitResolve = *wboitResolve;
+  auto mboitMoments = raster("mboit_moments.frag");
+  if (!mboitMoments) return mboitMoments.error();
+  s->progMboitMoments = *mboitMoments;
+  auto mboitColor = raster("mboit_color.frag");
+  if (!mboitColor) return mboitColor.error();
+  s->progMboitColor = *mboitColor;
+  auto mboitResolve =
+      linkProgram("mboit_resolve.comp", {{GL_COMPUTE_SHADER, "mboit_resolve.comp"}});
+  if (!mboitResolve) return mboitResolve.error();
+  s->progMboitResolve = *mboitResolve;
   auto occCount =
       linkProgram("occupancy_count.comp", {{GL_COMPUTE_SHADER, "occupancy_count.comp"}});
   if (!occCount) return occCount.error();
@@ -349,7 +372,8 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto resolve = linkProgram("resolve.comp", {{GL_COMPUTE_SHADER, "resolve.comp"}});
   if (!resolve) return resolve.error();
   s->progResolve = *resolve;
-  for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill})
+  for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill,
+                   s->progNearest, s->progWboit, s->progMboitMoments, s->progMboitColor})
     s->setRasterUniforms(p);
 
   // geometry, once
@@ -441,19 +465,37 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
   State& s = *state_;
   const bool isABuffer =
       method.allocation == AllocationPolicy::Unbounded && method.store == StoreChoice::Append;
-  const bool isKBuffer =
-      method.allocation == AllocationPolicy::FixedK &&
-      (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap) && method.k &&
-      *method.k > 0;
-  const bool hybrid = isKBuffer && method.compositing == Compositing::Hybrid;
-  if ((!isABuffer && !isKBuffer) || (isABuffer && method.occupancyWords != 0) ||
-      method.occupancyWords < 0 || method.occupancyWords > 64 ||
-      (method.compositing != Compositing::KBuffer && !hybrid))
-    return makeError("--engine gl: method " + method.name +
-                     " is not in the GL engine yet (abuffer and fixed-k max-array or max-heap "
-                     "k-buffers with an explicit k)");
-  const uint32_t k = isKBuffer ? *method.k : 0u;
+  const Allocation* alloc = options.allocation;
   const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
+  const bool perPixel = alloc != nullptr;
+  if (perPixel && (alloc->capacity.size() != pixels || alloc->offsets.size() != pixels ||
+                   alloc->kind.size() != pixels))
+    return makeError("--engine gl: " + method.name + ": an allocation of another size");
+  const bool isKBuffer =
+      (perPixel && method.allocation != AllocationPolicy::Unbounded &&
+       method.allocation != AllocationPolicy::NoNodes &&
+       (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap ||
+        method.store == StoreChoice::PerPixel)) ||
+      (!perPixel && method.allocation == AllocationPolicy::FixedK &&
+       (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap) &&
+       method.k && *method.k > 0);
+  const bool hybrid = isKBuffer && method.compositing == Compositing::Hybrid;
+  const bool accumulates = (method.compositing == Compositing::WeightedBlended ||
+                            method.compositing == Compositing::MomentBased) &&
+                           method.allocation == AllocationPolicy::NoNodes &&
+                           method.store == StoreChoice::None && method.occupancyWords == 0;
+  const bool isWboit = accumulates && method.compositing == Compositing::WeightedBlended;
+  const uint32_t accumWords = !accumulates ? 0u : isWboit ? kWboitWords : kMboitWords;
+  if (accumulates) {
+    // weighted blended or moment-based OIT: no nodes, the accumulators
+  } else if ((!isABuffer && !isKBuffer) || (isABuffer && method.occupancyWords != 0) ||
+             method.occupancyWords < 0 || method.occupancyWords > 64 ||
+             (method.compositing != Compositing::KBuffer && !hybrid))
+    return makeError("--engine gl: method " + method.name +
+                     " is not in the GL engine yet (abuffer, fixed-k max-array or max-heap "
+                     "k-buffers with an explicit k, k-buffers with a per-pixel allocation, "
+                     "wboit, mboit)");
+  const uint32_t k = isKBuffer && !perPixel ? *method.k : 0u;
   // every storage buffer must fit one shader storage block (GL clamps the accessible range)
   auto tooLarge = [&](const std::string& what, uint64_t bytes) {
     return makeError("--engine gl: " + method.name + " at " + std::to_string(s.width) + "x" +
@@ -462,11 +504,14 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
                      std::to_string(s.maxBlockBytes) + " B)");
   };
   {
-    const uint64_t perPixel =
-        std::max<uint64_t>({12, hybrid ? kTailWords * 4 : 0, uint64_t{k} * kNodeBytes,
+    const uint64_t perPixelBytes =
+        std::max<uint64_t>({accumulates ? accumWords * 4 : 12, hybrid ? kTailWords * 4 : 0,
+                            perPixel ? 8 : uint64_t{k} * kNodeBytes,
                             static_cast<uint64_t>(std::max(method.occupancyWords, 0)) * 4});
-    if (uint64_t{pixels} * perPixel > s.maxBlockBytes)
-      return tooLarge("per-pixel", uint64_t{pixels} * perPixel);
+    if (uint64_t{pixels} * perPixelBytes > s.maxBlockBytes)
+      return tooLarge("per-pixel", uint64_t{pixels} * perPixelBytes);
+    if (perPixel && alloc->slots * kNodeBytes > s.maxBlockBytes)  // (keeps the uint offsets exact)
+      return tooLarge("node", alloc->slots * kNodeBytes);
   }
 
   GlRenderOutput out;
@@ -489,6 +534,22 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
                             std::chrono::duration<double, std::milli>(t1 - t0).count()});
     };
 
+    // the per-pixel allocation: (first slot, k(p) | heap bit), a texel buffer
+    if (perPixel) {
+      std::vector<uint32_t> words(uint64_t{pixels} * 2);
+      for (uint32_t p = 0; p < pixels; ++p) {
+        words[2 * p] = static_cast<uint32_t>(alloc->offsets[p]);
+        words[2 * p + 1] =
+            alloc->capacity[p] | (alloc->kind[p] == StoreKind::MaxHeap ? kAllocHeapBit : 0u);
+      }
+      const GLuint a = fb.make("allocation", uint64_t{pixels} * 8, words.data());
+      GLuint t = 0;
+      glCreateTextures(GL_TEXTURE_BUFFER, 1, &t);
+      glTextureBuffer(t, GL_RG32UI, a);
+      fb.textures.push_back(t);
+      glBindTextureUnit(kBindAllocation, t);
+    }
+
     // count: n(p) by imageAtomicAdd
     const GLuint counts = fb.make("counts", uint64_t{pixels} * 4);
     clearUint(counts, 0);
@@ -500,9 +561,28 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
                       GL_BUFFER_UPDATE_BARRIER_BIT);
     });
 
-    GLuint offsets = 0, nodes = 0, tails = 0;
+    GLuint offsets = 0, nodes = 0, tails = 0, accum = 0;
     uint64_t nodeCount = 0;
-    if (isABuffer) {
+    if (accumulates) {
+      accum = fb.make("accumulators", uint64_t{pixels} * accumWords * 4);
+      {  // wboit: revealage 1, the rest 0
+        std::vector<float> init(uint64_t{pixels} * accumWords, 0.0f);
+        if (isWboit)
+          for (uint32_t p = 0; p < pixels; ++p) init[uint64_t{p} * accumWords + 4] = 1.0f;
+        glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
+      }
+      const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+      clearUint(locks, kLockFree);
+      auto accumulate = [&](GLuint program) {
+        glUseProgram(program);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+        fb.bindImage(locks, kBindLocks);
+        s.drawScene();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      };
+      if (!isWboit) pass("moments", [&] { accumulate(s.progMboitMoments); });
+      pass("capture", [&] { accumulate(isWboit ? s.progWboit : s.progMboitColor); });
+    } else if (isABuffer) {
       offsets = fb.make("offsets", uint64_t{pixels} * 4);
       pass("prefix sum", [&] { s.scan(fb, counts, offsets, pixels); });
       // the total in 64 bits from n(p) itself (the 32-bit scan would wrap silently)
@@ -524,7 +604,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
       });
     } else {
-      nodeCount = uint64_t{pixels} * k;
+      nodeCount = perPixel ? alloc->slots : uint64_t{pixels} * k;
       const uint32_t words = static_cast<uint32_t>(method.occupancyWords);
       const GLuint stats = fb.make("capture counters", 8);
       clearUint(stats, 0);
@@ -563,6 +643,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
           glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
           glProgramUniform1ui(p, loc(p, "uWords"), words);
           glProgramUniform1ui(p, loc(p, "uK"), k);
+          glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
           glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
           glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
           dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
@@ -579,6 +660,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       glProgramUniform1ui(p, loc(p, "uStore"),
                           method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
       glProgramUniform1ui(p, loc(p, "uOccupancyWords"), words);
+      glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
       glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
       pass("capture", [&] {
         glUseProgram(p);
@@ -597,24 +679,39 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     }
 
     const GLuint image = fb.make("image", uint64_t{pixels} * 12);
-    pass("resolve", [&] {
-      const GLuint p = s.progResolve;
-      glUseProgram(p);
-      glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
-      glProgramUniform1ui(p, loc(p, "uK"), k);
-      glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : counts);
-      glProgramUniform3f(p, loc(p, "uBackground"), options.background.r, options.background.g,
-                         options.background.b);
-      glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCounts, counts);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, offsets ? offsets : counts);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
-      dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
-      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    });
+    if (accumulates) {
+      pass("resolve", [&] {
+        const GLuint p = isWboit ? s.progWboitResolve : s.progMboitResolve;
+        glUseProgram(p);
+        glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+        glProgramUniform3f(p, loc(p, "uBackground"), options.background.r, options.background.g,
+                           options.background.b);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+        dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+    } else {
+      pass("resolve", [&] {
+        const GLuint p = s.progResolve;
+        glUseProgram(p);
+        glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+        glProgramUniform1ui(p, loc(p, "uK"), k);
+        glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
+        glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : counts);
+        glProgramUniform3f(p, loc(p, "uBackground"), options.background.r, options.background.g,
+                           options.background.b);
+        glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCounts, counts);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, offsets ? offsets : counts);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
+        dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+    }
     if (const GLenum e = glGetError(); e != GL_NO_ERROR) {
       char buf[16];
       std::snprintf(buf, sizeof buf, "%x", e);
@@ -648,13 +745,60 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
         }
       } else {
         for (uint32_t p = 0; p < pixels; ++p) {
-          out.nodeOffsets[p] = uint64_t{p} * k;
-          out.nodeCounts[p] = std::min(out.counts[p], k);
+          out.nodeOffsets[p] = perPixel ? alloc->offsets[p] : uint64_t{p} * k;
+          out.nodeCounts[p] = std::min(out.counts[p], perPixel ? alloc->capacity[p] : k);
         }
       }
     }
   }
   return out;
+}
+
+Result<std::vector<uint32_t>> GlEngine::count() {
+  State& s = *state_;
+  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  std::map<std::string, uint64_t> ledger;
+  FrameBuffers fb;
+  fb.ledger = &ledger;
+  const GLuint counts = fb.make("counts", pixels * 4);
+  clearUint(counts, 0);
+  glUseProgram(s.progCount);
+  fb.bindImage(counts, kBindCounts);
+  s.drawScene();
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  std::vector<uint32_t> n(pixels);
+  glGetNamedBufferSubData(counts, 0, static_cast<GLsizeiptr>(pixels * 4), n.data());
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+    return makeError("--engine gl: the count pass failed (GL error " + std::to_string(e) + ")");
+  return n;
+}
+
+Result<std::vector<float>> GlEngine::nearestCosine() {
+  State& s = *state_;
+  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  std::map<std::string, uint64_t> ledger;
+  FrameBuffers fb;
+  fb.ledger = &ledger;
+  const GLuint nearest = fb.make("nearest", pixels * kNearestWords * 4);
+  static_assert(kNearestWords == 3);
+  const uint32_t init[3] = {kFarDepthBits, 0u, 0u};
+  glClearNamedBufferData(nearest, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
+  const GLuint locks = fb.make("locks", pixels * 4);
+  clearUint(locks, kLockFree);
+  glUseProgram(s.progNearest);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNearest, nearest);
+  fb.bindImage(locks, kBindLocks);
+  s.drawScene();
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  std::vector<uint32_t> words(pixels * kNearestWords);
+  glGetNamedBufferSubData(nearest, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+    return makeError("--engine gl: the nearest |n.v| pass failed (GL error " + std::to_string(e) +
+                     ")");
+  std::vector<float> cosine(pixels);
+  for (uint64_t p = 0; p < pixels; ++p)
+    cosine[p] = static_cast<float>(words[p * kNearestWords + 2]) / 255.0f;
+  return cosine;
 }
 
 }  // namespace mfr::gl

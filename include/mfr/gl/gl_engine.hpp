@@ -20,8 +20,9 @@
 #include "mfr/core/image.hpp"
 #include "mfr/core/result.hpp"
 #include "mfr/gl/gl_context.hpp"
-#include "mfr/method/method.hpp"
+#include "mfr/method/allocation.hpp"
 #include "mfr/method/fragment_node.hpp"
+#include "mfr/method/method.hpp"
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/scene.hpp"
 
@@ -37,6 +38,9 @@ struct GlRenderOptions {
   glm::vec3 background{1.0f};  // linear RGB
   bool warmUp = true;          // run the passes once untimed first (shader compilation, caches)
   bool readNodes = false;      // read the captured nodes back (tests, tools)
+  // variable k (counted, dynamic, importance, optimal): k(p), offsets and store kind per pixel
+  // from the shared allocate(); the k-buffer capture and resolve read them per pixel
+  const Allocation* allocation = nullptr;
 };
 
 struct GlRenderOutput {
@@ -56,8 +60,9 @@ struct GlRenderOutput {
 };
 
 /// One scene and view uploaded to GL once; render() runs a method on it any number of times.
-/// Supported methods (this slice): `abuffer` (unbounded, append) and fixed-k max-array or max-heap
-/// k-buffers with an explicit k (`fkb`, `kplus-array`, `kplus-heap`, `zbuffer`; the k+ test runs
+/// Supported methods: `abuffer` (unbounded, append), fixed-k max-array or max-heap
+/// k-buffers with an explicit k, and any k-buffer with a per-pixel allocation
+/// (GlRenderOptions::allocation) (`fkb`, `kplus-array`, `kplus-heap`, `zbuffer`; the k+ test runs
 /// for all of them: it changes no captured set), optionally with occupancy culling (`+occupancy`,
 /// d = occupancyWords), with kbuffer or hybrid compositing; anything else is an error naming the
 /// method. The
@@ -74,6 +79,12 @@ class GlEngine {
   ~GlEngine();
 
   Result<GlRenderOutput> render(const MethodDesc& method, const GlRenderOptions& options = {});
+
+  /// The count pass alone: n(p), rows top to bottom (what a variable-k allocation needs first).
+  Result<std::vector<uint32_t>> count();
+  /// The nearest fragment's |n.v| per pixel, quantised to unorm8 / 255 like mfr::nearestCosine
+  /// (0 where nothing is covered).
+  Result<std::vector<float>> nearestCosine();
 
   int width() const;
   int height() const;
