@@ -182,15 +182,16 @@ struct GlEngine::State {
   GLuint progCount = 0, progABuffer = 0, progKBuffer = 0, progScan = 0, progScanAdd = 0,
          progResolve = 0, progDepthRange = 0, progOccFill = 0, progOccCount = 0, progNearest = 0,
          progWboit = 0, progWboitResolve = 0, progMboitMoments = 0, progMboitColor = 0,
-         progMboitResolve = 0;
+         progMboitResolve = 0, progMlab = 0, progMlabResolve = 0;
   GLuint query = 0;
   uint64_t maxBlockBytes = 0;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
   std::map<std::string, uint64_t> sceneBytes;
 
   ~State() {
-    for (GLuint p : {progCount, progABuffer, progKBuffer, progScan, progScanAdd, progResolve,
-                     progDepthRange, progOccFill, progOccCount, progNearest, progWboit,
-                     progWboitResolve, progMboitMoments, progMboitColor, progMboitResolve})
+    for (GLuint p :
+         {progCount, progABuffer, progKBuffer, progScan, progScanAdd, progResolve, progDepthRange,
+          progOccFill, progOccCount, progNearest, progWboit, progWboitResolve, progMboitMoments,
+          progMboitColor, progMboitResolve, progMlab, progMlabResolve})
       if (p) glDeleteProgram(p);
     if (!sceneBuffers.empty())
       glDeleteBuffers(static_cast<GLsizei>(sceneBuffers.size()), sceneBuffers.data());
@@ -359,6 +360,12 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
       linkProgram("mboit_resolve.comp", {{GL_COMPUTE_SHADER, "mboit_resolve.comp"}});
   if (!mboitResolve) return mboitResolve.error();
   s->progMboitResolve = *mboitResolve;
+  auto mlab = raster("mlab.frag");
+  if (!mlab) return mlab.error();
+  s->progMlab = *mlab;
+  auto mlabResolve = linkProgram("mlab_resolve.comp", {{GL_COMPUTE_SHADER, "mlab_resolve.comp"}});
+  if (!mlabResolve) return mlabResolve.error();
+  s->progMlabResolve = *mlabResolve;
   auto occCount =
       linkProgram("occupancy_count.comp", {{GL_COMPUTE_SHADER, "occupancy_count.comp"}});
   if (!occCount) return occCount.error();
@@ -372,8 +379,9 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto resolve = linkProgram("resolve.comp", {{GL_COMPUTE_SHADER, "resolve.comp"}});
   if (!resolve) return resolve.error();
   s->progResolve = *resolve;
-  for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill,
-                   s->progNearest, s->progWboit, s->progMboitMoments, s->progMboitColor})
+  for (GLuint p :
+       {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill,
+        s->progNearest, s->progWboit, s->progMboitMoments, s->progMboitColor, s->progMlab})
     s->setRasterUniforms(p);
 
   // geometry, once
@@ -486,16 +494,20 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
                            method.store == StoreChoice::None && method.occupancyWords == 0;
   const bool isWboit = accumulates && method.compositing == Compositing::WeightedBlended;
   const uint32_t accumWords = !accumulates ? 0u : isWboit ? kWboitWords : kMboitWords;
-  if (accumulates) {
-    // weighted blended or moment-based OIT: no nodes, the accumulators
+  const bool isMlab = !perPixel && method.allocation == AllocationPolicy::FixedK &&
+                      method.store == StoreChoice::MultiLayer &&
+                      method.compositing == Compositing::MultiLayerAlpha && method.k &&
+                      *method.k > 0 && method.occupancyWords == 0;
+  if (accumulates || isMlab) {
+    // weighted blended or moment-based OIT: no nodes, the accumulators; mlab: its own nodes
   } else if ((!isABuffer && !isKBuffer) || (isABuffer && method.occupancyWords != 0) ||
              method.occupancyWords < 0 || method.occupancyWords > 64 ||
              (method.compositing != Compositing::KBuffer && !hybrid))
     return makeError("--engine gl: method " + method.name +
                      " is not in the GL engine yet (abuffer, fixed-k max-array or max-heap "
                      "k-buffers with an explicit k, k-buffers with a per-pixel allocation, "
-                     "wboit, mboit)");
-  const uint32_t k = isKBuffer && !perPixel ? *method.k : 0u;
+                     "wboit, mboit, mlab)");
+  const uint32_t k = (isKBuffer && !perPixel) || isMlab ? *method.k : 0u;
   // every storage buffer must fit one shader storage block (GL clamps the accessible range)
   auto tooLarge = [&](const std::string& what, uint64_t bytes) {
     return makeError("--engine gl: " + method.name + " at " + std::to_string(s.width) + "x" +
@@ -506,7 +518,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
   {
     const uint64_t perPixelBytes =
         std::max<uint64_t>({accumulates ? accumWords * 4 : 12, hybrid ? kTailWords * 4 : 0,
-                            perPixel ? 8 : uint64_t{k} * kNodeBytes,
+                            perPixel ? 8 : uint64_t{k} * (isMlab ? kMlabWords * 4 : kNodeBytes),
                             static_cast<uint64_t>(std::max(method.occupancyWords, 0)) * 4});
     if (uint64_t{pixels} * perPixelBytes > s.maxBlockBytes)
       return tooLarge("per-pixel", uint64_t{pixels} * perPixelBytes);
@@ -582,6 +594,22 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       };
       if (!isWboit) pass("moments", [&] { accumulate(s.progMboitMoments); });
       pass("capture", [&] { accumulate(isWboit ? s.progWboit : s.progMboitColor); });
+    } else if (isMlab) {
+      nodes = fb.make("nodes", uint64_t{pixels} * k * kMlabWords * 4);
+      accum = fb.make("counters", uint64_t{pixels} * 4);  // nodes in use per pixel
+      clearUint(accum, 0);
+      const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+      clearUint(locks, kLockFree);
+      pass("capture", [&] {
+        const GLuint p = s.progMlab;
+        glUseProgram(p);
+        glProgramUniform1ui(p, loc(p, "uK"), k);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, accum);
+        fb.bindImage(locks, kBindLocks);
+        s.drawScene();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      });
     } else if (isABuffer) {
       offsets = fb.make("offsets", uint64_t{pixels} * 4);
       pass("prefix sum", [&] { s.scan(fb, counts, offsets, pixels); });
@@ -679,7 +707,21 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     }
 
     const GLuint image = fb.make("image", uint64_t{pixels} * 12);
-    if (accumulates) {
+    if (isMlab) {
+      pass("resolve", [&] {
+        const GLuint p = s.progMlabResolve;
+        glUseProgram(p);
+        glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+        glProgramUniform1ui(p, loc(p, "uK"), k);
+        glProgramUniform3f(p, loc(p, "uBackground"), options.background.r, options.background.g,
+                           options.background.b);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, accum);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage2, image);
+        dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+    } else if (accumulates) {
       pass("resolve", [&] {
         const GLuint p = isWboit ? s.progWboitResolve : s.progMboitResolve;
         glUseProgram(p);
@@ -725,7 +767,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     for (uint32_t n : out.counts) out.fragments += n;
     out.image = ImageRGB(s.width, s.height);
     glGetNamedBufferSubData(image, 0, uint64_t{pixels} * 12ll, out.image.pixels.data());
-    if (options.readNodes) {
+    if (options.readNodes && !isMlab) {  // (mlab's nodes are not fragment nodes)
       std::vector<uint32_t> words(nodeCount * 2);
       if (nodeCount > 0)
         glGetNamedBufferSubData(nodes, 0, static_cast<GLsizeiptr>(nodeCount * kNodeBytes),

@@ -426,9 +426,9 @@ TEST(GlEngine, UnsupportedMethodIsAnError) {
   ASSERT_TRUE(scene.ok());
   auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 32, 32);
   ASSERT_TRUE(engine.ok()) << engine.error().message;
-  auto out = engine->render(methodPreset("mlab").value());
+  auto out = engine->render(methodPreset("dkb").value());
   ASSERT_FALSE(out.ok());
-  EXPECT_NE(out.error().message.find("mlab"), std::string::npos) << out.error().message;
+  EXPECT_NE(out.error().message.find("dkb"), std::string::npos) << out.error().message;
   // a variable-k method without its per-pixel allocation
   out = engine->render(methodPreset("kplus-sb").value());
   ASSERT_FALSE(out.ok());

@@ -65,7 +65,8 @@ TEST_P(GlSeam, SameStatisticsAndImageAsTheCpuEngine) {
   // fragment-parallel capture (the A-buffer appends with atomics: no lock word on either engine in
   // tile-owned mode)
   RenderOptions cpuOptions = options;
-  if (method.allocation != AllocationPolicy::Unbounded)
+  // (mlab charges its lock in either mode: the CPU reference merges in primitive order)
+  if (method.allocation != AllocationPolicy::Unbounded && method.store != StoreChoice::MultiLayer)
     cpuOptions.capture = CaptureMode::FragmentParallel;
   auto g = gl->render(view, method, options);
   auto r = cpu.render(view, method, cpuOptions);
@@ -84,8 +85,8 @@ TEST_P(GlSeam, SameStatisticsAndImageAsTheCpuEngine) {
   EXPECT_EQ(g->kMap, r->kMap);
   ASSERT_EQ(g->image.pixels.size(), r->image.pixels.size());
   // kbuffer: the same captured sets, composited operation for operation; hybrid: GLSL pow in the
-  // tail; wboit, mboit: float sums in the fragments' arrival order under the lock (not primitive
-  // order), mboit's exp and log in float
+  // tail; wboit, mboit, mlab: float sums and merges in the fragments' arrival order under the lock
+  // (not primitive order), mboit's exp and log in float
   const float tolerance = c.compositing == Compositing::KBuffer  ? 0.0f
                           : c.compositing == Compositing::Hybrid ? 1e-6f
                                                                  : 1.0f / 255.0f;
@@ -131,7 +132,9 @@ INSTANTIATE_TEST_SUITE_P(
         SeamCase{"procedural:layers", "wboit", Compositing::WeightedBlended, 400u << 10},
         SeamCase{"procedural:bottles?count=4", "wboit", Compositing::WeightedBlended, 400u << 10},
         SeamCase{"procedural:layers", "mboit", Compositing::MomentBased, 600u << 10},
-        SeamCase{"procedural:hairball?strands=150", "mboit", Compositing::MomentBased, 600u << 10}),
+        SeamCase{"procedural:hairball?strands=150", "mboit", Compositing::MomentBased, 600u << 10},
+        SeamCase{"procedural:layers", "mlab", Compositing::MultiLayerAlpha, 600u << 10},
+        SeamCase{"procedural:bottles?count=4", "mlab", Compositing::MultiLayerAlpha, 300u << 10}),
     [](const auto& info) {
       std::string name = std::string(info.param.method) + "_" +
                          std::string(toString(info.param.compositing)) + "_" +

@@ -65,6 +65,9 @@ MFR_GL_CONST(uint, kWboitWords, 5u)
 MFR_GL_CONST(uint, kBindAccum, 2u)
 // moment-based OIT: per pixel b0, b1..b4, then sum T a c (r, g, b), sum T a (mfr::MboitPixel)
 MFR_GL_CONST(uint, kMboitWords, 9u)
+// multi-layer alpha blending: per node depth, premultiplied r, g, b, transmittance (mfr::MlabNode)
+MFR_GL_CONST(uint, kMlabWords, 5u)
+MFR_GL_CONST(uint, kBindImage2, 4u)  // mlab resolve output (kBindImage is mlab's fill counts)
 
 // material record (12 uint words; floats as their bits): base colour R, G, B, A; the texture's
 // first texel in the texel buffer (kNoTexture: none), its width, height; alpha mode
