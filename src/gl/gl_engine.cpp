@@ -5,6 +5,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -182,16 +183,17 @@ struct GlEngine::State {
   GLuint progCount = 0, progABuffer = 0, progKBuffer = 0, progScan = 0, progScanAdd = 0,
          progResolve = 0, progDepthRange = 0, progOccFill = 0, progOccCount = 0, progNearest = 0,
          progWboit = 0, progWboitResolve = 0, progMboitMoments = 0, progMboitColor = 0,
-         progMboitResolve = 0, progMlab = 0, progMlabResolve = 0;
+         progMboitResolve = 0, progMlab = 0, progMlabResolve = 0, progDkbFeatures = 0,
+         progDkbInfer = 0;
   GLuint query = 0;
   uint64_t maxBlockBytes = 0;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
   std::map<std::string, uint64_t> sceneBytes;
 
   ~State() {
-    for (GLuint p :
-         {progCount, progABuffer, progKBuffer, progScan, progScanAdd, progResolve, progDepthRange,
-          progOccFill, progOccCount, progNearest, progWboit, progWboitResolve, progMboitMoments,
-          progMboitColor, progMboitResolve, progMlab, progMlabResolve})
+    for (GLuint p : {progCount, progABuffer, progKBuffer, progScan, progScanAdd, progResolve,
+                     progDepthRange, progOccFill, progOccCount, progNearest, progWboit,
+                     progWboitResolve, progMboitMoments, progMboitColor, progMboitResolve, progMlab,
+                     progMlabResolve, progDkbFeatures, progDkbInfer})
       if (p) glDeleteProgram(p);
     if (!sceneBuffers.empty())
       glDeleteBuffers(static_cast<GLsizei>(sceneBuffers.size()), sceneBuffers.data());
@@ -366,6 +368,12 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto mlabResolve = linkProgram("mlab_resolve.comp", {{GL_COMPUTE_SHADER, "mlab_resolve.comp"}});
   if (!mlabResolve) return mlabResolve.error();
   s->progMlabResolve = *mlabResolve;
+  auto dkbFeatures = raster("dkb_features.frag");
+  if (!dkbFeatures) return dkbFeatures.error();
+  s->progDkbFeatures = *dkbFeatures;
+  auto dkbInfer = linkProgram("dkb_infer.comp", {{GL_COMPUTE_SHADER, "dkb_infer.comp"}});
+  if (!dkbInfer) return dkbInfer.error();
+  s->progDkbInfer = *dkbInfer;
   auto occCount =
       linkProgram("occupancy_count.comp", {{GL_COMPUTE_SHADER, "occupancy_count.comp"}});
   if (!occCount) return occCount.error();
@@ -379,9 +387,9 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto resolve = linkProgram("resolve.comp", {{GL_COMPUTE_SHADER, "resolve.comp"}});
   if (!resolve) return resolve.error();
   s->progResolve = *resolve;
-  for (GLuint p :
-       {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill,
-        s->progNearest, s->progWboit, s->progMboitMoments, s->progMboitColor, s->progMlab})
+  for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill,
+                   s->progNearest, s->progWboit, s->progMboitMoments, s->progMboitColor,
+                   s->progMlab, s->progDkbFeatures})
     s->setRasterUniforms(p);
 
   // geometry, once
@@ -841,6 +849,81 @@ Result<std::vector<float>> GlEngine::nearestCosine() {
   for (uint64_t p = 0; p < pixels; ++p)
     cosine[p] = static_cast<float>(words[p * kNearestWords + 2]) / 255.0f;
   return cosine;
+}
+
+Result<std::vector<float>> GlEngine::dkbImportance(const std::vector<float>& weights,
+                                                   uint64_t slots,
+                                                   std::vector<GlPassTime>* passes) {
+  constexpr size_t kWeights = 128 * 12 + 128 + 64 * 128 + 64 + 64 + 1;
+  if (weights.size() != kWeights)
+    return makeError("--engine gl: the deep k-buffer's network must be 12-128-64-1 on GL");
+  State& s = *state_;
+  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  std::map<std::string, uint64_t> ledger;
+  FrameBuffers fb;
+  fb.ledger = &ledger;
+  auto timed = [&](const char* name, auto&& body) {
+    const auto t0 = std::chrono::steady_clock::now();
+    body();
+    glFinish();
+    if (passes)
+      passes->push_back(
+          {name, 0.0,
+           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+               .count()});
+  };
+  const GLuint acc = fb.make("features", pixels * kDkbAccWords * 4);
+  const GLuint locks = fb.make("locks", pixels * 4);
+  const GLuint net = fb.make("network", weights.size() * 4, weights.data());
+  const GLuint importance = fb.make("importance", pixels * 4);
+  std::vector<uint32_t> words(pixels * kDkbAccWords);
+  timed("features", [&] {
+    static_assert(kDkbAccWords == 7);
+    std::vector<uint32_t> init(pixels * kDkbAccWords, 0u);
+    for (uint64_t p = 0; p < pixels; ++p) init[p * kDkbAccWords + 1] = kFarDepthBits;
+    glNamedBufferSubData(acc, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
+    clearUint(locks, kLockFree);
+    glUseProgram(s.progDkbFeatures);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindDkbAcc, acc);
+    fb.bindImage(locks, kBindLocks);
+    s.drawScene();
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glGetNamedBufferSubData(acc, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
+  });
+  std::vector<float> out(pixels, 0.0f);
+  timed("inference", [&] {
+    // the image's statistics (mfr::ImageFeatureStats) on the host: four numbers
+    uint64_t fragments = 0, covered = 0;
+    float nearest = 1.0f, farthest = 0.0f;
+    for (uint64_t p = 0; p < pixels; ++p) {
+      const uint32_t* a = &words[p * kDkbAccWords];
+      if (a[0] == 0) continue;
+      fragments += a[0];
+      ++covered;
+      nearest = std::min(nearest, std::bit_cast<float>(a[1]));
+      farthest = std::max(farthest, std::bit_cast<float>(a[3]));
+    }
+    if (fragments == 0) return;
+    const GLuint p = s.progDkbInfer;
+    glUseProgram(p);
+    glProgramUniform1ui(p, loc(p, "uPixels"), static_cast<GLuint>(pixels));
+    glProgramUniform1d(p, loc(p, "uMeanN"), static_cast<double>(fragments) / covered);
+    glProgramUniform1f(p, loc(p, "uNearest"), nearest);
+    glProgramUniform1f(p, loc(p, "uFarthest"), farthest);
+    glProgramUniform1f(p, loc(p, "uSlotShare"),
+                       static_cast<float>(std::min(1.0, static_cast<double>(slots) / fragments)));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindDkbAcc, acc);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindDkbWeights, net);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindDkbImportance, importance);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
+    dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(importance, 0, static_cast<GLsizeiptr>(pixels * 4), out.data());
+  });
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+    return makeError("--engine gl: the deep k-buffer's importance failed (GL error " +
+                     std::to_string(e) + ")");
+  return out;
 }
 
 }  // namespace mfr::gl

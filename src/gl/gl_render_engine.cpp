@@ -11,7 +11,9 @@
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/gl/gl_context.hpp"
 #include "mfr/gl/gl_engine.hpp"
+#include "mfr/learn/model_file.hpp"
 #include "mfr/method/allocation.hpp"
+#include "mfr/method/dkb_model.hpp"
 #include "mfr/method/importance.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/optimal_allocation.hpp"
@@ -118,10 +120,8 @@ class GlRenderEngine final : public Engine {
                           method.allocation == AllocationPolicy::DynamicK ||
                           method.allocation == AllocationPolicy::Importance ||
                           method.allocation == AllocationPolicy::Optimal;
-    if (method.allocation == AllocationPolicy::Importance &&
-        method.importanceSource == ImportanceSource::Network)
-      return makeError("--engine gl: method " + method.name +
-                       " is not in the GL engine yet (the deep k-buffer's network importance)");
+    const bool deep = method.allocation == AllocationPolicy::Importance &&
+                      method.importanceSource == ImportanceSource::Network;
     // the GL k-buffers take the per-pixel spin-lock: the CPU engine's fragment-parallel memory
     // (wboit's accumulators too)
     const MemoryModel memory =
@@ -151,7 +151,33 @@ class GlRenderEngine final : public Engine {
         n = std::move(counted.value());
         hostPasses.push_back({"count (n(p) read back)", msSince(t0)});
       }
-      if (method.allocation == AllocationPolicy::Importance) {
+      if (deep) {  // the deep k-buffer: features and network on GL (dkb_infer.comp)
+        if (!options.budgetBytes) return makeError(method.name + ": needs a budget");
+        std::shared_ptr<const learn::Model> model = method.model;
+        if (!model) {
+          auto builtin = builtinDkbModel();
+          if (!builtin) return builtin.error();
+          model = builtin.value();
+        } else if (auto fits = checkDkbModel(*model, "of " + method.name); !fits) {
+          return fits.error();
+        }
+        std::vector<float> weights;
+        for (size_t l = 0; l < model->net.weights.size(); ++l) {
+          const auto& w = model->net.weights[l];
+          const auto& b = model->net.biases[l];
+          weights.insert(weights.end(), w.data(), w.data() + w.size());  // column-major
+          weights.insert(weights.end(), b.data(), b.data() + b.size());
+        }
+        if (model->net.sizes != learn::kDkbLayers)
+          return makeError("--engine gl: " + method.name +
+                           ": the GL engine runs 12-128-64-1 networks only");
+        std::vector<GlPassTime> dkbPasses;
+        auto importance = gv->engine().dkbImportance(
+            weights, memory.fragmentSlots(*options.budgetBytes, pixels), &dkbPasses);
+        if (!importance) return importance.error();
+        out.importance.importance = std::move(importance.value());
+        for (const GlPassTime& t : dkbPasses) hostPasses.push_back({t.name, t.wallMs});
+      } else if (method.allocation == AllocationPolicy::Importance) {
         t0 = std::chrono::steady_clock::now();
         auto cosine = gv->engine().nearestCosine();
         if (!cosine) return cosine.error();

@@ -85,6 +85,12 @@ class GlEngine {
   /// The nearest fragment's |n.v| per pixel, quantised to unorm8 / 255 like mfr::nearestCosine
   /// (0 where nothing is covered).
   Result<std::vector<float>> nearestCosine();
+  /// The deep k-buffer's importance I(p): the feature pass (shaders/dkb_features.frag), the image
+  /// statistics from its accumulators on the host, features and network per pixel in a compute
+  /// shader (shaders/dkb_infer.comp). `layers` {12, 128, 64, 1}, `weights` Eigen's column-major
+  /// W0, b0, W1, b1, W2, b2 flattened; `slots` = F(M). `passes` gets the passes' wall times.
+  Result<std::vector<float>> dkbImportance(const std::vector<float>& weights, uint64_t slots,
+                                           std::vector<GlPassTime>* passes = nullptr);
 
   int width() const;
   int height() const;

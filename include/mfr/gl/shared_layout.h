@@ -67,6 +67,12 @@ MFR_GL_CONST(uint, kBindAccum, 2u)
 MFR_GL_CONST(uint, kMboitWords, 9u)
 // multi-layer alpha blending: per node depth, premultiplied r, g, b, transmittance (mfr::MlabNode)
 MFR_GL_CONST(uint, kMlabWords, 5u)
+// deep k-buffer: feature accumulators per pixel (n, nearest depth bits and colour, farthest depth
+// bits, premultiplied colour sum r, g, b), the network's weights, the importance
+MFR_GL_CONST(uint, kDkbAccWords, 7u)
+MFR_GL_CONST(uint, kBindDkbAcc, 0u)
+MFR_GL_CONST(uint, kBindDkbWeights, 1u)
+MFR_GL_CONST(uint, kBindDkbImportance, 2u)
 MFR_GL_CONST(uint, kBindImage2, 4u)  // mlab resolve output (kBindImage is mlab's fill counts)
 
 // material record (12 uint words; floats as their bits): base colour R, G, B, A; the texture's
