@@ -571,15 +571,19 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     }
 
     // count: n(p) by imageAtomicAdd
-    const GLuint counts = fb.make("counts", uint64_t{pixels} * 4);
-    clearUint(counts, 0);
-    pass("count", [&] {
-      glUseProgram(s.progCount);
-      fb.bindImage(counts, kBindCounts);
-      s.drawScene();
-      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                      GL_BUFFER_UPDATE_BARRIER_BIT);
-    });
+    const bool counted = options.counts && options.counts->size() == pixels;
+    const GLuint counts =
+        fb.make("counts", uint64_t{pixels} * 4, counted ? options.counts->data() : nullptr);
+    if (!counted) {
+      clearUint(counts, 0);
+      pass("count", [&] {
+        glUseProgram(s.progCount);
+        fb.bindImage(counts, kBindCounts);
+        s.drawScene();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                        GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+    }
 
     GLuint offsets = 0, nodes = 0, tails = 0, accum = 0;
     uint64_t nodeCount = 0;

@@ -134,8 +134,9 @@ class GlRenderEngine final : public Engine {
     std::vector<PassTime> hostPasses;
     RenderOutput out;
     std::optional<Allocation> perPixel;
+    std::vector<uint32_t> n;  // variable k: n(p) measured first, reused by the frame
     if (variable) {
-      std::vector<uint32_t> n, oracleK;
+      std::vector<uint32_t> oracleK;
       auto t0 = std::chrono::steady_clock::now();
       if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes) {
         auto chosen = cpuOracle(gv->view(), method, options,
@@ -203,6 +204,8 @@ class GlRenderEngine final : public Engine {
     go.background = options.background;
     go.readNodes = options.keepStores;
     go.allocation = perPixel ? &*perPixel : nullptr;
+    // (GL's own n(p) only: the optimal k-buffer's comes from the CPU oracle)
+    go.counts = n.empty() || method.allocation == AllocationPolicy::Optimal ? nullptr : &n;
     auto gl = gv->engine().render(method, go);
     if (!gl) return gl.error();
     GlRenderOutput& g = gl.value();

@@ -41,6 +41,8 @@ struct GlRenderOptions {
   // variable k (counted, dynamic, importance, optimal): k(p), offsets and store kind per pixel
   // from the shared allocate(); the k-buffer capture and resolve read them per pixel
   const Allocation* allocation = nullptr;
+  // n(p) measured before (count()): uploaded instead of running the count pass again
+  const std::vector<uint32_t>* counts = nullptr;
 };
 
 struct GlRenderOutput {
