@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -223,6 +224,20 @@ TEST(GlSeamErrors, MethodsNotInTheGlEngineAndBudgetsAreOneLine) {
   CpuEngine cpu;
   auto cpuView = cpu.prepare(view);
   ASSERT_TRUE(cpuView.ok());
+  // budget errors of the variable-k methods: the shared allocate()'s, the CPU engine's words
+  for (const char* name : {"kplus-sb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "optimal"})
+    for (std::optional<uint64_t> budget :
+         {std::optional<uint64_t>(1000), std::optional<uint64_t>()}) {
+      SCOPED_TRACE(name);
+      RenderOptions o;
+      o.budgetBytes = budget;
+      const MethodDesc m = methodPreset(name).value();
+      auto g = gl->render(**prepared, m, o);
+      auto r = cpu.render(**cpuView, m, o);
+      ASSERT_FALSE(g.ok());
+      ASSERT_FALSE(r.ok());
+      EXPECT_EQ(g.error().message, r.error().message);
+    }
   EXPECT_EQ(gl->countFragments(**prepared).value(), cpu.countFragments(**cpuView).value());
   // the nearest fragment's |n.v| (unorm8), the variable k-buffer's previous-frame input
   EXPECT_EQ(gl->nearestCosine(**prepared).value(), cpu.nearestCosine(**cpuView).value());
