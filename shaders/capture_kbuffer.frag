@@ -15,6 +15,9 @@ layout(std430, binding = kBindNodes) coherent buffer Nodes {
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
 uniform uint uK;
 uniform uint uStore;  // kStoreMaxArray or kStoreMaxHeap
+// 1: variable k, pixel p owns k(p) nodes from its own first slot, store per pixel (uAlloc)
+uniform uint uPerPixel;
+layout(binding = kBindAllocation) uniform usamplerBuffer uAlloc;
 uniform uint uOccupancyWords;  // 0: no occupancy culling
 uniform uint uHybrid;  // 1: rejected, culled and evicted fragments go to the pixel's tail
 layout(std430, binding = kBindOccupancy) readonly buffer Occupancy {
@@ -48,8 +51,17 @@ void main() {
     }
   }
   const uvec2 node = uvec2(floatBitsToUint(depth), shade(f, base));
-  const uint first = p * uK;
-  if (store && node.x > nodes[first].x) {  // k+ test
+  uint first = p * uK, k = uK, storeKind = uStore;
+  if (uPerPixel != 0u) {
+    const uvec2 a = texelFetch(uAlloc, f.pixel).xy;
+    first = a.x;
+    k = a.y & ~kAllocHeapBit;
+    storeKind = (a.y & kAllocHeapBit) != 0u ? kStoreMaxHeap : kStoreMaxArray;
+  }
+  if (store && k == 0u) {  // no slot: rejected
+    if (uHybrid == 0u) return;
+    store = false;
+  } else if (store && node.x > nodes[first].x) {  // k+ test
     atomicAdd(culledKPlus, 1u);
     if (uHybrid == 0u) return;
     store = false;
@@ -59,19 +71,19 @@ void main() {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
       uint tailColor = node.y;
       bool toTail = !store;
-      const uvec2 maxNode = nodes[first];
+      const uvec2 maxNode = k > 0u ? nodes[first] : uvec2(kFarDepthBits, 0u);
       if (!store) {
         // culled: to the tail
       } else if (!nodeLess(node, maxNode)) {
         toTail = true;  // rejected in the store
-      } else if (uStore == kStoreMaxHeap) {
+      } else if (storeKind == kStoreMaxHeap) {
         // down-heap: move the larger child up into the hole
         uint i = 0u;
         for (;;) {
           const uint left = 2u * i + 1u;
-          if (left >= uK) break;
+          if (left >= k) break;
           uint child = left;
-          if (left + 1u < uK) {
+          if (left + 1u < k) {
             if (nodeLess(nodes[first + left], nodes[first + left + 1u])) child = left + 1u;
           }
           const uvec2 c = nodes[first + child];
@@ -84,7 +96,7 @@ void main() {
         // replace the maximum; the new maximum of the k moves to slot 0
         uint maxIndex = 0u;
         uvec2 m = node;
-        for (uint i = 1u; i < uK; ++i) {
+        for (uint i = 1u; i < k; ++i) {
           const uvec2 s = nodes[first + i];
           if (nodeLess(m, s)) {
             m = s;

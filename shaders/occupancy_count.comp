@@ -11,17 +11,20 @@ layout(std430, binding = kBindOccupancy) buffer Occupancy {
 uniform uint uPixels;
 uniform uint uWords;
 uniform uint uK;
+uniform uint uPerPixel;  // 1: k(p) from the allocation (uAlloc)
+layout(binding = kBindAllocation) uniform usamplerBuffer uAlloc;
 
 void main() {
   const uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
   const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
   if (p >= uPixels) return;
+  const uint k = uPerPixel != 0u ? texelFetch(uAlloc, int(p)).y & ~kAllocHeapBit : uK;
   uint seen = 0u;
   uint result = kOccupancyNoCulling;
   for (uint w = 0u; w < uWords && result == kOccupancyNoCulling; ++w) {
     uint b = bits[p * uWords + w];
     while (b != 0u) {
-      if (++seen == uK) {
+      if (++seen == k) {
         result = w * 32u + uint(findLSB(b));
         break;
       }

@@ -162,8 +162,8 @@ uint packColor(vec3 rgb, float alpha) {
          (encodeSrgb8(clampUnit(rgb.b)) << 16) | (uint(int(scaledA)) << 24);
 }
 
-// headlight shading (RasterFrame::shade): the colour word
-uint shade(FragmentData f, vec4 base) {
+// headlight shading (RasterFrame::shade): the colour word, and the clamped n.v it used
+uint shadeWithCosine(FragmentData f, vec4 base, out float cosine) {
   precise float nx = gN0.x * f.l0 + gN1.x * f.l1 + gN2.x * f.l2;
   precise float ny = gN0.y * f.l0 + gN1.y * f.l1 + gN2.y * f.l2;
   precise float nz = gN0.z * f.l0 + gN1.z * f.l1 + gN2.z * f.l2;
@@ -176,7 +176,13 @@ uint shade(FragmentData f, vec4 base) {
   const float ndotv = nn > 0.0 ? (q < -1.0 ? -1.0 : (1.0 < q ? 1.0 : q)) : 1.0;
   precise float light = uAmbient + uDiffuse * abs(ndotv);
   precise vec3 rgb = base.rgb * light;
+  cosine = ndotv;
   return packColor(rgb, base.a);
+}
+
+uint shade(FragmentData f, vec4 base) {
+  float cosine;
+  return shadeWithCosine(f, base, cosine);
 }
 
 // occupancy map bucket of depth z (mfr::OccupancyMap::bucket): monotone in z, shared by the fill

@@ -28,7 +28,9 @@ layout(std430, binding = kBindResolveTails) readonly buffer Tails {
 
 uniform uint uHybrid;  // 1: mfr::compositeHybrid with the pixel's tail
 uniform uint uPixels;
-uniform uint uK;  // 0: A-buffer (n(p) nodes at offsets[p]); k > 0: k slots at p * k
+uniform uint uPerPixel;  // 1: variable k, k(p) slots from pixel p's first slot (uAlloc)
+layout(binding = kBindAllocation) uniform usamplerBuffer uAlloc;
+uniform uint uK;  // 0 (and uPerPixel 0): A-buffer (n(p) nodes at offsets[p]); k > 0: k slots at p * k
 uniform vec3 uBackground;
 uniform float uInv255;
 
@@ -60,7 +62,12 @@ void main() {
   const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
   if (p >= uPixels) return;
   uint first, slots, n;
-  if (uK == 0u) {
+  if (uPerPixel != 0u) {
+    const uvec2 a = texelFetch(uAlloc, int(p)).xy;
+    first = a.x;
+    slots = a.y & ~kAllocHeapBit;  // empty slots hold the far node and sort last
+    n = min(counts[p], slots);
+  } else if (uK == 0u) {
     first = offsets[p];
     slots = counts[p];
     n = slots;

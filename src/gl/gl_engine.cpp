@@ -5,6 +5,7 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -12,8 +13,8 @@
 
 #include "gl/shader_sources.hpp"
 #include "mfr/core/color.hpp"
-#include "mfr/gl/shared_layout.h"
 #include "mfr/cpu/raster_frame.hpp"
+#include "mfr/gl/shared_layout.h"
 
 namespace mfr::gl {
 
@@ -180,14 +181,19 @@ struct GlEngine::State {
   GLsizei indexCount = 0;
   GLuint fbo = 0;
   GLuint progCount = 0, progABuffer = 0, progKBuffer = 0, progScan = 0, progScanAdd = 0,
-         progResolve = 0, progDepthRange = 0, progOccFill = 0, progOccCount = 0;
+         progResolve = 0, progDepthRange = 0, progOccFill = 0, progOccCount = 0, progNearest = 0,
+         progWboit = 0, progWboitResolve = 0, progMboitMoments = 0, progMboitColor = 0,
+         progMboitResolve = 0, progMlab = 0, progMlabResolve = 0, progDkbFeatures = 0,
+         progDkbInfer = 0;
   GLuint query = 0;
   uint64_t maxBlockBytes = 0;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
   std::map<std::string, uint64_t> sceneBytes;
 
   ~State() {
     for (GLuint p : {progCount, progABuffer, progKBuffer, progScan, progScanAdd, progResolve,
-                     progDepthRange, progOccFill, progOccCount})
+                     progDepthRange, progOccFill, progOccCount, progNearest, progWboit,
+                     progWboitResolve, progMboitMoments, progMboitColor, progMboitResolve, progMlab,
+                     progMlabResolve, progDkbFeatures, progDkbInfer})
       if (p) glDeleteProgram(p);
     if (!sceneBuffers.empty())
       glDeleteBuffers(static_cast<GLsizei>(sceneBuffers.size()), sceneBuffers.data());
@@ -336,6 +342,38 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto occFill = raster("occupancy_fill.frag");
   if (!occFill) return occFill.error();
   s->progOccFill = *occFill;
+  auto nearest = raster("nearest_cosine.frag");
+  if (!nearest) return nearest.error();
+  s->progNearest = *nearest;
+  auto wboit = raster("wboit.frag");
+  if (!wboit) return wboit.error();
+  s->progWboit = *wboit;
+  auto wboitResolve =
+      linkProgram("wboit_resolve.comp", {{GL_COMPUTE_SHADER, "wboit_resolve.comp"}});
+  if (!wboitResolve) return wboitResolve.error();
+  s->progWboitResolve = *wboitResolve;
+  auto mboitMoments = raster("mboit_moments.frag");
+  if (!mboitMoments) return mboitMoments.error();
+  s->progMboitMoments = *mboitMoments;
+  auto mboitColor = raster("mboit_color.frag");
+  if (!mboitColor) return mboitColor.error();
+  s->progMboitColor = *mboitColor;
+  auto mboitResolve =
+      linkProgram("mboit_resolve.comp", {{GL_COMPUTE_SHADER, "mboit_resolve.comp"}});
+  if (!mboitResolve) return mboitResolve.error();
+  s->progMboitResolve = *mboitResolve;
+  auto mlab = raster("mlab.frag");
+  if (!mlab) return mlab.error();
+  s->progMlab = *mlab;
+  auto mlabResolve = linkProgram("mlab_resolve.comp", {{GL_COMPUTE_SHADER, "mlab_resolve.comp"}});
+  if (!mlabResolve) return mlabResolve.error();
+  s->progMlabResolve = *mlabResolve;
+  auto dkbFeatures = raster("dkb_features.frag");
+  if (!dkbFeatures) return dkbFeatures.error();
+  s->progDkbFeatures = *dkbFeatures;
+  auto dkbInfer = linkProgram("dkb_infer.comp", {{GL_COMPUTE_SHADER, "dkb_infer.comp"}});
+  if (!dkbInfer) return dkbInfer.error();
+  s->progDkbInfer = *dkbInfer;
   auto occCount =
       linkProgram("occupancy_count.comp", {{GL_COMPUTE_SHADER, "occupancy_count.comp"}});
   if (!occCount) return occCount.error();
@@ -349,7 +387,9 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto resolve = linkProgram("resolve.comp", {{GL_COMPUTE_SHADER, "resolve.comp"}});
   if (!resolve) return resolve.error();
   s->progResolve = *resolve;
-  for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill})
+  for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill,
+                   s->progNearest, s->progWboit, s->progMboitMoments, s->progMboitColor,
+                   s->progMlab, s->progDkbFeatures})
     s->setRasterUniforms(p);
 
   // geometry, once
@@ -441,19 +481,41 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
   State& s = *state_;
   const bool isABuffer =
       method.allocation == AllocationPolicy::Unbounded && method.store == StoreChoice::Append;
-  const bool isKBuffer =
-      method.allocation == AllocationPolicy::FixedK &&
-      (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap) && method.k &&
-      *method.k > 0;
-  const bool hybrid = isKBuffer && method.compositing == Compositing::Hybrid;
-  if ((!isABuffer && !isKBuffer) || (isABuffer && method.occupancyWords != 0) ||
-      method.occupancyWords < 0 || method.occupancyWords > 64 ||
-      (method.compositing != Compositing::KBuffer && !hybrid))
-    return makeError("--engine gl: method " + method.name +
-                     " is not in the GL engine yet (abuffer and fixed-k max-array or max-heap "
-                     "k-buffers with an explicit k)");
-  const uint32_t k = isKBuffer ? *method.k : 0u;
+  const Allocation* alloc = options.allocation;
   const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
+  const bool perPixel = alloc != nullptr;
+  if (perPixel && (alloc->capacity.size() != pixels || alloc->offsets.size() != pixels ||
+                   alloc->kind.size() != pixels))
+    return makeError("--engine gl: " + method.name + ": an allocation of another size");
+  const bool isKBuffer =
+      (perPixel && method.allocation != AllocationPolicy::Unbounded &&
+       method.allocation != AllocationPolicy::NoNodes &&
+       (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap ||
+        method.store == StoreChoice::PerPixel)) ||
+      (!perPixel && method.allocation == AllocationPolicy::FixedK &&
+       (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap) &&
+       method.k && *method.k > 0);
+  const bool hybrid = isKBuffer && method.compositing == Compositing::Hybrid;
+  const bool accumulates = (method.compositing == Compositing::WeightedBlended ||
+                            method.compositing == Compositing::MomentBased) &&
+                           method.allocation == AllocationPolicy::NoNodes &&
+                           method.store == StoreChoice::None && method.occupancyWords == 0;
+  const bool isWboit = accumulates && method.compositing == Compositing::WeightedBlended;
+  const uint32_t accumWords = !accumulates ? 0u : isWboit ? kWboitWords : kMboitWords;
+  const bool isMlab = !perPixel && method.allocation == AllocationPolicy::FixedK &&
+                      method.store == StoreChoice::MultiLayer &&
+                      method.compositing == Compositing::MultiLayerAlpha && method.k &&
+                      *method.k > 0 && method.occupancyWords == 0;
+  if (accumulates || isMlab) {
+    // weighted blended or moment-based OIT: no nodes, the accumulators; mlab: its own nodes
+  } else if ((!isABuffer && !isKBuffer) || (isABuffer && method.occupancyWords != 0) ||
+             method.occupancyWords < 0 || method.occupancyWords > 64 ||
+             (method.compositing != Compositing::KBuffer && !hybrid))
+    return makeError("--engine gl: method " + method.name +
+                     " is not in the GL engine yet (abuffer, fixed-k max-array or max-heap "
+                     "k-buffers with an explicit k, k-buffers with a per-pixel allocation, "
+                     "wboit, mboit, mlab)");
+  const uint32_t k = (isKBuffer && !perPixel) || isMlab ? *method.k : 0u;
   // every storage buffer must fit one shader storage block (GL clamps the accessible range)
   auto tooLarge = [&](const std::string& what, uint64_t bytes) {
     return makeError("--engine gl: " + method.name + " at " + std::to_string(s.width) + "x" +
@@ -462,11 +524,14 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
                      std::to_string(s.maxBlockBytes) + " B)");
   };
   {
-    const uint64_t perPixel =
-        std::max<uint64_t>({12, hybrid ? kTailWords * 4 : 0, uint64_t{k} * kNodeBytes,
+    const uint64_t perPixelBytes =
+        std::max<uint64_t>({accumulates ? accumWords * 4 : 12, hybrid ? kTailWords * 4 : 0,
+                            perPixel ? 8 : uint64_t{k} * (isMlab ? kMlabWords * 4 : kNodeBytes),
                             static_cast<uint64_t>(std::max(method.occupancyWords, 0)) * 4});
-    if (uint64_t{pixels} * perPixel > s.maxBlockBytes)
-      return tooLarge("per-pixel", uint64_t{pixels} * perPixel);
+    if (uint64_t{pixels} * perPixelBytes > s.maxBlockBytes)
+      return tooLarge("per-pixel", uint64_t{pixels} * perPixelBytes);
+    if (perPixel && alloc->slots * kNodeBytes > s.maxBlockBytes)  // (keeps the uint offsets exact)
+      return tooLarge("node", alloc->slots * kNodeBytes);
   }
 
   GlRenderOutput out;
@@ -489,20 +554,75 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
                             std::chrono::duration<double, std::milli>(t1 - t0).count()});
     };
 
-    // count: n(p) by imageAtomicAdd
-    const GLuint counts = fb.make("counts", uint64_t{pixels} * 4);
-    clearUint(counts, 0);
-    pass("count", [&] {
-      glUseProgram(s.progCount);
-      fb.bindImage(counts, kBindCounts);
-      s.drawScene();
-      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                      GL_BUFFER_UPDATE_BARRIER_BIT);
-    });
+    // the per-pixel allocation: (first slot, k(p) | heap bit), a texel buffer
+    if (perPixel) {
+      std::vector<uint32_t> words(uint64_t{pixels} * 2);
+      for (uint32_t p = 0; p < pixels; ++p) {
+        words[2 * p] = static_cast<uint32_t>(alloc->offsets[p]);
+        words[2 * p + 1] =
+            alloc->capacity[p] | (alloc->kind[p] == StoreKind::MaxHeap ? kAllocHeapBit : 0u);
+      }
+      const GLuint a = fb.make("allocation", uint64_t{pixels} * 8, words.data());
+      GLuint t = 0;
+      glCreateTextures(GL_TEXTURE_BUFFER, 1, &t);
+      glTextureBuffer(t, GL_RG32UI, a);
+      fb.textures.push_back(t);
+      glBindTextureUnit(kBindAllocation, t);
+    }
 
-    GLuint offsets = 0, nodes = 0, tails = 0;
+    // count: n(p) by imageAtomicAdd
+    const bool counted = options.counts && options.counts->size() == pixels;
+    const GLuint counts =
+        fb.make("counts", uint64_t{pixels} * 4, counted ? options.counts->data() : nullptr);
+    if (!counted) {
+      clearUint(counts, 0);
+      pass("count", [&] {
+        glUseProgram(s.progCount);
+        fb.bindImage(counts, kBindCounts);
+        s.drawScene();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                        GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+    }
+
+    GLuint offsets = 0, nodes = 0, tails = 0, accum = 0;
     uint64_t nodeCount = 0;
-    if (isABuffer) {
+    if (accumulates) {
+      accum = fb.make("accumulators", uint64_t{pixels} * accumWords * 4);
+      {  // wboit: revealage 1, the rest 0
+        std::vector<float> init(uint64_t{pixels} * accumWords, 0.0f);
+        if (isWboit)
+          for (uint32_t p = 0; p < pixels; ++p) init[uint64_t{p} * accumWords + 4] = 1.0f;
+        glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
+      }
+      const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+      clearUint(locks, kLockFree);
+      auto accumulate = [&](GLuint program) {
+        glUseProgram(program);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+        fb.bindImage(locks, kBindLocks);
+        s.drawScene();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      };
+      if (!isWboit) pass("moments", [&] { accumulate(s.progMboitMoments); });
+      pass("capture", [&] { accumulate(isWboit ? s.progWboit : s.progMboitColor); });
+    } else if (isMlab) {
+      nodes = fb.make("nodes", uint64_t{pixels} * k * kMlabWords * 4);
+      accum = fb.make("counters", uint64_t{pixels} * 4);  // nodes in use per pixel
+      clearUint(accum, 0);
+      const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+      clearUint(locks, kLockFree);
+      pass("capture", [&] {
+        const GLuint p = s.progMlab;
+        glUseProgram(p);
+        glProgramUniform1ui(p, loc(p, "uK"), k);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, accum);
+        fb.bindImage(locks, kBindLocks);
+        s.drawScene();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      });
+    } else if (isABuffer) {
       offsets = fb.make("offsets", uint64_t{pixels} * 4);
       pass("prefix sum", [&] { s.scan(fb, counts, offsets, pixels); });
       // the total in 64 bits from n(p) itself (the 32-bit scan would wrap silently)
@@ -524,7 +644,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
       });
     } else {
-      nodeCount = uint64_t{pixels} * k;
+      nodeCount = perPixel ? alloc->slots : uint64_t{pixels} * k;
       const uint32_t words = static_cast<uint32_t>(method.occupancyWords);
       const GLuint stats = fb.make("capture counters", 8);
       clearUint(stats, 0);
@@ -563,6 +683,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
           glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
           glProgramUniform1ui(p, loc(p, "uWords"), words);
           glProgramUniform1ui(p, loc(p, "uK"), k);
+          glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
           glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
           glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
           dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
@@ -579,6 +700,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       glProgramUniform1ui(p, loc(p, "uStore"),
                           method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
       glProgramUniform1ui(p, loc(p, "uOccupancyWords"), words);
+      glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
       glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
       pass("capture", [&] {
         glUseProgram(p);
@@ -597,24 +719,53 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     }
 
     const GLuint image = fb.make("image", uint64_t{pixels} * 12);
-    pass("resolve", [&] {
-      const GLuint p = s.progResolve;
-      glUseProgram(p);
-      glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
-      glProgramUniform1ui(p, loc(p, "uK"), k);
-      glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : counts);
-      glProgramUniform3f(p, loc(p, "uBackground"), options.background.r, options.background.g,
-                         options.background.b);
-      glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCounts, counts);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, offsets ? offsets : counts);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
-      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
-      dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
-      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-    });
+    if (isMlab) {
+      pass("resolve", [&] {
+        const GLuint p = s.progMlabResolve;
+        glUseProgram(p);
+        glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+        glProgramUniform1ui(p, loc(p, "uK"), k);
+        glProgramUniform3f(p, loc(p, "uBackground"), options.background.r, options.background.g,
+                           options.background.b);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, accum);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage2, image);
+        dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+    } else if (accumulates) {
+      pass("resolve", [&] {
+        const GLuint p = isWboit ? s.progWboitResolve : s.progMboitResolve;
+        glUseProgram(p);
+        glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+        glProgramUniform3f(p, loc(p, "uBackground"), options.background.r, options.background.g,
+                           options.background.b);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+        dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+    } else {
+      pass("resolve", [&] {
+        const GLuint p = s.progResolve;
+        glUseProgram(p);
+        glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+        glProgramUniform1ui(p, loc(p, "uK"), k);
+        glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
+        glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : counts);
+        glProgramUniform3f(p, loc(p, "uBackground"), options.background.r, options.background.g,
+                           options.background.b);
+        glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCounts, counts);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, offsets ? offsets : counts);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
+        dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+    }
     if (const GLenum e = glGetError(); e != GL_NO_ERROR) {
       char buf[16];
       std::snprintf(buf, sizeof buf, "%x", e);
@@ -628,7 +779,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     for (uint32_t n : out.counts) out.fragments += n;
     out.image = ImageRGB(s.width, s.height);
     glGetNamedBufferSubData(image, 0, uint64_t{pixels} * 12ll, out.image.pixels.data());
-    if (options.readNodes) {
+    if (options.readNodes && !isMlab) {  // (mlab's nodes are not fragment nodes)
       std::vector<uint32_t> words(nodeCount * 2);
       if (nodeCount > 0)
         glGetNamedBufferSubData(nodes, 0, static_cast<GLsizeiptr>(nodeCount * kNodeBytes),
@@ -648,12 +799,134 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
         }
       } else {
         for (uint32_t p = 0; p < pixels; ++p) {
-          out.nodeOffsets[p] = uint64_t{p} * k;
-          out.nodeCounts[p] = std::min(out.counts[p], k);
+          out.nodeOffsets[p] = perPixel ? alloc->offsets[p] : uint64_t{p} * k;
+          out.nodeCounts[p] = std::min(out.counts[p], perPixel ? alloc->capacity[p] : k);
         }
       }
     }
   }
+  return out;
+}
+
+Result<std::vector<uint32_t>> GlEngine::count() {
+  State& s = *state_;
+  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  std::map<std::string, uint64_t> ledger;
+  FrameBuffers fb;
+  fb.ledger = &ledger;
+  const GLuint counts = fb.make("counts", pixels * 4);
+  clearUint(counts, 0);
+  glUseProgram(s.progCount);
+  fb.bindImage(counts, kBindCounts);
+  s.drawScene();
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  std::vector<uint32_t> n(pixels);
+  glGetNamedBufferSubData(counts, 0, static_cast<GLsizeiptr>(pixels * 4), n.data());
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+    return makeError("--engine gl: the count pass failed (GL error " + std::to_string(e) + ")");
+  return n;
+}
+
+Result<std::vector<float>> GlEngine::nearestCosine() {
+  State& s = *state_;
+  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  std::map<std::string, uint64_t> ledger;
+  FrameBuffers fb;
+  fb.ledger = &ledger;
+  const GLuint nearest = fb.make("nearest", pixels * kNearestWords * 4);
+  static_assert(kNearestWords == 3);
+  const uint32_t init[3] = {kFarDepthBits, 0u, 0u};
+  glClearNamedBufferData(nearest, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
+  const GLuint locks = fb.make("locks", pixels * 4);
+  clearUint(locks, kLockFree);
+  glUseProgram(s.progNearest);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNearest, nearest);
+  fb.bindImage(locks, kBindLocks);
+  s.drawScene();
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+  std::vector<uint32_t> words(pixels * kNearestWords);
+  glGetNamedBufferSubData(nearest, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+    return makeError("--engine gl: the nearest |n.v| pass failed (GL error " + std::to_string(e) +
+                     ")");
+  std::vector<float> cosine(pixels);
+  for (uint64_t p = 0; p < pixels; ++p)
+    cosine[p] = static_cast<float>(words[p * kNearestWords + 2]) / 255.0f;
+  return cosine;
+}
+
+Result<std::vector<float>> GlEngine::dkbImportance(const std::vector<float>& weights,
+                                                   uint64_t slots,
+                                                   std::vector<GlPassTime>* passes) {
+  constexpr size_t kWeights = 128 * 12 + 128 + 64 * 128 + 64 + 64 + 1;
+  if (weights.size() != kWeights)
+    return makeError("--engine gl: the deep k-buffer's network must be 12-128-64-1 on GL");
+  State& s = *state_;
+  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  std::map<std::string, uint64_t> ledger;
+  FrameBuffers fb;
+  fb.ledger = &ledger;
+  auto timed = [&](const char* name, auto&& body) {
+    const auto t0 = std::chrono::steady_clock::now();
+    body();
+    glFinish();
+    if (passes)
+      passes->push_back(
+          {name, 0.0,
+           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+               .count()});
+  };
+  const GLuint acc = fb.make("features", pixels * kDkbAccWords * 4);
+  const GLuint locks = fb.make("locks", pixels * 4);
+  const GLuint net = fb.make("network", weights.size() * 4, weights.data());
+  const GLuint importance = fb.make("importance", pixels * 4);
+  std::vector<uint32_t> words(pixels * kDkbAccWords);
+  timed("features", [&] {
+    static_assert(kDkbAccWords == 7);
+    std::vector<uint32_t> init(pixels * kDkbAccWords, 0u);
+    for (uint64_t p = 0; p < pixels; ++p) init[p * kDkbAccWords + 1] = kFarDepthBits;
+    glNamedBufferSubData(acc, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
+    clearUint(locks, kLockFree);
+    glUseProgram(s.progDkbFeatures);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindDkbAcc, acc);
+    fb.bindImage(locks, kBindLocks);
+    s.drawScene();
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
+    glGetNamedBufferSubData(acc, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
+  });
+  std::vector<float> out(pixels, 0.0f);
+  timed("inference", [&] {
+    // the image's statistics (mfr::ImageFeatureStats) on the host: four numbers
+    uint64_t fragments = 0, covered = 0;
+    float nearest = 1.0f, farthest = 0.0f;
+    for (uint64_t p = 0; p < pixels; ++p) {
+      const uint32_t* a = &words[p * kDkbAccWords];
+      if (a[0] == 0) continue;
+      fragments += a[0];
+      ++covered;
+      nearest = std::min(nearest, std::bit_cast<float>(a[1]));
+      farthest = std::max(farthest, std::bit_cast<float>(a[3]));
+    }
+    if (fragments == 0) return;
+    const GLuint p = s.progDkbInfer;
+    glUseProgram(p);
+    glProgramUniform1ui(p, loc(p, "uPixels"), static_cast<GLuint>(pixels));
+    glProgramUniform1d(p, loc(p, "uMeanN"), static_cast<double>(fragments) / covered);
+    glProgramUniform1f(p, loc(p, "uNearest"), nearest);
+    glProgramUniform1f(p, loc(p, "uFarthest"), farthest);
+    glProgramUniform1f(p, loc(p, "uSlotShare"),
+                       static_cast<float>(std::min(1.0, static_cast<double>(slots) / fragments)));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindDkbAcc, acc);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindDkbWeights, net);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindDkbImportance, importance);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
+    dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(importance, 0, static_cast<GLsizeiptr>(pixels * 4), out.data());
+  });
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+    return makeError("--engine gl: the deep k-buffer's importance failed (GL error " +
+                     std::to_string(e) + ")");
   return out;
 }
 

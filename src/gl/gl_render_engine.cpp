@@ -5,30 +5,80 @@
 #include "mfr/gl/gl_render_engine.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <utility>
 
+#include "mfr/cpu/optimal_oracle.hpp"
+#include "mfr/cpu/raster_frame.hpp"
 #include "mfr/gl/gl_context.hpp"
 #include "mfr/gl/gl_engine.hpp"
+#include "mfr/learn/model_file.hpp"
 #include "mfr/method/allocation.hpp"
+#include "mfr/method/dkb_model.hpp"
+#include "mfr/method/importance.hpp"
 #include "mfr/method/memory_model.hpp"
+#include "mfr/method/optimal_allocation.hpp"
 
 namespace mfr::gl {
 namespace {
 
 class GlView final : public PreparedView {
  public:
-  explicit GlView(GlEngine engine) : engine_(std::move(engine)) {}
+  GlView(GlEngine engine, const View& view) : engine_(std::move(engine)), view_(view) {}
   int width() const override { return engine_.width(); }
   int height() const override { return engine_.height(); }
   GlEngine& engine() const { return engine_; }
+  const View& view() const { return view_; }  // for the CPU oracle of the optimal k-buffer
   /// True the first time: the first render of a view warms up (shader compilation, llvmpipe's
   /// first-frame timer values), later ones are timed as they run.
   bool firstRender() const { return std::exchange(first_, false); }
 
  private:
   mutable GlEngine engine_;  // rendering changes GL state, not the view
+  View view_;
   mutable bool first_ = true;
 };
+
+double msSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The optimal k-buffer's k(p) from the CPU engine's oracle on the same view (render.cpp
+// optimalK): the A-buffer pre-pass, the error curves of the method's rule, the allocation; no k
+// when the budget cannot give every covered pixel a slot (allocate() reports that).
+struct OracleChoice {
+  std::vector<uint32_t> n, k;
+  std::optional<OracleReport> report;
+};
+
+Result<OracleChoice> cpuOracle(const View& view, const MethodDesc& method,
+                               const RenderOptions& options, uint64_t slots) {
+  RasterOptions ro;
+  ro.width = view.width;
+  ro.height = view.height;
+  auto frame = RasterFrame::build(*view.scene, view.camera, ro);
+  if (!frame) return frame.error();
+  auto oracle =
+      frameErrorCurves(*frame, options.background, method.compositing, options.memoryLimitBytes);
+  if (!oracle) return makeError(method.name + ": the oracle's pre-pass: " + oracle.error().message);
+  OracleChoice out;
+  if (slots >= oracle->coveredPixels) {
+    OracleOptions oo;
+    oo.publishedGreedy = method.publishedGreedy;
+    OracleAllocation a = allocateOptimal(oracle->curves, slots, oo);
+    OracleReport& r = out.report.emplace();
+    r.error = a.error;
+    r.lowerBound = a.lowerBound;
+    r.lagrangianBound = a.lagrangianBound;
+    r.exact = a.exact;
+    r.solver = a.solver;
+    r.nonconvexPixels = a.nonconvexPixels;
+    r.corePixels = a.corePixels;
+    out.k = std::move(a.k);
+  }
+  out.n = std::move(oracle->n);
+  return out;
+}
 
 class GlRenderEngine final : public Engine {
  public:
@@ -56,7 +106,7 @@ class GlRenderEngine final : public Engine {
     if (!view.scene) return makeError("engine gl: a view without a scene");
     auto engine = GlEngine::create(context_, *view.scene, view.camera, view.width, view.height);
     if (!engine) return engine.error();
-    return std::unique_ptr<PreparedView>(std::make_unique<GlView>(std::move(engine.value())));
+    return std::unique_ptr<PreparedView>(std::make_unique<GlView>(std::move(engine.value()), view));
   }
 
   Result<RenderOutput> render(const PreparedView& view, const MethodDesc& methodIn,
@@ -67,30 +117,115 @@ class GlRenderEngine final : public Engine {
     const uint64_t pixels = layout.pixels();
     MethodDesc method = methodIn;
     const bool fixedK = method.allocation == AllocationPolicy::FixedK;
-    const MemoryModel memory = MemoryModel::of(method, /*fragmentParallel=*/fixedK);
+    const bool accumulates = method.allocation == AllocationPolicy::NoNodes;
+    // variable k (counted, dynamic, importance, optimal): n(p) [and I(p) or the oracle's k(p)]
+    // measured first, k(p) and offsets from the shared allocate() on the host, then the GL
+    // capture and resolve with that allocation
+    const bool variable = method.allocation == AllocationPolicy::CountedK ||
+                          method.allocation == AllocationPolicy::DynamicK ||
+                          method.allocation == AllocationPolicy::Importance ||
+                          method.allocation == AllocationPolicy::Optimal;
+    const bool deep = method.allocation == AllocationPolicy::Importance &&
+                      method.importanceSource == ImportanceSource::Network;
+    // the GL k-buffers take the per-pixel spin-lock: the CPU engine's fragment-parallel memory
+    // (wboit's accumulators too)
+    const MemoryModel memory =
+        MemoryModel::of(method, /*fragmentParallel=*/fixedK || variable || accumulates);
     if (fixedK) {  // k from the budget (or explicit), checked as on the CPU engine
       auto a = allocate(layout, method, memory, options.budgetBytes, {}, {}, {});
       if (!a) return a.error();
       method.k = a->globalK;
     }
+    std::vector<PassTime> hostPasses;
+    RenderOutput out;
+    std::optional<Allocation> perPixel;
+    std::vector<uint32_t> n;  // variable k: n(p) measured first, reused by the frame
+    if (variable) {
+      std::vector<uint32_t> oracleK;
+      auto t0 = std::chrono::steady_clock::now();
+      if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes) {
+        auto chosen = cpuOracle(gv->view(), method, options,
+                                memory.fragmentSlots(*options.budgetBytes, pixels));
+        if (!chosen) return chosen.error();
+        n = std::move(chosen->n);
+        oracleK = std::move(chosen->k);
+        out.stats.oracle = std::move(chosen->report);
+        hostPasses.push_back({"oracle (cpu)", msSince(t0)});
+      } else {
+        auto counted = gv->engine().count();
+        if (!counted) return counted.error();
+        n = std::move(counted.value());
+        hostPasses.push_back({"count (n(p) read back)", msSince(t0)});
+      }
+      if (deep) {  // the deep k-buffer: features and network on GL (dkb_infer.comp)
+        if (!options.budgetBytes) return makeError(method.name + ": needs a budget");
+        std::shared_ptr<const learn::Model> model = method.model;
+        if (!model) {
+          auto builtin = builtinDkbModel();
+          if (!builtin) return builtin.error();
+          model = builtin.value();
+        } else if (auto fits = checkDkbModel(*model, "of " + method.name); !fits) {
+          return fits.error();
+        }
+        std::vector<float> weights;
+        for (size_t l = 0; l < model->net.weights.size(); ++l) {
+          const auto& w = model->net.weights[l];
+          const auto& b = model->net.biases[l];
+          weights.insert(weights.end(), w.data(), w.data() + w.size());  // column-major
+          weights.insert(weights.end(), b.data(), b.data() + b.size());
+        }
+        if (model->net.sizes != learn::kDkbLayers)
+          return makeError("--engine gl: " + method.name +
+                           ": the GL engine runs 12-128-64-1 networks only");
+        std::vector<GlPassTime> dkbPasses;
+        auto importance = gv->engine().dkbImportance(
+            weights, memory.fragmentSlots(*options.budgetBytes, pixels), &dkbPasses);
+        if (!importance) return importance.error();
+        out.importance.importance = std::move(importance.value());
+        for (const GlPassTime& t : dkbPasses) hostPasses.push_back({t.name, t.wallMs});
+      } else if (method.allocation == AllocationPolicy::Importance) {
+        t0 = std::chrono::steady_clock::now();
+        auto cosine = gv->engine().nearestCosine();
+        if (!cosine) return cosine.error();
+        out.nearestCosine = std::move(cosine.value());
+        hostPasses.push_back({"nearest_normal", msSince(t0)});
+        t0 = std::chrono::steady_clock::now();
+        const std::vector<float>& previous =
+            options.previousNearestCosine && options.previousNearestCosine->size() == pixels
+                ? *options.previousNearestCosine
+                : out.nearestCosine;
+        out.importance =
+            computeImportance(layout.width, layout.height, n, previous, method.importance);
+        hostPasses.push_back({"importance (host)", msSince(t0)});
+      }
+      t0 = std::chrono::steady_clock::now();
+      auto a = allocate(layout, method, memory, options.budgetBytes, n, out.importance.importance,
+                        oracleK);
+      if (!a) return a.error();
+      perPixel = std::move(a.value());
+      hostPasses.push_back({"allocate (host)", msSince(t0)});
+    }
     GlRenderOptions go;
     go.background = options.background;
     go.readNodes = options.keepStores;
     go.warmUp = gv->firstRender();
+    go.allocation = perPixel ? &*perPixel : nullptr;
+    // (GL's own n(p) only: the optimal k-buffer's comes from the CPU oracle)
+    go.counts = n.empty() || method.allocation == AllocationPolicy::Optimal ? nullptr : &n;
     auto gl = gv->engine().render(method, go);
     if (!gl) return gl.error();
     GlRenderOutput& g = gl.value();
     // the A-buffer's slots are its fragments: the budget check needs the count pass's n(p)
-    auto a = allocate(layout, method, memory, options.budgetBytes, g.counts, {}, {});
+    auto a = perPixel ? Result<Allocation>(std::move(*perPixel))
+                      : allocate(layout, method, memory, options.budgetBytes, g.counts, {}, {});
     if (!a) return a.error();
 
-    RenderOutput out;
     out.image = std::move(g.image);
     RenderStats& s = out.stats;
     s.method = method.name;
     s.budgetBytes = options.budgetBytes;
-    s.fragmentSlots = a->slots;
-    s.bytesByCategory = memory.breakdown(pixels, a->slots);
+    s.fragmentSlots = a->reservedSlots;
+    s.bytesByCategory = memory.breakdown(pixels, a->reservedSlots);
     for (const auto& [category, bytes] : s.bytesByCategory) s.bytesUsed += bytes;
     s.bytesAllocatedByCategory = g.bufferBytes;
     s.bytesAllocated = g.totalBufferBytes();
@@ -99,13 +234,16 @@ class GlRenderEngine final : public Engine {
     s.culledKPlus = g.culledKPlus;
     s.globalK = a->globalK;
     uint32_t kMin = UINT32_MAX, kMax = 0, maxN = 0;
+    // the k reported: as allocated (importance may reserve more slots than n(p))
+    const std::vector<uint32_t>& reported = a->reservedK.empty() ? a->capacity : a->reservedK;
     for (size_t p = 0; p < pixels; ++p) {
       const uint32_t n = g.counts[p];
-      s.captured += std::min(n, a->capacity[p]);  // every store keeps the min(n, k) nearest
+      // every store keeps the min(n, k) nearest; wboit's accumulators take every fragment
+      s.captured += accumulates ? n : std::min(n, a->capacity[p]);
       if (n == 0) continue;
       ++s.coveredPixels;
-      kMin = std::min(kMin, a->capacity[p]);
-      kMax = std::max(kMax, a->capacity[p]);
+      kMin = std::min(kMin, reported[p]);
+      kMax = std::max(kMax, reported[p]);
       maxN = std::max(maxN, n);
     }
     s.kMin = s.coveredPixels ? kMin : 0;
@@ -115,11 +253,12 @@ class GlRenderEngine final : public Engine {
     s.meanDepthComplexity =
         s.coveredPixels ? static_cast<double>(g.fragments) / s.coveredPixels : 0.0;
     s.engine = "gl";
+    s.passes = std::move(hostPasses);  // the host side of a variable-k allocation first
     for (const GlPassTime& t : g.passes) {
       s.passes.push_back({t.name, t.wallMs});  // llvmpipe's GL_TIME_ELAPSED is not usable
       s.engineCounters["gpu_ms_" + t.name] = t.gpuMs;
     }
-    out.kMap = std::move(a->capacity);
+    out.kMap = a->reservedK.empty() ? std::move(a->capacity) : std::move(a->reservedK);
     out.depthComplexity = std::move(g.counts);
     if (options.keepStores) {
       out.nodes = std::move(g.nodes);
@@ -135,9 +274,10 @@ class GlRenderEngine final : public Engine {
     return std::move(out->depthComplexity);
   }
 
-  Result<std::vector<float>> nearestCosine(const PreparedView&) override {
-    return makeError(
-        "--engine gl: the previous frame's |n.v| (variable k-buffer) is not in the GL engine yet");
+  Result<std::vector<float>> nearestCosine(const PreparedView& view) override {
+    const auto* gv = dynamic_cast<const GlView*>(&view);
+    if (!gv) return makeError("engine gl: the view was prepared by another engine");
+    return gv->engine().nearestCosine();
   }
 
  private:

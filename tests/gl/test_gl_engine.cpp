@@ -15,11 +15,11 @@
 #include <vector>
 
 #include "gl/shader_sources.hpp"
+#include "mfr/cpu/raster_frame.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/gl/gl_context.hpp"
 #include "mfr/gl/gl_engine.hpp"
 #include "mfr/method/method.hpp"
-#include "mfr/cpu/render.hpp"
-#include "mfr/cpu/raster_frame.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr::gl {
@@ -426,9 +426,13 @@ TEST(GlEngine, UnsupportedMethodIsAnError) {
   ASSERT_TRUE(scene.ok());
   auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 32, 32);
   ASSERT_TRUE(engine.ok()) << engine.error().message;
-  auto out = engine->render(methodPreset("wboit").value());
+  auto out = engine->render(methodPreset("dkb").value());
   ASSERT_FALSE(out.ok());
-  EXPECT_NE(out.error().message.find("wboit"), std::string::npos) << out.error().message;
+  EXPECT_NE(out.error().message.find("dkb"), std::string::npos) << out.error().message;
+  // a variable-k method without its per-pixel allocation
+  out = engine->render(methodPreset("kplus-sb").value());
+  ASSERT_FALSE(out.ok());
+  EXPECT_NE(out.error().message.find("kplus-sb"), std::string::npos) << out.error().message;
 }
 
 // Pass times at 128x128 and 512x512 (printed; not a pass/fail criterion; about a minute on

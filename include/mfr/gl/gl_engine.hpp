@@ -20,8 +20,9 @@
 #include "mfr/core/image.hpp"
 #include "mfr/core/result.hpp"
 #include "mfr/gl/gl_context.hpp"
-#include "mfr/method/method.hpp"
+#include "mfr/method/allocation.hpp"
 #include "mfr/method/fragment_node.hpp"
+#include "mfr/method/method.hpp"
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/scene.hpp"
 
@@ -37,6 +38,11 @@ struct GlRenderOptions {
   glm::vec3 background{1.0f};  // linear RGB
   bool warmUp = true;          // run the passes once untimed first (shader compilation, caches)
   bool readNodes = false;      // read the captured nodes back (tests, tools)
+  // variable k (counted, dynamic, importance, optimal): k(p), offsets and store kind per pixel
+  // from the shared allocate(); the k-buffer capture and resolve read them per pixel
+  const Allocation* allocation = nullptr;
+  // n(p) measured before (count()): uploaded instead of running the count pass again
+  const std::vector<uint32_t>* counts = nullptr;
 };
 
 struct GlRenderOutput {
@@ -56,8 +62,9 @@ struct GlRenderOutput {
 };
 
 /// One scene and view uploaded to GL once; render() runs a method on it any number of times.
-/// Supported methods (this slice): `abuffer` (unbounded, append) and fixed-k max-array or max-heap
-/// k-buffers with an explicit k (`fkb`, `kplus-array`, `kplus-heap`, `zbuffer`; the k+ test runs
+/// Supported methods: `abuffer` (unbounded, append), fixed-k max-array or max-heap
+/// k-buffers with an explicit k, and any k-buffer with a per-pixel allocation
+/// (GlRenderOptions::allocation) (`fkb`, `kplus-array`, `kplus-heap`, `zbuffer`; the k+ test runs
 /// for all of them: it changes no captured set), optionally with occupancy culling (`+occupancy`,
 /// d = occupancyWords), with kbuffer or hybrid compositing; anything else is an error naming the
 /// method. The
@@ -74,6 +81,18 @@ class GlEngine {
   ~GlEngine();
 
   Result<GlRenderOutput> render(const MethodDesc& method, const GlRenderOptions& options = {});
+
+  /// The count pass alone: n(p), rows top to bottom (what a variable-k allocation needs first).
+  Result<std::vector<uint32_t>> count();
+  /// The nearest fragment's |n.v| per pixel, quantised to unorm8 / 255 like mfr::nearestCosine
+  /// (0 where nothing is covered).
+  Result<std::vector<float>> nearestCosine();
+  /// The deep k-buffer's importance I(p): the feature pass (shaders/dkb_features.frag), the image
+  /// statistics from its accumulators on the host, features and network per pixel in a compute
+  /// shader (shaders/dkb_infer.comp). `layers` {12, 128, 64, 1}, `weights` Eigen's column-major
+  /// W0, b0, W1, b1, W2, b2 flattened; `slots` = F(M). `passes` gets the passes' wall times.
+  Result<std::vector<float>> dkbImportance(const std::vector<float>& weights, uint64_t slots,
+                                           std::vector<GlPassTime>* passes = nullptr);
 
   int width() const;
   int height() const;

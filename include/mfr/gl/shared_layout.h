@@ -53,6 +53,27 @@ MFR_GL_CONST(uint, kBindCaptureStats, 3u)  // k-buffer capture: culled counters
 MFR_GL_CONST(uint, kBindScanIn, 0u)        // prefix sum level: input, output, block sums
 MFR_GL_CONST(uint, kBindScanOut, 1u)
 MFR_GL_CONST(uint, kBindScanSums, 2u)
+// per-pixel allocation (variable k): usamplerBuffer (rg32ui) on this texture unit, per pixel
+// (first slot, k(p) | kAllocHeapBit when the pixel's store is the max-heap)
+MFR_GL_CONST(uint, kBindAllocation, 0u)
+MFR_GL_CONST(uint, kAllocHeapBit, 0x80000000u)
+// nearest |n.v| pass: per pixel the nearest node (depth bits, colour) and unorm8(|n.v|)
+MFR_GL_CONST(uint, kNearestWords, 3u)
+MFR_GL_CONST(uint, kBindNearest, 0u)
+// weighted blended OIT: per pixel sum C w (r, g, b), sum a w, revealage (mfr::WboitPixel)
+MFR_GL_CONST(uint, kWboitWords, 5u)
+MFR_GL_CONST(uint, kBindAccum, 2u)
+// moment-based OIT: per pixel b0, b1..b4, then sum T a c (r, g, b), sum T a (mfr::MboitPixel)
+MFR_GL_CONST(uint, kMboitWords, 9u)
+// multi-layer alpha blending: per node depth, premultiplied r, g, b, transmittance (mfr::MlabNode)
+MFR_GL_CONST(uint, kMlabWords, 5u)
+// deep k-buffer: feature accumulators per pixel (n, nearest depth bits and colour, farthest depth
+// bits, premultiplied colour sum r, g, b), the network's weights, the importance
+MFR_GL_CONST(uint, kDkbAccWords, 7u)
+MFR_GL_CONST(uint, kBindDkbAcc, 0u)
+MFR_GL_CONST(uint, kBindDkbWeights, 1u)
+MFR_GL_CONST(uint, kBindDkbImportance, 2u)
+MFR_GL_CONST(uint, kBindImage2, 4u)  // mlab resolve output (kBindImage is mlab's fill counts)
 
 // material record (12 uint words; floats as their bits): base colour R, G, B, A; the texture's
 // first texel in the texel buffer (kNoTexture: none), its width, height; alpha mode

@@ -1,0 +1,44 @@
+// Moment-based OIT, pass 1 (Muenstermann et al. 2018; mfr::MboitPixel::addMoments): each fragment
+// adds its absorbance A = -ln(1 - min(a, 0.99999)) times 1, z, z^2, z^3, z^4 (z = 2 d - 1) to the
+// pixel's moments under the pixel's spin-lock. Sums in arrival order (see wboit.frag).
+layout(std430, binding = kBindAccum) coherent buffer Accum {
+  float accum[];  // kMboitWords per pixel: b0, b1..b4, sum T a c (r, g, b), sum T a
+};
+layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
+
+void main() {
+  FragmentData f;
+  if (!exactCoverage(f)) discard;
+  vec4 base;
+  if (!surface(f, false, base)) discard;
+  const float depth = fragmentDepth(f);
+  const uint rgba = shade(f, base);
+  precise float alpha = float(rgba >> 24) / 255.0;
+  if (alpha <= 0.0) return;
+  precise float A = -log(1.0 - min(alpha, 0.99999));
+  precise float z = 2.0 * clamp(depth, 0.0, 1.0) - 1.0;
+  precise float z2 = z * z;
+  precise float m1 = A * z;
+  precise float m2 = A * z2;
+  precise float m3 = A * z2 * z;
+  precise float m4 = A * z2 * z2;
+  const uint i = kMboitWords * uint(f.pixel);
+  bool done = false;
+  while (!done) {
+    if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
+      precise float s0 = accum[i] + A;
+      precise float s1 = accum[i + 1u] + m1;
+      precise float s2 = accum[i + 2u] + m2;
+      precise float s3 = accum[i + 3u] + m3;
+      precise float s4 = accum[i + 4u] + m4;
+      accum[i] = s0;
+      accum[i + 1u] = s1;
+      accum[i + 2u] = s2;
+      accum[i + 3u] = s3;
+      accum[i + 4u] = s4;
+      memoryBarrierBuffer();
+      imageAtomicExchange(uLocks, f.pixel, kLockFree);
+      done = true;
+    }
+  }
+}

@@ -1,0 +1,48 @@
+// Weighted blended OIT (McGuire and Bavoil 2013; mfr::WboitPixel::add): each fragment adds
+// C w, a w to the pixel's sums and multiplies its revealage by 1 - a, under the pixel's spin-lock
+// (float atomics are not core GL; the CPU engine's fragment-parallel capture locks the same way).
+// The sums follow the fragments' arrival order, so their last bits may differ from the CPU
+// engine's primitive order.
+layout(std430, binding = kBindAccum) coherent buffer Accum {
+  float accum[];  // kWboitWords per pixel: sum C w (r, g, b), sum a w, revealage
+};
+layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
+
+void main() {
+  FragmentData f;
+  if (!exactCoverage(f)) discard;
+  vec4 base;
+  if (!surface(f, false, base)) discard;
+  const float depth = fragmentDepth(f);
+  const uint rgba = shade(f, base);
+  precise float a = float(rgba >> 24) * uInv255;
+  if (a <= 0.0) return;
+  const vec3 c = vec3(srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
+                      srgb8ToLinear((rgba >> 16) & 0xffu));
+  precise float t = 1.0 - clamp(depth, 0.0, 1.0);
+  precise float w = a * max(1e-2, 3e3 * t * t * t);  // mfr::wboitWeight
+  precise float cr = c.r * a * w;
+  precise float cg = c.g * a * w;
+  precise float cb = c.b * a * w;
+  precise float aw = a * w;
+  precise float keep = 1.0 - a;
+  const uint i = kWboitWords * uint(f.pixel);
+  bool done = false;
+  while (!done) {
+    if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
+      precise float r = accum[i] + cr;
+      precise float g = accum[i + 1u] + cg;
+      precise float b = accum[i + 2u] + cb;
+      precise float sumA = accum[i + 3u] + aw;
+      precise float revealage = accum[i + 4u] * keep;
+      accum[i] = r;
+      accum[i + 1u] = g;
+      accum[i + 2u] = b;
+      accum[i + 3u] = sumA;
+      accum[i + 4u] = revealage;
+      memoryBarrierBuffer();
+      imageAtomicExchange(uLocks, f.pixel, kLockFree);
+      done = true;
+    }
+  }
+}
