@@ -188,8 +188,11 @@ Frame FrameRenderer::update(const ViewSettings& s) {
             }
         if (split > 0 && split < w)
           for (int y = 0; y < h; ++y)
-            for (int ch = 0; ch < 3; ++ch)
-              f.display.rgba[(static_cast<size_t>(y) * w + split) * 4 + ch] = 255;
+            for (int ch = 0; ch < 3; ++ch)  // an orange line between the two
+              f.display.rgba[(static_cast<size_t>(y) * w + split) * 4 + ch] =
+                  static_cast<uint8_t>(ch == 0   ? 255
+                                       : ch == 1 ? 140
+                                                 : 0);
         break;
       }
     }

@@ -52,7 +52,7 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
   if (truthMb > 0)
     ImGui::Text("  = %.1f%% of the exact A-buffer (%.2f MB)", 100.0f * mb / truthMb, truthMb);
   int k = static_cast<int>(s.k);
-  if (ImGui::InputInt("k (0: from budget)", &k)) s.k = static_cast<uint32_t>(std::max(0, k));
+  if (ImGui::InputInt("k (0: auto)", &k)) s.k = static_cast<uint32_t>(std::max(0, k));
 
   // view
   ImGui::Separator();
@@ -76,11 +76,12 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
     } else {
       ImGui::Text("memory %s (no budget)", formatBytes(st.bytesUsed).c_str());
     }
-    ImGui::Text("fragments %llu, captured %llu, lost %llu (%.2f%%)",
+    ImGui::Text("fragments %llu  captured %llu",
                 static_cast<unsigned long long>(st.fragmentsGenerated),
-                static_cast<unsigned long long>(st.captured),
-                static_cast<unsigned long long>(st.lost), st.lostPercent());
-    ImGui::Text("k min %u  max %u", st.kMin, st.kMax);
+                static_cast<unsigned long long>(st.captured));
+    ImGui::Text("lost %llu (%.2f%%)", static_cast<unsigned long long>(st.lost), st.lostPercent());
+    ImGui::SameLine();
+    ImGui::Text("  k min %u  max %u", st.kMin, st.kMax);
     for (const PassTime& p : st.passes) ImGui::Text("  %-12s %7.2f ms", p.name.c_str(), p.ms);
     ImGui::Text("passes %.2f ms, update %.1f ms, frame %.1f ms", st.totalMs(), f->renderMs,
                 info.frameMs);

@@ -165,7 +165,7 @@ int runViewer(const ViewerArgs& a) {
       const auto start = std::chrono::steady_clock::now();
       glfwPollEvents();
       FrameActions actions;
-      if (step < steps.size()) {
+      if (step < steps.size() && pendingShots.empty()) {  // a screenshot sees its own step
         if (auto ok = applyStep(steps[step++], settings, actions); !ok) {
           exitCode = cli::fail("--script: " + ok.error().message);
           break;
