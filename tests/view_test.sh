@@ -62,6 +62,14 @@ JSON
   echo "ok: $scene: screenshots == mfr render --engine gl (start camera and: $cmd)"
 done
 
+# --engine cpu in the viewer: the same bytes as mfr render --engine cpu
+"$MFR" render procedural:spheres --engine cpu --method kplus-heap --budget 256KB --width $S \
+  --height $S -q -o cpu_ref.png
+"$MFR" view procedural:spheres --engine cpu --method kplus-heap --budget 256KB --width $S \
+  --height $S --frames 2 --screenshot cpu.png
+cmp cpu.png cpu_ref.png || { echo "FAIL: --engine cpu: view screenshot != mfr render"; exit 1; }
+echo "ok: --engine cpu: screenshot == mfr render --engine cpu"
+
 # (b) every method and every view mode
 "$MFR" view --list-methods >methods.txt
 python3 - "$S" <<'PY'

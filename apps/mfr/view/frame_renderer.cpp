@@ -96,6 +96,10 @@ Frame FrameRenderer::update(const ViewSettings& s) {
       }
       c.view = std::move(view.value());
       c.cameraKey = cameraKey;
+    }
+    const bool truthView = s.mode == ViewMode::GroundTruth || s.mode == ViewMode::FlipError ||
+                           s.mode == ViewMode::Wiper;
+    if ((s.compare || truthView) && !c.truth && c.truthError.empty()) {  // ground truth, lazily
       auto truth = engine_.render(*c.view, methodPreset("abuffer").value(), ro);
       if (truth) {
         c.truth = std::move(truth.value());
@@ -117,13 +121,13 @@ Frame FrameRenderer::update(const ViewSettings& s) {
       if (out) {
         c.output = std::move(out.value());
         c.image = encodeSrgb(c.output->image);
-        if (c.truth) {
-          if (auto flip = computeFlip(c.truthImage, c.image)) c.flip = std::move(flip.value());
-          if (auto e = compareImages(c.truthImage, c.image)) c.psnr = e->psnrLinear;
-        }
       } else {
         c.error = out.error().message;
       }
+    }
+    if (c.output && c.truth && !c.flip) {  // the error against the ground truth
+      if (auto flip = computeFlip(c.truthImage, c.image)) c.flip = std::move(flip.value());
+      if (auto e = compareImages(c.truthImage, c.image)) c.psnr = e->psnrLinear;
     }
     if (s.mode == ViewMode::DepthComplexity && !c.counts) {
       if (c.output && !c.output->depthComplexity.empty())

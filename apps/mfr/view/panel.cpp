@@ -60,6 +60,7 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
   for (ViewMode mode : allViewModes())
     if (ImGui::RadioButton(viewModeLabel(mode), s.mode == mode)) s.mode = mode;
   if (s.mode == ViewMode::Wiper) ImGui::SliderFloat("split", &s.wiper, 0.0f, 1.0f, "%.2f");
+  ImGui::Checkbox("compare with the A-buffer (FLIP, PSNR)", &s.compare);
 
   // statistics
   ImGui::Separator();

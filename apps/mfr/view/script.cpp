@@ -86,6 +86,9 @@ Result<void> applyStep(const nlohmann::json& step, ViewSettings& s, FrameActions
       s.camera.pan(value[0].get<float>(), value[1].get<float>());
     } else if (key == "reset") {
       s.camera.reset();
+    } else if (key == "compare") {
+      if (!value.is_boolean()) return makeError("\"compare\": expected true or false");
+      s.compare = value.get<bool>();
     } else if (key == "screenshot") {
       MFR_VIEW_GET(path, text(value, key));
       actions.screenshots.push_back(path);

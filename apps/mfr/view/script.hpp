@@ -4,6 +4,7 @@
 //   {"method": "fkb"}  {"composite": "hybrid"}  {"budget_mb": 2.5}  {"budget": "3MB"}  {"k": 4}
 //   {"mode": "flip"}  (image depth kmap importance truth flip wiper)  {"wiper": 0.3}
 //   {"orbit": 30}  {"pitch": 10}  {"pan": [0.1, 0]}  {"zoom": 1.5}  {"fov": 50}  {"reset": true}
+//   {"compare": false}  (no A-buffer, FLIP or PSNR unless the view needs them)
 //   {"screenshot": "a.png"}  {"screenshot_ui": "b.png"}  {"copy_command": true}
 // Screenshots are taken after the frame's settings have been rendered.
 #pragma once

@@ -8,7 +8,8 @@ std::string ViewSettings::methodKey() const {
 }
 
 std::string ViewSettings::displayKey() const {
-  return methodKey() + "|" + viewModeName(mode) + "|" + std::to_string(wiper);
+  return methodKey() + "|" + viewModeName(mode) + "|" + std::to_string(wiper) +
+         (compare ? "|compare" : "");
 }
 
 }  // namespace mfr::view

@@ -16,7 +16,8 @@ struct ViewSettings {
   uint64_t budgetBytes = 0;        // 0: no budget
   uint32_t k = 0;                  // 0: derived from the budget
   ViewMode mode = ViewMode::Image;
-  float wiper = 0.5f;  // split position of the wiper view, share of the width
+  float wiper = 0.5f;   // split position of the wiper view, share of the width
+  bool compare = true;  // render the exact A-buffer for mean FLIP and PSNR (always for its views)
   OrbitCamera camera;
 
   explicit ViewSettings(const Camera& start) : camera(start) {}

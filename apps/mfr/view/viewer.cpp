@@ -189,9 +189,13 @@ int runViewer(const ViewerArgs& a) {
       const PanelRequests requests = drawPanel(static_cast<float>(w), static_cast<float>(fbW - w),
                                                static_cast<float>(fbH), settings, info);
       bool updated = false;
-      if (settings.displayKey() != shownKey) {  // re-render only what changed
-        frame = renderer.update(settings);
-        shownKey = settings.displayKey();
+      // while the camera is dragged, skip the A-buffer and FLIP (rendered again on release)
+      ViewSettings shown = settings;
+      if (ImGui::IsMouseDown(ImGuiMouseButton_Left) || ImGui::IsMouseDown(ImGuiMouseButton_Right))
+        shown.compare = shown.compare && io.WantCaptureMouse;
+      if (shown.displayKey() != shownKey) {  // re-render only what changed
+        frame = renderer.update(shown);
+        shownKey = shown.displayKey();
         texture.upload(frame.display);
         renders.push_back(statsEntry(n, settings, frame));
         updated = true;
