@@ -57,7 +57,9 @@ JSON
   eval "\"$MFR\" ${cmd#mfr } -q -o orbit_ref.png"
   cmp orbit.png orbit_ref.png ||
     { echo "FAIL: $scene: orbited screenshot != its copied command: $cmd"; exit 1; }
-  "$MFR" view "$scene" "${opts[@]}" --frames 3 --screenshot frames.png
+  "$MFR" view "$scene" "${opts[@]}" --frames 3 --screenshot frames.png --stats-json frames.json
+  python3 -c "import json,sys; r=json.load(open('frames.json'))['renders']; sys.exit(len(r) != 1)" ||
+    { echo "FAIL: $scene: re-rendered frames where nothing changed"; cat frames.json; exit 1; }
   cmp frames.png ref.png || { echo "FAIL: $scene: --frames/--screenshot != render"; exit 1; }
   echo "ok: $scene: screenshots == mfr render --engine gl (start camera and: $cmd)"
 done

@@ -175,6 +175,7 @@ int runViewer(const ViewerArgs& a) {
       ImGui_ImplGlfw_NewFrame();
       ImGui::NewFrame();
       const ImGuiIO& io = ImGui::GetIO();
+      if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) glfwSetWindowShouldClose(window, 1);
       if (!io.WantCaptureMouse && io.MousePos.x < w) {  // the camera, on the image
         if (ImGui::IsMouseDragging(ImGuiMouseButton_Left, 0.0f))
           settings.camera.orbit(-0.3f * io.MouseDelta.x, 0.3f * io.MouseDelta.y);
