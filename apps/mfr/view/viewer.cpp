@@ -163,7 +163,10 @@ int runViewer(const ViewerArgs& a) {
     int screenshotCount = 0;
     for (int n = 0; !glfwWindowShouldClose(window); ++n) {
       const auto start = std::chrono::steady_clock::now();
-      glfwPollEvents();
+      if (scripted)
+        glfwPollEvents();
+      else
+        glfwWaitEventsTimeout(0.1);  // idle: no busy loop when nothing happens
       FrameActions actions;
       if (step < steps.size() && pendingShots.empty()) {  // a screenshot sees its own step
         if (auto ok = applyStep(steps[step++], settings, actions); !ok) {
