@@ -22,6 +22,9 @@ int main(int argc, char** argv) {
   const mfr::cli::Runner compare = mfr::cli::addCompareCommand(app);
   const mfr::cli::Runner dataset = mfr::cli::addDatasetCommand(app);
   const mfr::cli::Runner train = mfr::cli::addTrainCommand(app);
+#ifdef MFR_HAS_VIEW
+  const mfr::cli::Runner view = mfr::cli::addViewCommand(app);
+#endif
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -34,6 +37,9 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("compare")) return compare();
     if (app.got_subcommand("dataset")) return dataset();
     if (app.got_subcommand("train")) return train();
+#ifdef MFR_HAS_VIEW
+    if (app.got_subcommand("view")) return view();
+#endif
   } catch (const std::bad_alloc&) {
     // the memory pre-flights let it through: named, never "std::bad_alloc"
     const auto commands = app.get_subcommands();

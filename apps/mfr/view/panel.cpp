@@ -1,0 +1,107 @@
+#include "panel.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <imgui.h>
+
+#include "mfr/core/units.hpp"
+#include "mfr/method/method.hpp"
+
+namespace mfr::view {
+
+const std::vector<std::string>& viewerMethods() {
+  static const std::vector<std::string> methods = [] {
+    std::vector<std::string> m;
+    for (const std::string& name : presetNames()) {
+      m.push_back(name);
+      if (methodPreset(name + "+occupancy")) m.push_back(name + "+occupancy");
+    }
+    return m;
+  }();
+  return methods;
+}
+
+PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
+                        const PanelInfo& info) {
+  PanelRequests requests;
+  ImGui::SetNextWindowPos(ImVec2(x, 0.0f));
+  ImGui::SetNextWindowSize(ImVec2(width, height));
+  ImGui::Begin("mfr view", nullptr,
+               ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  ImGui::Text("%s  %dx%d  engine %s", info.scene.c_str(), info.width, info.height,
+              info.engine.c_str());
+
+  // method
+  if (ImGui::BeginCombo("method", s.method.c_str())) {
+    for (const std::string& name : viewerMethods())
+      if (ImGui::Selectable(name.c_str(), name == s.method)) s.method = name;
+    ImGui::EndCombo();
+  }
+  const char* rules[] = {"preset's own", "kbuffer", "hybrid"};
+  int rule = s.composite == "kbuffer" ? 1 : s.composite == "hybrid" ? 2 : 0;
+  if (ImGui::Combo("compositing", &rule, rules, 3)) s.composite = rule == 0 ? "" : rules[rule];
+  const Frame* f = info.frame;
+  float mb = static_cast<float>(static_cast<double>(s.budgetBytes) / 1048576.0);
+  const float truthMb =
+      f && f->truthBytes ? static_cast<float>(static_cast<double>(f->truthBytes) / 1048576.0) : 0;
+  const float maxMb = std::max(16.0f, 2.0f * truthMb);
+  if (ImGui::SliderFloat("budget (MB)", &mb, 0.0f, maxMb, "%.2f", ImGuiSliderFlags_Logarithmic))
+    s.budgetBytes = static_cast<uint64_t>(std::llround(std::max(0.0f, mb) * 1048576.0));
+  if (truthMb > 0)
+    ImGui::Text("  = %.1f%% of the exact A-buffer (%.2f MB)", 100.0f * mb / truthMb, truthMb);
+  int k = static_cast<int>(s.k);
+  if (ImGui::InputInt("k (0: auto)", &k)) s.k = static_cast<uint32_t>(std::max(0, k));
+
+  // view
+  ImGui::Separator();
+  ImGui::Text("view");
+  for (ViewMode mode : allViewModes())
+    if (ImGui::RadioButton(viewModeLabel(mode), s.mode == mode)) s.mode = mode;
+  if (s.mode == ViewMode::Wiper) ImGui::SliderFloat("split", &s.wiper, 0.0f, 1.0f, "%.2f");
+  ImGui::Checkbox("compare with the A-buffer (FLIP, PSNR)", &s.compare);
+
+  // statistics
+  ImGui::Separator();
+  if (f && !f->error.empty())
+    ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", f->error.c_str());
+  if (f && f->stats) {
+    const RenderStats& st = *f->stats;
+    if (st.budgetBytes && *st.budgetBytes > 0) {
+      char label[96];
+      std::snprintf(label, sizeof label, "%s / %s", formatBytes(st.bytesUsed).c_str(),
+                    formatBytes(*st.budgetBytes).c_str());
+      ImGui::ProgressBar(static_cast<float>(static_cast<double>(st.bytesUsed) / *st.budgetBytes),
+                         ImVec2(-1.0f, 0.0f), label);
+    } else {
+      ImGui::Text("memory %s (no budget)", formatBytes(st.bytesUsed).c_str());
+    }
+    ImGui::Text("fragments %llu  captured %llu",
+                static_cast<unsigned long long>(st.fragmentsGenerated),
+                static_cast<unsigned long long>(st.captured));
+    ImGui::Text("lost %llu (%.2f%%)", static_cast<unsigned long long>(st.lost), st.lostPercent());
+    ImGui::SameLine();
+    ImGui::Text("  k min %u  max %u", st.kMin, st.kMax);
+    for (const PassTime& p : st.passes) ImGui::Text("  %-12s %7.2f ms", p.name.c_str(), p.ms);
+    ImGui::Text("passes %.2f ms, update %.1f ms, frame %.1f ms", st.totalMs(), f->renderMs,
+                info.frameMs);
+    if (f->flipMean) ImGui::Text("mean FLIP vs A-buffer %.5f", *f->flipMean);
+    if (f->psnr) ImGui::Text("PSNR vs A-buffer %.2f dB", *f->psnr);
+  }
+
+  // camera and actions
+  ImGui::Separator();
+  ImGui::TextWrapped("left drag: orbit, right drag: pan, wheel: zoom");
+  float fov = s.camera.camera().fovYDegrees;
+  if (ImGui::SliderFloat("fov", &fov, 5.0f, 120.0f, "%.1f")) s.camera.setFov(fov);
+  if (ImGui::Button("reset camera")) s.camera.reset();
+  ImGui::SameLine();
+  if (ImGui::Button("screenshot")) requests.screenshot = true;
+  ImGui::SameLine();
+  if (ImGui::Button("copy command")) requests.copyCommand = true;
+  ImGui::End();
+  return requests;
+}
+
+}  // namespace mfr::view

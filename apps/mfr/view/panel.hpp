@@ -1,0 +1,33 @@
+// The ImGui panel on the right of the image: method, compositing, budget, k, view mode, camera,
+// live statistics and the screenshot / copy-command buttons. It edits the settings in place.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "frame_renderer.hpp"
+#include "view_settings.hpp"
+
+namespace mfr::view {
+
+struct PanelInfo {
+  std::string scene;
+  std::string engine;
+  int width = 0, height = 0;
+  const Frame* frame = nullptr;
+  double frameMs = 0.0;  // last frame, wall time
+};
+
+struct PanelRequests {
+  bool screenshot = false;
+  bool copyCommand = false;
+};
+
+/// Every preset the viewer offers: presetNames() and their +occupancy forms.
+const std::vector<std::string>& viewerMethods();
+
+/// Draws the panel at x, full height, `width` wide.
+PanelRequests drawPanel(float x, float width, float height, ViewSettings& settings,
+                        const PanelInfo& info);
+
+}  // namespace mfr::view

@@ -1,0 +1,127 @@
+#include "script.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include "mfr/core/units.hpp"
+#include "mfr/method/method.hpp"
+
+namespace mfr::view {
+
+namespace {
+
+// `const auto var = expr.value()`, or return expr's error
+#define MFR_VIEW_GET(var, expr)                   \
+  auto var##_result = (expr);                     \
+  if (!var##_result) return var##_result.error(); \
+  const auto var = var##_result.value()
+
+Result<double> number(const nlohmann::json& v, const std::string& key) {
+  if (!v.is_number() || !std::isfinite(v.get<double>()))
+    return makeError("\"" + key + "\": expected a number");
+  return v.get<double>();
+}
+
+Result<std::string> text(const nlohmann::json& v, const std::string& key) {
+  if (!v.is_string()) return makeError("\"" + key + "\": expected a string");
+  return v.get<std::string>();
+}
+
+}  // namespace
+
+Result<void> applyStep(const nlohmann::json& step, ViewSettings& s, FrameActions& actions) {
+  if (!step.is_object()) return makeError("expected an object of actions");
+  for (const auto& [key, value] : step.items()) {
+    if (key == "method") {
+      MFR_VIEW_GET(name, text(value, key));
+      if (auto preset = methodPreset(name); !preset) return preset.error();
+      s.method = name;
+    } else if (key == "composite") {
+      MFR_VIEW_GET(rule, text(value, key));
+      if (!rule.empty())
+        if (auto parsed = parseCompositing(rule); !parsed)
+          return makeError("\"composite\": " + parsed.error().message);
+      s.composite = rule;
+    } else if (key == "budget_mb") {
+      MFR_VIEW_GET(mb, number(value, key));
+      if (!(mb >= 0.0 && mb <= 1024.0 * 1024.0)) return makeError("\"budget_mb\": out of range");
+      s.budgetBytes = static_cast<uint64_t>(std::llround(mb * 1048576.0));
+    } else if (key == "budget") {
+      MFR_VIEW_GET(size, text(value, key));
+      auto bytes = parseByteSize(size);
+      if (!bytes) return makeError("\"budget\": " + bytes.error().message);
+      s.budgetBytes = bytes.value();
+    } else if (key == "k") {
+      MFR_VIEW_GET(k, number(value, key));
+      if (!(k >= 0.0 && k <= 1048576.0)) return makeError("\"k\": must be in [0, 1048576]");
+      s.k = static_cast<uint32_t>(k);
+    } else if (key == "mode") {
+      MFR_VIEW_GET(name, text(value, key));
+      auto mode = parseViewMode(name);
+      if (!mode)
+        return makeError("\"mode\": '" + name +
+                         "': expected image, depth, kmap, importance, truth, flip or wiper");
+      s.mode = *mode;
+    } else if (key == "wiper") {
+      MFR_VIEW_GET(x, number(value, key));
+      s.wiper = static_cast<float>(std::clamp(x, 0.0, 1.0));
+    } else if (key == "orbit") {
+      MFR_VIEW_GET(a, number(value, key));
+      s.camera.orbit(static_cast<float>(a), 0.0f);
+    } else if (key == "pitch") {
+      MFR_VIEW_GET(a, number(value, key));
+      s.camera.orbit(0.0f, static_cast<float>(a));
+    } else if (key == "zoom") {
+      MFR_VIEW_GET(z, number(value, key));
+      if (!(z > 0.0)) return makeError("\"zoom\": must be > 0");
+      s.camera.zoom(static_cast<float>(z));
+    } else if (key == "fov") {
+      MFR_VIEW_GET(fov, number(value, key));
+      s.camera.setFov(static_cast<float>(fov));
+    } else if (key == "pan") {
+      if (!value.is_array() || value.size() != 2 || !value[0].is_number() || !value[1].is_number())
+        return makeError("\"pan\": expected [dx, dy]");
+      s.camera.pan(value[0].get<float>(), value[1].get<float>());
+    } else if (key == "reset") {
+      s.camera.reset();
+    } else if (key == "compare") {
+      if (!value.is_boolean()) return makeError("\"compare\": expected true or false");
+      s.compare = value.get<bool>();
+    } else if (key == "screenshot") {
+      MFR_VIEW_GET(path, text(value, key));
+      actions.screenshots.push_back(path);
+    } else if (key == "screenshot_ui") {
+      MFR_VIEW_GET(path, text(value, key));
+      actions.screenshotsUi.push_back(path);
+    } else if (key == "copy_command") {
+      actions.copyCommand = true;
+    } else {
+      return makeError("unknown action \"" + key + "\"");
+    }
+  }
+  return {};
+}
+
+Result<std::vector<nlohmann::json>> loadScript(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) return makeError("--script " + path + ": cannot read the file");
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  nlohmann::json doc = nlohmann::json::parse(buffer.str(), nullptr, false);
+  if (doc.is_discarded() || !doc.is_array())
+    return makeError("--script " + path + ": expected a JSON array of action objects");
+  std::vector<nlohmann::json> steps(doc.begin(), doc.end());
+  // check every step on a scratch copy, so a typo fails before the window opens
+  ViewSettings scratch{Camera{}};
+  for (size_t i = 0; i < steps.size(); ++i) {
+    FrameActions ignored;
+    if (auto ok = applyStep(steps[i], scratch, ignored); !ok)
+      return makeError("--script " + path + ": step " + std::to_string(i) + ": " +
+                       ok.error().message);
+  }
+  return steps;
+}
+
+}  // namespace mfr::view

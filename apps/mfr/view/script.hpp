@@ -1,0 +1,34 @@
+// --script FILE.json: a session as a list of UI actions, applied one per frame, for tests and for
+// reproducing what a person did. The file is a JSON array of objects; each object is one frame's
+// actions, applied in this order:
+//   {"method": "fkb"}  {"composite": "hybrid"}  {"budget_mb": 2.5}  {"budget": "3MB"}  {"k": 4}
+//   {"mode": "flip"}  (image depth kmap importance truth flip wiper)  {"wiper": 0.3}
+//   {"orbit": 30}  {"pitch": 10}  {"pan": [0.1, 0]}  {"zoom": 1.5}  {"fov": 50}  {"reset": true}
+//   {"compare": false}  (no A-buffer, FLIP or PSNR unless the view needs them)
+//   {"screenshot": "a.png"}  {"screenshot_ui": "b.png"}  {"copy_command": true}
+// Screenshots are taken after the frame's settings have been rendered.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mfr/core/result.hpp"
+#include "view_settings.hpp"
+
+namespace mfr::view {
+
+struct FrameActions {
+  std::vector<std::string> screenshots;    // image area
+  std::vector<std::string> screenshotsUi;  // whole window with the panel
+  bool copyCommand = false;
+};
+
+/// Reads and checks a script (unknown keys and wrong types are one-line errors naming the step).
+Result<std::vector<nlohmann::json>> loadScript(const std::string& path);
+
+/// Applies one step to the settings; what is not a setting goes into `actions`.
+Result<void> applyStep(const nlohmann::json& step, ViewSettings& settings, FrameActions& actions);
+
+}  // namespace mfr::view

@@ -1,0 +1,276 @@
+#include "viewer.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <fstream>
+
+#include <GLFW/glfw3.h>
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+#include <nlohmann/json.hpp>
+
+#include "engine_context.hpp"
+#include "frame_renderer.hpp"
+#include "image_texture.hpp"
+#include "mfr/core/atomic_file.hpp"
+#include "mfr/core/units.hpp"
+#include "panel.hpp"
+#include "script.hpp"
+
+namespace mfr::view {
+
+namespace {
+
+constexpr int kPanelWidth = 380;
+std::string glfwLastError;
+
+void onGlfwError(int, const char* description) {
+  glfwLastError = description ? description : "?";
+}
+
+int failNoWindow(const std::string& what) {
+  return cli::fail("view: " + what + " (" + glfwLastError +
+                   "); `mfr render` writes the same images without a window");
+}
+
+std::string shellQuote(const std::string& text) {
+  if (text.find_first_of(" ?&*;'\"$|<>()") == std::string::npos) return text;
+  std::string quoted = "'";
+  for (char c : text) quoted += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return quoted + "'";
+}
+
+std::string renderCommand(const ViewerArgs& a, const ViewSettings& s) {
+  std::string cmd = "mfr render " + shellQuote(a.scene.source) + " --engine " + a.scene.engine +
+                    " --method " + s.method;
+  if (!s.composite.empty()) cmd += " --composite " + s.composite;
+  if (s.budgetBytes > 0) cmd += " --budget " + std::to_string(s.budgetBytes);
+  if (s.k > 0) cmd += " --k " + std::to_string(s.k);
+  if (a.scene.alpha) cmd += " --alpha " + std::to_string(*a.scene.alpha);
+  if (a.scene.seed != 1) cmd += " --seed " + std::to_string(a.scene.seed);
+  cmd += " --width " + std::to_string(a.scene.width) + " --height " +
+         std::to_string(a.scene.height) + " --camera " + s.camera.spec() + " -o view.png";
+  return cmd;
+}
+
+nlohmann::json statsEntry(int frame, const ViewSettings& s, const Frame& f) {
+  nlohmann::json j;
+  j["frame"] = frame;
+  j["method"] = s.method;
+  j["mode"] = viewModeName(s.mode);
+  j["budget_bytes"] = s.budgetBytes;
+  j["error"] = f.error;
+  j["update_ms"] = f.renderMs;
+  j["display_width"] = f.display.width;
+  j["display_height"] = f.display.height;
+  if (f.stats) {
+    j["bytes_used"] = f.stats->bytesUsed;
+    j["fragments"] = f.stats->fragmentsGenerated;
+    j["captured"] = f.stats->captured;
+    j["lost"] = f.stats->lost;
+    j["k_min"] = f.stats->kMin;
+    j["k_max"] = f.stats->kMax;
+    j["passes_ms"] = f.stats->totalMs();
+  }
+  if (f.flipMean) j["flip_mean"] = *f.flipMean;
+  if (f.psnr && std::isfinite(*f.psnr)) j["psnr"] = *f.psnr;
+  return j;
+}
+
+}  // namespace
+
+int runViewer(const ViewerArgs& a) {
+  if (a.listMethods) {
+    for (const std::string& m : viewerMethods()) std::printf("%s\n", m.c_str());
+    return 0;
+  }
+  // the options first, with render's errors
+  auto prepared = cli::prepareScene(a.scene);
+  if (!prepared) return cli::fail(prepared.error().message);
+  ViewSettings settings(prepared->cameras.front());
+  settings.method = a.method;
+  settings.composite = a.composite;
+  if (!a.budget.empty()) {
+    auto budget = parseByteSize(a.budget);
+    if (!budget) return cli::fail(budget.error().message);
+    settings.budgetBytes = budget.value();
+  }
+  if (a.k) settings.k = *a.k;
+  auto mode = parseViewMode(a.mode);
+  if (!mode)
+    return cli::fail("--mode '" + a.mode +
+                     "': expected image, depth, kmap, importance, truth, flip or wiper");
+  settings.mode = *mode;
+  if (auto method = settingsMethod(settings); !method) return cli::fail(method.error().message);
+  std::vector<nlohmann::json> steps;
+  if (!a.script.empty()) {
+    auto loaded = loadScript(a.script);
+    if (!loaded) return cli::fail(loaded.error().message);
+    steps = std::move(loaded.value());
+  }
+  if (a.frames < 0) return cli::fail("--frames: must be >= 0");
+  const int frames = a.frames == 0 && !a.screenshot.empty() && a.script.empty() ? 2 : a.frames;
+
+  // the window and its GL context
+  glfwSetErrorCallback(onGlfwError);
+  if (!glfwInit()) return failNoWindow("no display to open a window on");
+  const int w = a.scene.width, h = a.scene.height;
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);
+  GLFWwindow* window =
+      glfwCreateWindow(w + kPanelWidth, std::max(h + 80, 720), "mfr view", nullptr, nullptr);
+  if (window == nullptr) {
+    glfwTerminate();
+    return failNoWindow("no OpenGL 3.3 context for a window");
+  }
+  // the engine makes its own (headless) context current: not while the window's is
+  glfwMakeContextCurrent(nullptr);
+  auto engine = cli::makeSceneEngine(a.scene);
+  EngineContext engineContext;
+  engineContext.captureCurrent();
+  engineContext.release();
+  if (!engine) {
+    glfwDestroyWindow(window);
+    glfwTerminate();
+    return cli::fail(engine.error().message);
+  }
+  glfwMakeContextCurrent(window);
+  const bool scripted = frames > 0 || !steps.empty();
+  glfwSwapInterval(scripted ? 0 : 1);
+  IMGUI_CHECKVERSION();
+  ImGui::CreateContext();
+  ImGui::GetIO().IniFilename = nullptr;
+  ImGui::StyleColorsDark();
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  ImGui_ImplOpenGL3_Init("#version 330");
+
+  int exitCode = 0;
+  {
+    FrameRenderer renderer(**engine, engineContext, window, *prepared, a.scene);
+    ImageTexture texture;
+    Frame frame;
+    std::string shownKey;
+    nlohmann::json renders = nlohmann::json::array(), shots = nlohmann::json::array();
+    std::deque<std::pair<std::string, bool>> pendingShots;  // path, with the panel
+    size_t step = 0;
+    double frameMs = 0.0;
+    int screenshotCount = 0;
+    for (int n = 0; !glfwWindowShouldClose(window); ++n) {
+      const auto start = std::chrono::steady_clock::now();
+      if (scripted)
+        glfwPollEvents();
+      else
+        glfwWaitEventsTimeout(0.1);  // idle: no busy loop when nothing happens
+      FrameActions actions;
+      if (step < steps.size() && pendingShots.empty()) {  // a screenshot sees its own step
+        if (auto ok = applyStep(steps[step++], settings, actions); !ok) {
+          exitCode = cli::fail("--script: " + ok.error().message);
+          break;
+        }
+      }
+      ImGui_ImplOpenGL3_NewFrame();
+      ImGui_ImplGlfw_NewFrame();
+      ImGui::NewFrame();
+      const ImGuiIO& io = ImGui::GetIO();
+      if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) glfwSetWindowShouldClose(window, 1);
+      if (!io.WantCaptureMouse && io.MousePos.x < w) {  // the camera, on the image
+        if (ImGui::IsMouseDragging(ImGuiMouseButton_Left, 0.0f))
+          settings.camera.orbit(-0.3f * io.MouseDelta.x, 0.3f * io.MouseDelta.y);
+        if (ImGui::IsMouseDragging(ImGuiMouseButton_Right, 0.0f) ||
+            ImGui::IsMouseDragging(ImGuiMouseButton_Middle, 0.0f))
+          settings.camera.pan(io.MouseDelta.x / h, io.MouseDelta.y / h);
+        if (io.MouseWheel != 0.0f) settings.camera.zoom(std::pow(1.1f, io.MouseWheel));
+      }
+      int fbW = 0, fbH = 0;
+      glfwGetFramebufferSize(window, &fbW, &fbH);
+      PanelInfo info{a.scene.source, a.scene.engine, w, h, &frame, frameMs};
+      const PanelRequests requests = drawPanel(static_cast<float>(w), static_cast<float>(fbW - w),
+                                               static_cast<float>(fbH), settings, info);
+      bool updated = false;
+      // while the camera is dragged, skip the A-buffer and FLIP (rendered again on release)
+      ViewSettings shown = settings;
+      if (ImGui::IsMouseDown(ImGuiMouseButton_Left) || ImGui::IsMouseDown(ImGuiMouseButton_Right))
+        shown.compare = shown.compare && io.WantCaptureMouse;
+      if (shown.displayKey() != shownKey) {  // re-render only what changed
+        frame = renderer.update(shown);
+        shownKey = shown.displayKey();
+        texture.upload(frame.display);
+        renders.push_back(statsEntry(n, settings, frame));
+        updated = true;
+      }
+      if (requests.copyCommand || actions.copyCommand) {
+        const std::string cmd = renderCommand(a, settings);
+        glfwSetClipboardString(window, cmd.c_str());
+        std::printf("%s\n", cmd.c_str());
+        std::fflush(stdout);
+      }
+      if (requests.screenshot)
+        pendingShots.emplace_back("mfr-view-" + std::to_string(++screenshotCount) + ".png", false);
+      for (const std::string& p : actions.screenshots) pendingShots.emplace_back(p, false);
+      for (const std::string& p : actions.screenshotsUi) pendingShots.emplace_back(p, true);
+      const bool last =
+          frames > 0 ? n + 1 >= frames
+                     : !steps.empty() && step >= steps.size() && pendingShots.empty() && !updated;
+      if (last && !a.screenshot.empty()) pendingShots.emplace_back(a.screenshot, a.screenshotUi);
+      texture.draw();
+      ImGui::Render();
+      glViewport(0, 0, fbW, fbH);
+      glClearColor(0.1f, 0.1f, 0.1f, 1.0f);
+      glClear(GL_COLOR_BUFFER_BIT);
+      ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+      // screenshots of a frame whose panel already shows its render's statistics
+      while (!pendingShots.empty() && (!updated || last)) {
+        const auto [path, ui] = pendingShots.front();
+        pendingShots.pop_front();
+        const Image8 shot =
+            ui ? readWindow(fbH, fbW, fbH) : readWindow(fbH, texture.width(), texture.height());
+        if (auto written = writePng(path, shot); !written) {
+          exitCode = cli::fail(written.error().message);
+          break;
+        }
+        nlohmann::json j = statsEntry(n, settings, frame);
+        j["path"] = path;
+        j["ui"] = ui;
+        j["width"] = shot.width;
+        j["height"] = shot.height;
+        size_t differing = 0;  // pixels unlike the top-left one: 0 for an empty (uniform) shot
+        for (size_t i = 0; i < shot.rgba.size(); i += 4)
+          differing += shot.rgba[i] != shot.rgba[0] || shot.rgba[i + 1] != shot.rgba[1] ||
+                       shot.rgba[i + 2] != shot.rgba[2];
+        j["pixels_unlike_corner"] = differing;
+        shots.push_back(j);
+        if (!scripted) std::printf("screenshot: %s\n", path.c_str());
+      }
+      glfwSwapBuffers(window);
+      frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                    .count();
+      if (exitCode != 0 || (last && pendingShots.empty())) break;
+    }
+    if (!a.statsJson.empty()) {
+      nlohmann::json out{{"renders", renders}, {"screenshots", shots}};
+      if (auto written = writeFileAtomically(a.statsJson, out.dump(2) + "\n"); !written)
+        exitCode = cli::fail(written.error().message);
+    }
+    texture.destroy();
+  }  // the renderer frees the engine's views in the engine's context
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+  glfwMakeContextCurrent(nullptr);
+  {
+    engineContext.makeCurrent();
+    engine.value().reset();
+    engineContext.release();
+  }
+  glfwDestroyWindow(window);
+  glfwTerminate();
+  return exitCode;
+}
+
+}  // namespace mfr::view
