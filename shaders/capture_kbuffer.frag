@@ -8,7 +8,9 @@
 // arrival order). A fragment not nearer than that maximum is culled before the critical section
 // (its depth word alone is compared there: slot 0's depth word only decreases, so a stale read is
 // conservative). Otherwise it takes the pixel's spin-lock (imageAtomicExchange); the loop is around
-// the critical section, not a spin inside it, so lanes of one SIMD group cannot deadlock.
+// the critical section, not a spin inside it, so lanes of one SIMD group cannot deadlock. With
+// MFR_INTERLOCK (--gl-sync interlock, the engine's prelude defines it with the extension's
+// begin/end), the fragment shader interlock orders the critical section instead of the lock.
 layout(std430, binding = kBindNodes) coherent buffer Nodes {
   uvec2 nodes[];
 };
@@ -31,6 +33,67 @@ layout(std430, binding = kBindCaptureStats) buffer CaptureStats {
   uint culledKPlus;
 };
 
+// The critical section: the store update and the tail, for one pixel's fragments one at a time.
+void insertNode(const uint p, const uint first, const uint k, const uint storeKind, const bool store,
+                const uvec2 node) {
+  uint tailColor = node.y;
+  bool toTail = !store;
+  const uvec2 maxNode = k > 0u ? nodes[first] : uvec2(kFarDepthBits, 0u);
+  if (!store) {
+    // culled: to the tail
+  } else if (!nodeLess(node, maxNode)) {
+    toTail = true;  // rejected in the store
+  } else if (storeKind == kStoreMaxHeap) {
+    // down-heap: move the larger child up into the hole
+    uint i = 0u;
+    for (;;) {
+      const uint left = 2u * i + 1u;
+      if (left >= k) break;
+      uint child = left;
+      if (left + 1u < k) {
+        if (nodeLess(nodes[first + left], nodes[first + left + 1u])) child = left + 1u;
+      }
+      const uvec2 c = nodes[first + child];
+      if (!nodeLess(node, c)) break;
+      nodes[first + i] = c;
+      i = child;
+    }
+    nodes[first + i] = node;
+  } else {
+    // replace the maximum; the new maximum of the k moves to slot 0
+    uint maxIndex = 0u;
+    uvec2 m = node;
+    for (uint i = 1u; i < k; ++i) {
+      const uvec2 s = nodes[first + i];
+      if (nodeLess(m, s)) {
+        m = s;
+        maxIndex = i;
+      }
+    }
+    if (maxIndex != 0u) nodes[first + maxIndex] = node;
+    nodes[first] = m;
+  }
+  if (store && nodeLess(node, maxNode) && maxNode.x != kFarDepthBits) {
+    toTail = true;  // evicted (an empty slot's far node is not a fragment)
+    tailColor = maxNode.y;
+  }
+  if (toTail && uHybrid != 0u) {  // mfr::HybridTail::add
+    const uint t = kTailWords * p;
+    precise float a = float(tailColor >> 24) * uInv255;
+    precise float r = uintBitsToFloat(tails[t]) + a * srgb8ToLinear(tailColor & 0xffu);
+    precise float g =
+        uintBitsToFloat(tails[t + 1u]) + a * srgb8ToLinear((tailColor >> 8) & 0xffu);
+    precise float b =
+        uintBitsToFloat(tails[t + 2u]) + a * srgb8ToLinear((tailColor >> 16) & 0xffu);
+    precise float sumA = uintBitsToFloat(tails[t + 3u]) + a;
+    tails[t] = floatBitsToUint(r);
+    tails[t + 1u] = floatBitsToUint(g);
+    tails[t + 2u] = floatBitsToUint(b);
+    tails[t + 3u] = floatBitsToUint(sumA);
+    tails[t + 4u] += 1u;
+  }
+}
+
 void main() {
   FragmentData f;
   if (!exactCoverage(f)) discard;
@@ -39,6 +102,7 @@ void main() {
   const float depth = fragmentDepth(f);
   const uint p = uint(f.pixel);
   bool store = true;  // false: culled, to the tail (hybrid) or dropped
+  bool drop = false;  // true: nothing to write (no early return: the interlock forbids it)
   if (uOccupancyWords > 0u) {  // occupancy test: behind the pixel's k-th occupied bucket
     const uint t = occupancy[kOccupancyWords * p + 2u];
     if (t != kOccupancyNoCulling &&
@@ -46,7 +110,7 @@ void main() {
                         uintBitsToFloat(occupancy[kOccupancyWords * p + 1u]),
                         32u * uOccupancyWords) > t) {
       atomicAdd(culledOccupancy, 1u);
-      if (uHybrid == 0u) return;
+      if (uHybrid == 0u) drop = true;
       store = false;
     }
   }
@@ -59,75 +123,28 @@ void main() {
     storeKind = (a.y & kAllocHeapBit) != 0u ? kStoreMaxHeap : kStoreMaxArray;
   }
   if (store && k == 0u) {  // no slot: rejected
-    if (uHybrid == 0u) return;
+    if (uHybrid == 0u) drop = true;
     store = false;
   } else if (store && node.x > nodes[first].x) {  // k+ test
     atomicAdd(culledKPlus, 1u);
-    if (uHybrid == 0u) return;
+    if (uHybrid == 0u) drop = true;
     store = false;
   }
+#ifdef MFR_INTERLOCK
+  // the driver orders the pixel's fragments (outside any control flow, no return before it)
+  MFR_INTERLOCK_BEGIN();
+  if (!drop) insertNode(p, first, k, storeKind, store, node);
+  MFR_INTERLOCK_END();
+#else
+  if (drop) return;
   bool done = false;
   while (!done) {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
-      uint tailColor = node.y;
-      bool toTail = !store;
-      const uvec2 maxNode = k > 0u ? nodes[first] : uvec2(kFarDepthBits, 0u);
-      if (!store) {
-        // culled: to the tail
-      } else if (!nodeLess(node, maxNode)) {
-        toTail = true;  // rejected in the store
-      } else if (storeKind == kStoreMaxHeap) {
-        // down-heap: move the larger child up into the hole
-        uint i = 0u;
-        for (;;) {
-          const uint left = 2u * i + 1u;
-          if (left >= k) break;
-          uint child = left;
-          if (left + 1u < k) {
-            if (nodeLess(nodes[first + left], nodes[first + left + 1u])) child = left + 1u;
-          }
-          const uvec2 c = nodes[first + child];
-          if (!nodeLess(node, c)) break;
-          nodes[first + i] = c;
-          i = child;
-        }
-        nodes[first + i] = node;
-      } else {
-        // replace the maximum; the new maximum of the k moves to slot 0
-        uint maxIndex = 0u;
-        uvec2 m = node;
-        for (uint i = 1u; i < k; ++i) {
-          const uvec2 s = nodes[first + i];
-          if (nodeLess(m, s)) {
-            m = s;
-            maxIndex = i;
-          }
-        }
-        if (maxIndex != 0u) nodes[first + maxIndex] = node;
-        nodes[first] = m;
-      }
-      if (store && nodeLess(node, maxNode) && maxNode.x != kFarDepthBits) {
-        toTail = true;  // evicted (an empty slot's far node is not a fragment)
-        tailColor = maxNode.y;
-      }
-      if (toTail && uHybrid != 0u) {  // mfr::HybridTail::add
-        const uint t = kTailWords * p;
-        precise float a = float(tailColor >> 24) * uInv255;
-        precise float r = uintBitsToFloat(tails[t]) + a * srgb8ToLinear(tailColor & 0xffu);
-        precise float g =
-            uintBitsToFloat(tails[t + 1u]) + a * srgb8ToLinear((tailColor >> 8) & 0xffu);
-        precise float b =
-            uintBitsToFloat(tails[t + 2u]) + a * srgb8ToLinear((tailColor >> 16) & 0xffu);
-        precise float sumA = uintBitsToFloat(tails[t + 3u]) + a;
-        tails[t] = floatBitsToUint(r);
-        tails[t + 1u] = floatBitsToUint(g);
-        tails[t + 2u] = floatBitsToUint(b);
-        tails[t + 3u] = floatBitsToUint(sumA);
-        tails[t + 4u] += 1u;
-      }
+      insertNode(p, first, k, storeKind, store, node);
       memoryBarrierBuffer();
       imageAtomicExchange(uLocks, f.pixel, kLockFree);
       done = true;
     }
   }
+#endif
 }

@@ -41,6 +41,7 @@ struct SceneOptions {
   bool allowOutsideReferences = false;  // files named in a scene may lie outside its folder
   std::string memoryLimit;              // --memory-limit (empty: defaultMemoryLimit())
   std::string engine = "cpu";           // --engine (render, compare, info)
+  std::string glSync = "auto";          // --gl-sync (the GL engine's k-buffer sync)
 
   /// Registers the options (and the positional scene unless the command takes several; --engine
   /// for the commands that run on either engine).

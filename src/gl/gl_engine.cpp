@@ -51,8 +51,10 @@ std::string oneLine(std::string text) {
 }
 
 // "#version", the shared layout, [the fragment shaders' common part,] the shader's own text
-std::string composeSource(const std::string& file, bool fragmentCommon) {
+std::string composeSource(const std::string& file, bool fragmentCommon,
+                          const std::string& prelude) {
   std::string s = "#version 450 core\n";
+  s += prelude;
   s += embeddedShader("shared_layout.h");
   s += "\n";
   if (fragmentCommon) {
@@ -64,9 +66,10 @@ std::string composeSource(const std::string& file, bool fragmentCommon) {
   return s;
 }
 
-Result<GLuint> compileShader(GLenum stage, const std::string& file, bool fragmentCommon) {
+Result<GLuint> compileShader(GLenum stage, const std::string& file, bool fragmentCommon,
+                             const std::string& prelude) {
   if (embeddedShader(file).empty()) return makeError("GL engine: no embedded shader " + file);
-  return compileShaderSource(stage, file, composeSource(file, fragmentCommon));
+  return compileShaderSource(stage, file, composeSource(file, fragmentCommon, prelude));
 }
 
 struct StageFile {
@@ -74,13 +77,16 @@ struct StageFile {
   std::string file;
 };
 
-Result<GLuint> linkProgram(const std::string& name, const std::vector<StageFile>& stages) {
+// `prelude`: lines after "#version" in the fragment shader (the interlock's #extension, #define)
+Result<GLuint> linkProgram(const std::string& name, const std::vector<StageFile>& stages,
+                           const std::string& prelude = "") {
   std::vector<GLuint> shaders;
   auto cleanup = [&] {
     for (GLuint s : shaders) glDeleteShader(s);
   };
   for (const StageFile& sf : stages) {
-    auto shader = compileShader(sf.stage, sf.file, sf.stage == GL_FRAGMENT_SHADER);
+    const bool fragment = sf.stage == GL_FRAGMENT_SHADER;
+    auto shader = compileShader(sf.stage, sf.file, fragment, fragment ? prelude : std::string());
     if (!shader) {
       cleanup();
       return shader.error();
@@ -279,7 +285,7 @@ const Camera& GlEngine::camera() const {
 }
 
 Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
-                                  const Camera& cameraIn, int width, int height) {
+                                  const Camera& cameraIn, int width, int height, bool interlock) {
   if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize)
     return makeError("image size " + std::to_string(width) + "x" + std::to_string(height) +
                      ": width and height must be in [1, " + std::to_string(kMaxImageSize) + "]");
@@ -322,18 +328,44 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   s->ray.w = (1.0f - 1.0f / static_cast<float>(height)) * tanHalf;
 
   // programs
-  auto raster = [&](const std::string& frag) {
-    return linkProgram(frag, {{GL_VERTEX_SHADER, "raster.vert"},
-                              {GL_GEOMETRY_SHADER, "raster.geom"},
-                              {GL_FRAGMENT_SHADER, frag}});
+  auto raster = [&](const std::string& frag, const std::string& prelude = "") {
+    return linkProgram(frag,
+                       {{GL_VERTEX_SHADER, "raster.vert"},
+                        {GL_GEOMETRY_SHADER, "raster.geom"},
+                        {GL_FRAGMENT_SHADER, frag}},
+                       prelude);
   };
+  std::string kbufferPrelude;
+  if (interlock) {
+    const std::string ext = interlockExtension(context);
+    if (ext.empty())
+      return makeError(
+          "--gl-sync interlock: the driver offers none of GL_ARB_fragment_shader_interlock, "
+          "GL_NV_fragment_shader_interlock, GL_INTEL_fragment_shader_ordering");
+    kbufferPrelude = "#extension " + ext + " : require\n";
+    if (ext == "GL_ARB_fragment_shader_interlock")
+      kbufferPrelude +=
+          "#define MFR_INTERLOCK_BEGIN() beginInvocationInterlockARB()\n"
+          "#define MFR_INTERLOCK_END() endInvocationInterlockARB()\n";
+    else if (ext == "GL_NV_fragment_shader_interlock")
+      kbufferPrelude +=
+          "#define MFR_INTERLOCK_BEGIN() beginInvocationInterlockNV()\n"
+          "#define MFR_INTERLOCK_END() endInvocationInterlockNV()\n";
+    else  // the ordering lasts to the end of the shader
+      kbufferPrelude +=
+          "#define MFR_INTERLOCK_BEGIN() beginFragmentShaderOrderingINTEL()\n"
+          "#define MFR_INTERLOCK_END()\n";
+    kbufferPrelude += "#define MFR_INTERLOCK 1\n";
+    if (ext != "GL_INTEL_fragment_shader_ordering")
+      kbufferPrelude += "layout(pixel_interlock_ordered) in;\n";
+  }
   auto count = raster("count.frag");
   if (!count) return count.error();
   s->progCount = *count;
   auto abuffer = raster("capture_abuffer.frag");
   if (!abuffer) return abuffer.error();
   s->progABuffer = *abuffer;
-  auto kbuffer = raster("capture_kbuffer.frag");
+  auto kbuffer = raster("capture_kbuffer.frag", kbufferPrelude);
   if (!kbuffer) return kbuffer.error();
   s->progKBuffer = *kbuffer;
   auto depthRange = raster("depth_range.frag");
@@ -928,6 +960,14 @@ Result<std::vector<float>> GlEngine::dkbImportance(const std::vector<float>& wei
     return makeError("--engine gl: the deep k-buffer's importance failed (GL error " +
                      std::to_string(e) + ")");
   return out;
+}
+
+std::string interlockExtension(const GlContext& context) {
+  const GlExtensions& e = context.extensions();
+  if (e.arbFragmentShaderInterlock) return "GL_ARB_fragment_shader_interlock";
+  if (e.nvFragmentShaderInterlock) return "GL_NV_fragment_shader_interlock";
+  if (e.intelFragmentShaderOrdering) return "GL_INTEL_fragment_shader_ordering";
+  return {};
 }
 
 }  // namespace mfr::gl

@@ -82,7 +82,8 @@ Result<OracleChoice> cpuOracle(const View& view, const MethodDesc& method,
 
 class GlRenderEngine final : public Engine {
  public:
-  explicit GlRenderEngine(GlContext context) : context_(std::move(context)) {}
+  GlRenderEngine(GlContext context, bool interlock)
+      : context_(std::move(context)), interlock_(interlock) {}
 
   std::string_view name() const override { return "gl"; }
 
@@ -94,7 +95,8 @@ class GlRenderEngine final : public Engine {
             {"version", context_.version()},
             {"vendor", context_.vendor()},
             {"egl_platform", context_.eglPlatform()},
-            {"sync", "lock"},  // per-pixel spin-lock (imageAtomicExchange loop)
+            // the k-buffer capture: per-pixel spin-lock (imageAtomicExchange loop) or interlock
+            {"sync", interlock_ ? "interlock (" + interlockExtension(context_) + ")" : "lock"},
             {"GL_ARB_fragment_shader_interlock", yes(c.arbFragmentShaderInterlock)},
             {"GL_NV_fragment_shader_interlock", yes(c.nvFragmentShaderInterlock)},
             {"GL_INTEL_fragment_shader_ordering", yes(c.intelFragmentShaderOrdering)},
@@ -104,7 +106,8 @@ class GlRenderEngine final : public Engine {
 
   Result<std::unique_ptr<PreparedView>> prepare(const View& view) override {
     if (!view.scene) return makeError("engine gl: a view without a scene");
-    auto engine = GlEngine::create(context_, *view.scene, view.camera, view.width, view.height);
+    auto engine =
+        GlEngine::create(context_, *view.scene, view.camera, view.width, view.height, interlock_);
     if (!engine) return engine.error();
     return std::unique_ptr<PreparedView>(std::make_unique<GlView>(std::move(engine.value()), view));
   }
@@ -258,6 +261,7 @@ class GlRenderEngine final : public Engine {
       s.passes.push_back({t.name, t.wallMs});  // llvmpipe's GL_TIME_ELAPSED is not usable
       s.engineCounters["gpu_ms_" + t.name] = t.gpuMs;
     }
+    s.engineCounters["sync_interlock"] = interlock_ ? 1 : 0;  // the k-buffer capture's sync
     out.kMap = a->reservedK.empty() ? std::move(a->capacity) : std::move(a->reservedK);
     out.depthComplexity = std::move(g.counts);
     if (options.keepStores) {
@@ -282,18 +286,29 @@ class GlRenderEngine final : public Engine {
 
  private:
   GlContext context_;
+  bool interlock_ = false;
 };
 
 }  // namespace
 
-Result<std::unique_ptr<Engine>> makeGlEngine() {
+Result<std::unique_ptr<Engine>> makeGlEngine(const std::string& sync) {
+  if (sync != "auto" && sync != "lock" && sync != "interlock")
+    return makeError("--gl-sync '" + sync + "': expected auto, lock or interlock");
   auto context = GlContext::create();
   if (!context) return context.error();
-  return std::unique_ptr<Engine>(std::make_unique<GlRenderEngine>(std::move(context.value())));
+  const bool offered = !interlockExtension(context.value()).empty();
+  if (sync == "interlock" && !offered)
+    return makeError(
+        "--gl-sync interlock: the driver offers none of GL_ARB_fragment_shader_interlock, "
+        "GL_NV_fragment_shader_interlock, GL_INTEL_fragment_shader_ordering (renderer " +
+        context->renderer() + ")");
+  const bool interlock = sync == "interlock" || (sync == "auto" && offered);
+  return std::unique_ptr<Engine>(
+      std::make_unique<GlRenderEngine>(std::move(context.value()), interlock));
 }
 
 void registerGlEngine() {
-  registerEngine("gl", [](const EngineOptions&) { return makeGlEngine(); });
+  registerEngine("gl", [](const EngineOptions& o) { return makeGlEngine(o.glSync); });
 }
 
 }  // namespace mfr::gl

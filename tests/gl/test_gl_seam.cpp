@@ -4,8 +4,10 @@
 // float rounding for hybrid; methods not in the GL engine are one-line errors; `mfr compare
 // --engine gl` writes its results. Without a GL 4.5 context the tests skip (fail under CI=true).
 #include <gtest/gtest.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -270,6 +272,86 @@ TEST(GlSeamCli, CompareOnTheGlEngine) {
       EXPECT_LE(run["bytes_used"].get<uint64_t>(), budget["budget_bytes"].get<uint64_t>());
       EXPECT_GT(run["flip_mean"].get<double>(), 0.0) << "layers lose fragments at these budgets";
     }
+  std::filesystem::remove_all(dir);
+}
+
+// --gl-sync: auto is the interlock where the driver offers one, else the lock (stats and
+// describe() say which); interlock without the extension is a one-line error naming what the
+// driver lacks; an unknown value is an error.
+TEST(GlSeam, SyncMode) {
+  MFR_GL_ENGINE(gl);
+  const std::string sync = gl->describe().at("sync");
+  gl.reset();
+  auto bogus = makeGlEngine("spin");
+  ASSERT_FALSE(bogus.ok());
+  EXPECT_EQ(bogus.error().message, "--gl-sync 'spin': expected auto, lock or interlock");
+  auto lock = makeGlEngine("lock");
+  ASSERT_TRUE(lock.ok()) << lock.error().message;
+  EXPECT_EQ((*lock)->describe().at("sync"), "lock");
+  const Scene scene = loadScene("procedural:layers").value();
+  const View view{&scene, *scene.defaultCamera, 32, 32};
+  auto pv = (*lock)->prepare(view);
+  ASSERT_TRUE(pv.ok());
+  MethodDesc method = methodPreset("kplus-array").value();
+  method.k = 4;
+  auto out = (*lock)->render(**pv, method, {});
+  ASSERT_TRUE(out.ok()) << out.error().message;
+  EXPECT_EQ(out->stats.engineCounters.at("sync_interlock"), 0);
+  pv.value().reset();
+  lock.value().reset();
+  auto interlock = makeGlEngine("interlock");
+  if (sync == "lock") {  // auto chose the lock: the driver has no interlock
+    ASSERT_FALSE(interlock.ok());
+    const std::string m = interlock.error().message;
+    EXPECT_EQ(m.find("--gl-sync interlock: the driver offers none of "
+                     "GL_ARB_fragment_shader_interlock, GL_NV_fragment_shader_interlock, "
+                     "GL_INTEL_fragment_shader_ordering"),
+              0u)
+        << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  } else {
+    ASSERT_TRUE(interlock.ok()) << interlock.error().message;
+    EXPECT_EQ(sync.rfind("interlock", 0), 0u) << sync;
+  }
+}
+
+// The CLI: --gl-sync lock renders what the default renders (byte-identical PNG); interlock on a
+// driver without it is one line on stderr and exit 1.
+TEST(GlSeamCli, GlSyncOption) {
+  MFR_GL_ENGINE(gl);
+  const bool hasInterlock = gl->describe().at("sync") != "lock";
+  gl.reset();
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("mfr_gl_sync_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string base = std::string(MFR_CLI_PATH) +
+                           " render procedural:layers --engine gl -m kplus-heap --k 4 --width 64 "
+                           "--height 64 --quiet";
+  auto slurp = [](const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+  };
+  ASSERT_EQ(std::system((base + " -o " + (dir / "auto.png").string()).c_str()), 0);
+  ASSERT_EQ(std::system((base + " --gl-sync lock -o " + (dir / "lock.png").string()).c_str()), 0);
+  EXPECT_FALSE(slurp(dir / "auto.png").empty());
+  if (!hasInterlock) {
+    EXPECT_EQ(slurp(dir / "auto.png"), slurp(dir / "lock.png"));
+    const std::string cmd = base + " --gl-sync interlock -o " + (dir / "x.png").string() + " 2>" +
+                            (dir / "err.txt").string();
+    const int rc = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(rc));
+    EXPECT_EQ(WEXITSTATUS(rc), 1);
+    const std::string err = slurp(dir / "err.txt");
+    EXPECT_NE(err.find("--gl-sync interlock: the driver offers none of "
+                       "GL_ARB_fragment_shader_interlock"),
+              std::string::npos)
+        << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+    EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));
+  }
   std::filesystem::remove_all(dir);
 }
 

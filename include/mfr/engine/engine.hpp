@@ -35,6 +35,9 @@ struct View {
 struct EngineOptions {
   int threads = 0;
   int tileSize = 16;
+  /// GL engine only: the k-buffer capture's synchronisation, "auto" (the fragment shader interlock
+  /// when the driver offers it, else the spin-lock), "lock" or "interlock" (--gl-sync).
+  std::string glSync = "auto";
 };
 
 /// A view set up by one engine for any number of renders. Owned by the caller; render() takes it

@@ -73,8 +73,10 @@ class GlEngine {
  public:
   /// Errors (one line): the size outside [1, 16384] or above GL's limits, a scene failing
   /// validateScene, a shader that does not compile or link (its name and info log).
+  /// `interlock`: the k-buffer capture orders a pixel's fragments with the driver's fragment
+  /// shader interlock (interlockExtension(context) must name one) instead of the spin-lock.
   static Result<GlEngine> create(const GlContext& context, const Scene& scene, const Camera& camera,
-                                 int width, int height);
+                                 int width, int height, bool interlock = false);
 
   GlEngine(GlEngine&&) noexcept;
   GlEngine& operator=(GlEngine&&) noexcept;
@@ -104,5 +106,10 @@ class GlEngine {
   explicit GlEngine(std::unique_ptr<State> state);
   std::unique_ptr<State> state_;
 };
+
+/// The fragment shader interlock extension the context offers, in the order
+/// GL_ARB_fragment_shader_interlock, GL_NV_fragment_shader_interlock,
+/// GL_INTEL_fragment_shader_ordering; empty when it offers none.
+std::string interlockExtension(const GlContext& context);
 
 }  // namespace mfr::gl

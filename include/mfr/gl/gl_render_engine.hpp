@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 
 #include "mfr/core/result.hpp"
 #include "mfr/engine/engine.hpp"
@@ -13,8 +14,11 @@
 namespace mfr::gl {
 
 /// A GL engine on a new headless GL 4.5 core context. Errors (one line): no such context
-/// ("--engine gl: no OpenGL 4.5 core context (EGL: ...)"). Use it on the thread that made it.
-Result<std::unique_ptr<Engine>> makeGlEngine();
+/// ("--engine gl: no OpenGL 4.5 core context (EGL: ...)"); `sync` not auto, lock or interlock;
+/// interlock asked for on a driver without GL_ARB_fragment_shader_interlock,
+/// GL_NV_fragment_shader_interlock or GL_INTEL_fragment_shader_ordering. Use it on the thread that
+/// made it.
+Result<std::unique_ptr<Engine>> makeGlEngine(const std::string& sync = "auto");
 
 /// Adds "gl" to makeEngine's engines (registerEngine).
 void registerGlEngine();
