@@ -119,6 +119,80 @@ print(f"ok: {len(ran)} screenshots non-empty, modes differ, bytes_used <= budget
       f"{len(stats['renders'])} renders; refused by this engine: {', '.join(refused) or 'none'}")
 PY
 
+# (e) file cameras, WASD fly, method parameters, bytes by category, compare line, open a scene
+cat >cams.json <<'JSON'
+{"mesh": "procedural:spheres",
+ "cameras": [{"eye": [0.3, 0.8, 3.2], "target": [0, 0, 0], "fov": 45},
+             {"eye": [2.6, 1.4, -1.2], "target": [0, 0.1, 0], "up": [0, 1, 0], "fov": 55}]}
+JSON
+opts=(--method fkb --budget 256KB --width $S --height $S)
+for v in 0 1; do "$MFR" render cams.json --engine gl "${opts[@]}" --view $v -q -o cam_ref$v.png; done
+"$MFR" render procedural:layers --engine gl "${opts[@]}" -q -o open_ref.png
+"$MFR" render procedural:layers --engine gl --method fkb+occupancy --occupancy-d 4 --budget 2MB \
+  --width $S --height $S -q -o occ_ref.png
+"$MFR" render procedural:layers --engine gl --method vkb --budget 2MB --importance-alpha 0.25 \
+  --n-limit 8 --no-noise --width $S --height $S -q -o vkb_ref.png
+cat >cams_script.json <<'JSON'
+[{"file_camera": 1, "screenshot": "cam1.png"},
+ {"next_camera": 1, "screenshot": "cam0.png"},
+ {"fly": [0.1, 0.05, 0.3], "copy_command": true, "screenshot": "fly.png"},
+ {"open": "procedural:layers", "screenshot": "open.png"},
+ {"open": "no_such_scene.gltf", "screenshot": "open_bad.png"},
+ {"method": "fkb+occupancy", "budget": "2MB", "screenshot": "occ1.png"},
+ {"occupancy_d": 4, "screenshot": "occ.png"},
+ {"method": "vkb", "importance": {"alpha": 0.25, "n_limit": 8, "noise_term": false},
+  "screenshot": "vkb.png"},
+ {"method": "dkb", "model": "no_such_model.mfrnn", "screenshot": "dkb_bad.png"},
+ {"method": "fkb", "model": "", "budget_share": 0.5, "screenshot": "share.png"}]
+JSON
+"$MFR" view cams.json "${opts[@]}" --script cams_script.json --stats-json cams_stats.json >cams_cmd.txt
+cmp cam1.png cam_ref1.png || { echo "FAIL: file_camera 1 != mfr render --view 1"; exit 1; }
+cmp cam0.png cam_ref0.png || { echo "FAIL: next file camera (0) != mfr render --view 0"; exit 1; }
+"$MFR" view cams.json "${opts[@]}" --view 1 --frames 2 --screenshot start1.png
+cmp start1.png cam_ref1.png || { echo "FAIL: mfr view --view 1 != mfr render --view 1"; exit 1; }
+cmd=$(grep '^mfr render ' cams_cmd.txt | head -1)
+cmd=${cmd% -o view.png}
+eval "\"$MFR\" ${cmd#mfr } -q -o fly_ref.png"
+cmp fly.png fly_ref.png || { echo "FAIL: flown screenshot != its copied command: $cmd"; exit 1; }
+! cmp -s fly.png cam0.png || { echo "FAIL: fly did not move the camera"; exit 1; }
+cmp open.png open_ref.png || { echo "FAIL: opened scene != mfr render of it"; exit 1; }
+cmp open_bad.png open_ref.png || { echo "FAIL: a bad open changed the scene"; exit 1; }
+cmp occ.png occ_ref.png || { echo "FAIL: occupancy_d 4 != render --occupancy-d 4"; exit 1; }
+cmp vkb.png vkb_ref.png || { echo "FAIL: vkb parameters != render's"; exit 1; }
+compare=$(grep '^mfr compare ' cams_cmd.txt | head -1)
+[[ "$compare" == *"--methods fkb --budget 262144 "*"--camera "* ]] ||
+  { echo "FAIL: compare line: $compare"; cat cams_cmd.txt; exit 1; }
+eval "\"$MFR\" ${compare#mfr } -q" >/dev/null
+[ -s compare/results.json ] || { echo "FAIL: the copied compare line wrote no results.json"; exit 1; }
+if "$MFR" render procedural:layers --engine gl --method dkb --budget 256KB \
+  --model no_such_model.mfrnn --width $S --height $S -q -o x.png 2>dkb_err.txt; then
+  echo "FAIL: render loaded a missing model"; exit 1
+fi
+python3 - <<'PY'
+import json
+stats = json.load(open("cams_stats.json"))
+shots = {s["path"]: s for s in stats["screenshots"]}
+assert shots["cam1.png"]["file_camera"] == 1 and shots["cam0.png"]["file_camera"] == 0, shots
+assert shots["open.png"]["scene"] == "procedural:layers" and not shots["open.png"]["notice"]
+bad = shots["open_bad.png"]
+assert bad["scene"] == "procedural:layers" and "no_such_scene.gltf" in bad["notice"], bad
+assert "\n" not in bad["notice"], bad
+err = open("dkb_err.txt").read().strip()
+dkb = shots["dkb_bad.png"]["error"]
+assert dkb and dkb in err, (dkb, err)
+for s in stats["screenshots"]:
+    if "bytes_used" in s:
+        assert sum(s["bytes_by_category"].values()) == s["bytes_used"], s
+occ1, occ4 = shots["occ1.png"]["bytes_by_category"], shots["occ.png"]["bytes_by_category"]
+assert occ1 != occ4, f"occupancy d changes no category: {occ1}"
+share = shots["share.png"]
+assert share["truth_bytes"] > 0 and abs(share["budget_bytes"] - share["truth_bytes"] / 2) <= 1, share
+assert share["bytes_used"] <= share["budget_bytes"], share
+print(f"ok: file cameras, fly, open (a bad one: {bad['notice']}), occupancy d, vkb parameters, "
+      f"--model error ({dkb}), budget share, bytes by category {occ4}")
+PY
+echo "ok: file cameras, fly, open, occupancy d, vkb == mfr render; compare line runs: $compare"
+
 # (c) the window with its panel
 "$MFR" view procedural:layers --width $S --height $S --method kplus-array --budget 200KB \
   --mode wiper --frames 3 --screenshot ui.png --screenshot-ui

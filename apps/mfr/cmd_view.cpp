@@ -25,6 +25,8 @@ Runner addViewCommand(CLI::App& app) {
   cmd->add_option("--budget,-M", args->budget, "Memory budget, e.g. 20MB (MB = 2^20 bytes)");
   cmd->add_option("--k", args->k, "Explicit k (otherwise derived from the budget)");
   cmd->add_option("--composite", args->composite, "kbuffer or hybrid (default: the preset's)");
+  cmd->add_option("--occupancy-d", args->occupancyD, "+occupancy presets: bucket words d (1-64)");
+  cmd->add_option("--model", args->model, "dkb*: network model (.mfrnn; default: built-in)");
   cmd->add_option("--mode", args->mode,
                   "View: image, depth, kmap, importance, truth, flip or wiper (default image)");
   cmd->add_option("--frames", args->frames, "Render N frames, then exit (tests)");

@@ -58,6 +58,26 @@ Result<MethodDesc> settingsMethod(const ViewSettings& s) {
     if (!rule) return makeError("--composite: " + rule.error().message);
     m.compositing = rule.value();
   }
+  if (m.occupancyWords > 0 && s.occupancyD > 0) {  // as `mfr render --occupancy-d`
+    if (s.occupancyD > 64) return makeError("--occupancy-d: must be in [1, 64]");
+    m.occupancyWords = s.occupancyD;
+  }
+  if (m.allocation == AllocationPolicy::Importance) {  // as render's vkb options
+    const ImportanceParams& ip = s.importance;
+    if (!(ip.alpha >= 0.0f && ip.alpha <= 1.0f))
+      return makeError("--importance-alpha: must be in [0, 1]");
+    if (!(ip.nLimit >= 1.0f && ip.nLimit <= 1e6f))
+      return makeError("--n-limit: must be in [1, 1e6]");
+    if (!(ip.peripheryExponent > 0.0f && ip.peripheryExponent <= 100.0f))
+      return makeError("--periphery-d: must be in (0, 100]");
+    if (!(ip.noise >= 0.0f && ip.noise <= 1.0f)) return makeError("--noise: must be in [0, 1]");
+    m.importance = ip;
+  }
+  if (!s.model.empty() && checkMethodOption(MethodOption::Model, m, "--model")) {
+    auto model = cli::loadDkbModel(s.model);
+    if (!model) return model.error();
+    m.model = model.value();
+  }
   return m;
 }
 

@@ -35,6 +35,17 @@ void OrbitCamera::pan(float dx, float dy) {
   camera_.target += move;
 }
 
+void OrbitCamera::fly(float right, float up, float forward) {
+  const glm::vec3 view = camera_.target - camera_.eye;
+  const float distance = glm::length(view);
+  const glm::vec3 f = view / distance;
+  const glm::vec3 r = glm::normalize(glm::cross(f, camera_.up));
+  const glm::vec3 u = glm::cross(r, f);
+  const glm::vec3 move = (right * r + up * u + forward * f) * distance;
+  camera_.eye += move;
+  camera_.target += move;
+}
+
 void OrbitCamera::zoom(float factor) {
   if (!(factor > 0.0f)) return;
   const glm::vec3 offset = (camera_.eye - camera_.target) / factor;

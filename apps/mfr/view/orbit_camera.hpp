@@ -21,6 +21,11 @@ class OrbitCamera {
   void zoom(float factor);
   void setFov(float degrees);
   void reset() { camera_ = start_; }
+  /// WASD fly: moves eye and target together, `right` sideways, `up` along the camera's up and
+  /// `forward` along the view direction, each in units of the distance to the target.
+  void fly(float right, float up, float forward);
+  /// A new starting camera (a file camera, a newly opened scene): reset() returns to it.
+  void restart(const Camera& start) { start_ = camera_ = start; }
   /// "EX,EY,EZ,TX,TY,TZ,UX,UY,UZ,FOV", exact enough to give the same image in `mfr render`.
   std::string spec() const;
 

@@ -8,6 +8,7 @@
 
 #include "mfr/core/units.hpp"
 #include "mfr/method/method.hpp"
+#include "mfr/method/method_options.hpp"
 
 namespace mfr::view {
 
@@ -49,10 +50,44 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
   const float maxMb = std::max(16.0f, 2.0f * truthMb);
   if (ImGui::SliderFloat("budget (MB)", &mb, 0.0f, maxMb, "%.2f", ImGuiSliderFlags_Logarithmic))
     s.budgetBytes = static_cast<uint64_t>(std::llround(std::max(0.0f, mb) * 1048576.0));
-  if (truthMb > 0)
-    ImGui::Text("  = %.1f%% of the exact A-buffer (%.2f MB)", 100.0f * mb / truthMb, truthMb);
+  if (truthMb > 0) {
+    float percent = 100.0f * mb / truthMb;
+    if (ImGui::InputFloat("% of exact A-buffer", &percent, 5.0f, 25.0f, "%.1f",
+                          ImGuiInputTextFlags_EnterReturnsTrue))
+      requests.budgetShare = std::max(0.0f, percent) / 100.0;
+    ImGui::Text("  exact A-buffer: %.2f MB", truthMb);
+  }
   int k = static_cast<int>(s.k);
   if (ImGui::InputInt("k (0: auto)", &k)) s.k = static_cast<uint32_t>(std::max(0, k));
+  if (auto preset = methodPreset(s.method)) {  // the preset's own parameters
+    const MethodDesc& m = preset.value();
+    if (m.occupancyWords > 0) {
+      int d = s.occupancyD > 0 ? s.occupancyD : m.occupancyWords;
+      if (ImGui::SliderInt("occupancy d", &d, 1, 64)) s.occupancyD = d;
+    }
+    if (m.allocation == AllocationPolicy::Importance &&
+        m.importanceSource == ImportanceSource::Heuristic) {
+      ImportanceParams& ip = s.importance;
+      ImGui::SliderFloat("alpha (Eq. 3)", &ip.alpha, 0.0f, 1.0f, "%.3f");
+      ImGui::SliderFloat("N_limit (Eq. 3)", &ip.nLimit, 1.0f, 100.0f, "%.1f");
+      ImGui::SliderFloat("periphery d (Eq. 4)", &ip.peripheryExponent, 0.1f, 10.0f, "%.2f");
+      ImGui::SliderFloat("noise lambda (Eq. 6)", &ip.noise, 0.0f, 1.0f, "%.3f");
+      ImGui::Checkbox("I_d", &ip.useDepth);
+      ImGui::SameLine();
+      ImGui::Checkbox("I_per", &ip.usePeriphery);
+      ImGui::SameLine();
+      ImGui::Checkbox("I_f", &ip.useFresnel);
+      ImGui::SameLine();
+      ImGui::Checkbox("noise", &ip.useNoise);
+    }
+    if (checkMethodOption(MethodOption::Model, m)) {
+      static char path[1024] = "";
+      if (!ImGui::IsAnyItemActive()) std::snprintf(path, sizeof path, "%s", s.model.c_str());
+      if (ImGui::InputText("--model (Enter)", path, sizeof path,
+                           ImGuiInputTextFlags_EnterReturnsTrue))
+        s.model = path;
+    }
+  }
 
   // view
   ImGui::Separator();
@@ -64,6 +99,8 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
 
   // statistics
   ImGui::Separator();
+  if (!info.notice.empty())
+    ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", info.notice.c_str());
   if (f && !f->error.empty())
     ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", f->error.c_str());
   if (f && f->stats) {
@@ -77,6 +114,8 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
     } else {
       ImGui::Text("memory %s (no budget)", formatBytes(st.bytesUsed).c_str());
     }
+    for (const auto& [category, bytes] : st.bytesByCategory)
+      ImGui::Text("  %-20s %s", category.c_str(), formatBytes(bytes).c_str());
     ImGui::Text("fragments %llu  captured %llu",
                 static_cast<unsigned long long>(st.fragmentsGenerated),
                 static_cast<unsigned long long>(st.captured));
@@ -92,7 +131,16 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
 
   // camera and actions
   ImGui::Separator();
-  ImGui::TextWrapped("left drag: orbit, right drag: pan, wheel: zoom");
+  ImGui::TextWrapped(
+      "left drag: orbit, right drag: pan, wheel: zoom, WASD: fly, Q/E: down/up, "
+      "[ ]: previous/next file camera, R: reset");
+  if (info.fileCameras > 0) {
+    ImGui::Text("file camera %d of %d", info.fileCamera, info.fileCameras);
+    ImGui::SameLine();
+    if (ImGui::Button("<")) requests.nextCamera = -1;
+    ImGui::SameLine();
+    if (ImGui::Button(">")) requests.nextCamera = 1;
+  }
   float fov = s.camera.camera().fovYDegrees;
   if (ImGui::SliderFloat("fov", &fov, 5.0f, 120.0f, "%.1f")) s.camera.setFov(fov);
   if (ImGui::Button("reset camera")) s.camera.reset();

@@ -2,6 +2,7 @@
 // live statistics and the screenshot / copy-command buttons. It edits the settings in place.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,11 +17,16 @@ struct PanelInfo {
   int width = 0, height = 0;
   const Frame* frame = nullptr;
   double frameMs = 0.0;  // last frame, wall time
+  int fileCameras = 0;   // the scene file's cameras
+  int fileCamera = -1;   // the one last chosen (-1: none)
+  std::string notice;    // one line: a scene that did not open
 };
 
 struct PanelRequests {
   bool screenshot = false;
   bool copyCommand = false;
+  int nextCamera = 0;                 // +1 / -1: the next / previous file camera
+  std::optional<double> budgetShare;  // of the exact A-buffer's bytes
 };
 
 /// Every preset the viewer offers: presetNames() and their +occupancy forms.

@@ -84,6 +84,56 @@ Result<void> applyStep(const nlohmann::json& step, ViewSettings& s, FrameActions
       if (!value.is_array() || value.size() != 2 || !value[0].is_number() || !value[1].is_number())
         return makeError("\"pan\": expected [dx, dy]");
       s.camera.pan(value[0].get<float>(), value[1].get<float>());
+    } else if (key == "fly") {
+      if (!value.is_array() || value.size() != 3 || !value[0].is_number() ||
+          !value[1].is_number() || !value[2].is_number())
+        return makeError("\"fly\": expected [right, up, forward]");
+      s.camera.fly(value[0].get<float>(), value[1].get<float>(), value[2].get<float>());
+    } else if (key == "file_camera") {
+      MFR_VIEW_GET(n, number(value, key));
+      if (!(n >= 0.0 && n < 1e6)) return makeError("\"file_camera\": expected a camera index");
+      actions.fileCamera = static_cast<int>(n);
+    } else if (key == "next_camera") {
+      MFR_VIEW_GET(n, number(value, key));
+      if (n != 1.0 && n != -1.0) return makeError("\"next_camera\": expected 1 or -1");
+      actions.nextCamera = static_cast<int>(n);
+    } else if (key == "open") {
+      MFR_VIEW_GET(path, text(value, key));
+      actions.open = path;
+    } else if (key == "occupancy_d") {
+      MFR_VIEW_GET(d, number(value, key));
+      if (!(d >= 0.0 && d <= 64.0)) return makeError("\"occupancy_d\": must be in [0, 64]");
+      s.occupancyD = static_cast<int>(d);
+    } else if (key == "model") {
+      MFR_VIEW_GET(path, text(value, key));
+      s.model = path;
+    } else if (key == "importance") {
+      if (!value.is_object()) return makeError("\"importance\": expected an object");
+      for (const auto& [name, v] : value.items()) {
+        float* param = name == "alpha"         ? &s.importance.alpha
+                       : name == "n_limit"     ? &s.importance.nLimit
+                       : name == "periphery_d" ? &s.importance.peripheryExponent
+                       : name == "noise"       ? &s.importance.noise
+                                               : nullptr;
+        bool* flag = name == "depth"        ? &s.importance.useDepth
+                     : name == "periphery"  ? &s.importance.usePeriphery
+                     : name == "fresnel"    ? &s.importance.useFresnel
+                     : name == "noise_term" ? &s.importance.useNoise
+                                            : nullptr;
+        if (param) {
+          MFR_VIEW_GET(x, number(v, "importance." + name));
+          *param = static_cast<float>(x);
+        } else if (flag) {
+          if (!v.is_boolean()) return makeError("\"importance." + name + "\": expected a boolean");
+          *flag = v.get<bool>();
+        } else {
+          return makeError("\"importance\": unknown parameter \"" + name + "\"");
+        }
+      }
+    } else if (key == "budget_share") {
+      MFR_VIEW_GET(share, number(value, key));
+      if (!(share >= 0.0 && share <= 1000.0)) return makeError("\"budget_share\": out of range");
+      actions.budgetShare = share;
     } else if (key == "reset") {
       s.camera.reset();
     } else if (key == "compare") {

@@ -3,8 +3,14 @@
 namespace mfr::view {
 
 std::string ViewSettings::methodKey() const {
+  const ImportanceParams& ip = importance;
   return method + "|" + composite + "|" + std::to_string(budgetBytes) + "|" + std::to_string(k) +
-         "|" + camera.spec();
+         "|" + std::to_string(occupancyD) + "|" + std::to_string(ip.alpha) + "," +
+         std::to_string(ip.nLimit) + "," + std::to_string(ip.peripheryExponent) + "," +
+         std::to_string(ip.noise) + "," + std::to_string(ip.seed) + "," +
+         std::to_string(ip.useDepth) + std::to_string(ip.usePeriphery) +
+         std::to_string(ip.useFresnel) + std::to_string(ip.useNoise) + "|" + model + "|" +
+         camera.spec();
 }
 
 std::string ViewSettings::displayKey() const {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <string>
 
+#include "mfr/method/importance.hpp"
 #include "orbit_camera.hpp"
 #include "view_mode.hpp"
 
@@ -15,13 +16,16 @@ struct ViewSettings {
   std::string composite;           // empty: the preset's own rule; else kbuffer or hybrid
   uint64_t budgetBytes = 0;        // 0: no budget
   uint32_t k = 0;                  // 0: derived from the budget
+  int occupancyD = 0;              // +occupancy presets: bucket words d (0: the preset's)
+  ImportanceParams importance;     // vkb*: Eq. 3-6 parameters and factor switches
+  std::string model;               // dkb*: a .mfrnn network (empty: the built-in one)
   ViewMode mode = ViewMode::Image;
   float wiper = 0.5f;   // split position of the wiper view, share of the width
   bool compare = true;  // render the exact A-buffer for mean FLIP and PSNR (always for its views)
   OrbitCamera camera;
 
   explicit ViewSettings(const Camera& start) : camera(start) {}
-  /// The key of the method's render (method, rule, budget, k, camera).
+  /// The key of the method's render (method, rule, budget, k, method parameters, camera).
   std::string methodKey() const;
   /// The key of what the image area shows (the render plus the view mode and wiper).
   std::string displayKey() const;

@@ -6,6 +6,10 @@
 #include <cstdio>
 #include <deque>
 #include <fstream>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include <GLFW/glfw3.h>
 #include <imgui.h>
@@ -18,6 +22,7 @@
 #include "image_texture.hpp"
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/units.hpp"
+#include "mfr/method/method.hpp"
 #include "panel.hpp"
 #include "script.hpp"
 
@@ -27,9 +32,14 @@ namespace {
 
 constexpr int kPanelWidth = 380;
 std::string glfwLastError;
+std::vector<std::string> droppedPaths;  // files dropped on the window since the last frame
 
 void onGlfwError(int, const char* description) {
   glfwLastError = description ? description : "?";
+}
+
+void onDrop(GLFWwindow*, int count, const char** paths) {
+  for (int i = 0; i < count; ++i) droppedPaths.emplace_back(paths[i]);
 }
 
 int failNoWindow(const std::string& what) {
@@ -44,16 +54,63 @@ std::string shellQuote(const std::string& text) {
   return quoted + "'";
 }
 
-std::string renderCommand(const ViewerArgs& a, const ViewSettings& s) {
-  std::string cmd = "mfr render " + shellQuote(a.scene.source) + " --engine " + a.scene.engine +
-                    " --method " + s.method;
+std::string number(float x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", x);
+  return text;
+}
+
+/// render's options for the preset's own parameters that differ from their defaults.
+std::string methodParameters(const ViewSettings& s) {
+  std::string cmd;
+  auto preset = methodPreset(s.method);
+  if (!preset) return cmd;
+  const MethodDesc& m = preset.value();
+  if (m.occupancyWords > 0 && s.occupancyD > 0)
+    cmd += " --occupancy-d " + std::to_string(s.occupancyD);
+  if (m.allocation == AllocationPolicy::Importance) {
+    const ImportanceParams ip = s.importance, d{};
+    if (ip.alpha != d.alpha) cmd += " --importance-alpha " + number(ip.alpha);
+    if (ip.nLimit != d.nLimit) cmd += " --n-limit " + number(ip.nLimit);
+    if (ip.peripheryExponent != d.peripheryExponent)
+      cmd += " --periphery-d " + number(ip.peripheryExponent);
+    if (ip.noise != d.noise) cmd += " --noise " + number(ip.noise);
+    if (!ip.useDepth) cmd += " --no-depth-term";
+    if (!ip.usePeriphery) cmd += " --no-periphery-term";
+    if (!ip.useFresnel) cmd += " --no-fresnel-term";
+    if (!ip.useNoise) cmd += " --no-noise";
+  }
+  if (!s.model.empty()) cmd += " --model " + shellQuote(s.model);
+  return cmd;
+}
+
+std::string renderCommand(const cli::SceneOptions& a, const ViewSettings& s) {
+  std::string cmd =
+      "mfr render " + shellQuote(a.source) + " --engine " + a.engine + " --method " + s.method;
   if (!s.composite.empty()) cmd += " --composite " + s.composite;
   if (s.budgetBytes > 0) cmd += " --budget " + std::to_string(s.budgetBytes);
   if (s.k > 0) cmd += " --k " + std::to_string(s.k);
-  if (a.scene.alpha) cmd += " --alpha " + std::to_string(*a.scene.alpha);
-  if (a.scene.seed != 1) cmd += " --seed " + std::to_string(a.scene.seed);
-  cmd += " --width " + std::to_string(a.scene.width) + " --height " +
-         std::to_string(a.scene.height) + " --camera " + s.camera.spec() + " -o view.png";
+  cmd += methodParameters(s);
+  if (a.alpha) cmd += " --alpha " + std::to_string(*a.alpha);
+  if (a.seed != 1) cmd += " --seed " + std::to_string(a.seed);
+  cmd += " --width " + std::to_string(a.width) + " --height " + std::to_string(a.height) +
+         " --camera " + s.camera.spec() + " -o view.png";
+  return cmd;
+}
+
+/// The `mfr compare` line of the same view: the current method at the current budget (compare
+/// needs a budget: without one, the exact A-buffer's bytes). compare has no --k: k is left out.
+std::string compareCommand(const cli::SceneOptions& a, const ViewSettings& s, uint64_t truthBytes) {
+  const uint64_t budget = s.budgetBytes > 0 ? s.budgetBytes : truthBytes;
+  std::string cmd =
+      "mfr compare " + shellQuote(a.source) + " --engine " + a.engine + " --methods " + s.method;
+  if (!s.composite.empty()) cmd += " --composite " + s.composite;
+  if (!s.model.empty()) cmd += " --model " + shellQuote(s.model);
+  if (budget > 0) cmd += " --budget " + std::to_string(budget);
+  if (a.alpha) cmd += " --alpha " + std::to_string(*a.alpha);
+  if (a.seed != 1) cmd += " --seed " + std::to_string(a.seed);
+  cmd += " --width " + std::to_string(a.width) + " --height " + std::to_string(a.height) +
+         " --camera " + s.camera.spec() + " -o compare";
   return cmd;
 }
 
@@ -63,6 +120,8 @@ nlohmann::json statsEntry(int frame, const ViewSettings& s, const Frame& f) {
   j["method"] = s.method;
   j["mode"] = viewModeName(s.mode);
   j["budget_bytes"] = s.budgetBytes;
+  j["camera"] = s.camera.spec();
+  j["truth_bytes"] = f.truthBytes;
   j["error"] = f.error;
   j["update_ms"] = f.renderMs;
   j["display_width"] = f.display.width;
@@ -75,6 +134,7 @@ nlohmann::json statsEntry(int frame, const ViewSettings& s, const Frame& f) {
     j["k_min"] = f.stats->kMin;
     j["k_max"] = f.stats->kMax;
     j["passes_ms"] = f.stats->totalMs();
+    j["bytes_by_category"] = f.stats->bytesByCategory;
   }
   if (f.flipMean) j["flip_mean"] = *f.flipMean;
   if (f.psnr && std::isfinite(*f.psnr)) j["psnr"] = *f.psnr;
@@ -89,8 +149,11 @@ int runViewer(const ViewerArgs& a) {
     return 0;
   }
   // the options first, with render's errors
-  auto prepared = cli::prepareScene(a.scene);
-  if (!prepared) return cli::fail(prepared.error().message);
+  auto preparedResult = cli::prepareScene(a.scene);
+  if (!preparedResult) return cli::fail(preparedResult.error().message);
+  auto prepared = std::make_unique<cli::PreparedScene>(std::move(preparedResult.value()));
+  cli::SceneOptions sceneOptions = a.scene;  // of the scene shown (a dropped file replaces it)
+  int fileCamera = a.scene.view;
   ViewSettings settings(prepared->cameras.front());
   settings.method = a.method;
   settings.composite = a.composite;
@@ -100,6 +163,9 @@ int runViewer(const ViewerArgs& a) {
     settings.budgetBytes = budget.value();
   }
   if (a.k) settings.k = *a.k;
+  settings.occupancyD = a.occupancyD;
+  settings.model = a.model;
+  settings.importance.seed = a.scene.seed;  // as render's ImportanceParams
   auto mode = parseViewMode(a.mode);
   if (!mode)
     return cli::fail("--mode '" + a.mode +
@@ -149,10 +215,12 @@ int runViewer(const ViewerArgs& a) {
   ImGui::StyleColorsDark();
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   ImGui_ImplOpenGL3_Init("#version 330");
+  glfwSetDropCallback(window, onDrop);
 
   int exitCode = 0;
   {
-    FrameRenderer renderer(**engine, engineContext, window, *prepared, a.scene);
+    auto renderer =
+        std::make_unique<FrameRenderer>(**engine, engineContext, window, *prepared, sceneOptions);
     ImageTexture texture;
     Frame frame;
     std::string shownKey;
@@ -161,6 +229,46 @@ int runViewer(const ViewerArgs& a) {
     size_t step = 0;
     double frameMs = 0.0;
     int screenshotCount = 0;
+    std::map<int, bool> keysDown;
+    std::string notice;  // a scene that did not open, or a file camera that does not exist
+    // the file camera `index` of the scene, with --zoom as `mfr render --view` applies it
+    auto chooseFileCamera = [&](int index) {
+      const std::vector<Camera>& cameras = prepared->scene.cameras;
+      if (index < 0 || index >= static_cast<int>(cameras.size())) {
+        notice = sceneOptions.source + ": no camera " + std::to_string(index) + ", the scene has " +
+                 std::to_string(cameras.size()) + " camera(s)";
+        return false;
+      }
+      Camera camera = cameras[index];
+      camera.eye = camera.target + (camera.eye - camera.target) / static_cast<float>(a.scene.zoom);
+      settings.camera.restart(camera);
+      fileCamera = index;
+      notice.clear();
+      return true;
+    };
+    // a dropped (or scripted) scene file replaces the scene; on an error the old one stays
+    auto openScene = [&](const std::string& path) {
+      cli::SceneOptions o = sceneOptions;
+      o.source = path;
+      o.view = -1;
+      o.camera.clear();
+      o.orbit = 0;
+      o.orbitView = -1;
+      auto loaded = cli::prepareScene(o);
+      if (!loaded) {
+        notice = loaded.error().message;
+        return;
+      }
+      renderer.reset();  // it refers to the old scene
+      *prepared = std::move(loaded.value());
+      sceneOptions = o;
+      renderer =
+          std::make_unique<FrameRenderer>(**engine, engineContext, window, *prepared, sceneOptions);
+      settings.camera.restart(prepared->cameras.front());
+      fileCamera = -1;
+      shownKey.clear();
+      notice.clear();
+    };
     for (int n = 0; !glfwWindowShouldClose(window); ++n) {
       const auto start = std::chrono::steady_clock::now();
       if (scripted)
@@ -174,11 +282,31 @@ int runViewer(const ViewerArgs& a) {
           break;
         }
       }
+      for (const std::string& path : droppedPaths) actions.open = path;  // the last one dropped
+      droppedPaths.clear();
       ImGui_ImplOpenGL3_NewFrame();
       ImGui_ImplGlfw_NewFrame();
       ImGui::NewFrame();
       const ImGuiIO& io = ImGui::GetIO();
       if (glfwGetKey(window, GLFW_KEY_ESCAPE) == GLFW_PRESS) glfwSetWindowShouldClose(window, 1);
+      auto pressed = [&](int key) {  // went down since the last frame
+        const bool isDown = glfwGetKey(window, key) == GLFW_PRESS;
+        const bool was = keysDown[key];
+        keysDown[key] = isDown;
+        return isDown && !was;
+      };
+      if (!io.WantCaptureKeyboard) {  // WASD fly, Q/E down/up, [ ] file cameras, R reset
+        auto down = [&](int key) { return glfwGetKey(window, key) == GLFW_PRESS ? 1.0f : 0.0f; };
+        const float flyStep = 0.5f * static_cast<float>(std::min(frameMs, 100.0) / 1000.0);
+        const float right = down(GLFW_KEY_D) - down(GLFW_KEY_A);
+        const float up = down(GLFW_KEY_E) - down(GLFW_KEY_Q);
+        const float forward = down(GLFW_KEY_W) - down(GLFW_KEY_S);
+        if (right != 0.0f || up != 0.0f || forward != 0.0f)
+          settings.camera.fly(right * flyStep, up * flyStep, forward * flyStep);
+        if (pressed(GLFW_KEY_RIGHT_BRACKET)) actions.nextCamera = 1;
+        if (pressed(GLFW_KEY_LEFT_BRACKET)) actions.nextCamera = -1;
+        if (pressed(GLFW_KEY_R)) settings.camera.reset();
+      }
       if (!io.WantCaptureMouse && io.MousePos.x < w) {  // the camera, on the image
         if (ImGui::IsMouseDragging(ImGuiMouseButton_Left, 0.0f))
           settings.camera.orbit(-0.3f * io.MouseDelta.x, 0.3f * io.MouseDelta.y);
@@ -189,25 +317,53 @@ int runViewer(const ViewerArgs& a) {
       }
       int fbW = 0, fbH = 0;
       glfwGetFramebufferSize(window, &fbW, &fbH);
-      PanelInfo info{a.scene.source, a.scene.engine, w, h, &frame, frameMs};
+      PanelInfo info{sceneOptions.source,
+                     sceneOptions.engine,
+                     w,
+                     h,
+                     &frame,
+                     frameMs,
+                     static_cast<int>(prepared->scene.cameras.size()),
+                     fileCamera,
+                     notice};
       const PanelRequests requests = drawPanel(static_cast<float>(w), static_cast<float>(fbW - w),
                                                static_cast<float>(fbH), settings, info);
+      if (requests.nextCamera != 0) actions.nextCamera = requests.nextCamera;
+      if (requests.budgetShare) actions.budgetShare = requests.budgetShare;
+      if (!actions.open.empty()) openScene(actions.open);
+      if (actions.fileCamera && !chooseFileCamera(*actions.fileCamera) && !steps.empty()) {
+        exitCode = cli::fail("--script: " + notice);
+        break;
+      }
+      if (actions.nextCamera != 0 && !prepared->scene.cameras.empty()) {
+        const int count = static_cast<int>(prepared->scene.cameras.size());
+        chooseFileCamera(fileCamera < 0 ? (actions.nextCamera > 0 ? 0 : count - 1)
+                                        : (fileCamera + actions.nextCamera + count) % count);
+      }
+      if (actions.budgetShare) {
+        if (frame.truthBytes > 0)
+          settings.budgetBytes = static_cast<uint64_t>(
+              std::llround(*actions.budgetShare * static_cast<double>(frame.truthBytes)));
+        else
+          notice = "budget share: the exact A-buffer is not rendered (compare is off)";
+      }
       bool updated = false;
       // while the camera is dragged, skip the A-buffer and FLIP (rendered again on release)
       ViewSettings shown = settings;
       if (ImGui::IsMouseDown(ImGuiMouseButton_Left) || ImGui::IsMouseDown(ImGuiMouseButton_Right))
         shown.compare = shown.compare && io.WantCaptureMouse;
       if (shown.displayKey() != shownKey) {  // re-render only what changed
-        frame = renderer.update(shown);
+        frame = renderer->update(shown);
         shownKey = shown.displayKey();
         texture.upload(frame.display);
         renders.push_back(statsEntry(n, settings, frame));
         updated = true;
       }
       if (requests.copyCommand || actions.copyCommand) {
-        const std::string cmd = renderCommand(a, settings);
-        glfwSetClipboardString(window, cmd.c_str());
-        std::printf("%s\n", cmd.c_str());
+        const std::string cmd = renderCommand(sceneOptions, settings);
+        const std::string compare = compareCommand(sceneOptions, settings, frame.truthBytes);
+        glfwSetClipboardString(window, (cmd + "\n" + compare).c_str());
+        std::printf("%s\n%s\n", cmd.c_str(), compare.c_str());
         std::fflush(stdout);
       }
       if (requests.screenshot)
@@ -235,6 +391,9 @@ int runViewer(const ViewerArgs& a) {
           break;
         }
         nlohmann::json j = statsEntry(n, settings, frame);
+        j["scene"] = sceneOptions.source;
+        j["file_camera"] = fileCamera;
+        j["notice"] = notice;
         j["path"] = path;
         j["ui"] = ui;
         j["width"] = shot.width;

@@ -15,6 +15,8 @@ struct ViewerArgs {
   std::string budget;
   std::optional<uint32_t> k;
   std::string composite;
+  int occupancyD = 0;  // 0: the preset's
+  std::string model;
   std::string mode = "image";
   int frames = 0;  // 0: interactive (until the window closes or the script ends)
   std::string screenshot;
