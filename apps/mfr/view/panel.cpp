@@ -116,6 +116,15 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
     }
     for (const auto& [category, bytes] : st.bytesByCategory)
       ImGui::Text("  %-20s %s", category.c_str(), formatBytes(bytes).c_str());
+    // F(M) (DHOIT Eq. 1): the node slots the budget buys once the per-pixel words are paid
+    const auto nodes = st.bytesByCategory.find("nodes");
+    if (st.budgetBytes && nodes != st.bytesByCategory.end() && st.fragmentSlots > 0 &&
+        st.bytesUsed - nodes->second <= *st.budgetBytes) {
+      const uint64_t nodeBytes = nodes->second / st.fragmentSlots;
+      const uint64_t fm = (*st.budgetBytes - (st.bytesUsed - nodes->second)) / nodeBytes;
+      ImGui::Text("F(M) %llu node slots, %llu allocated", static_cast<unsigned long long>(fm),
+                  static_cast<unsigned long long>(st.fragmentSlots));
+    }
     ImGui::Text("fragments %llu  captured %llu",
                 static_cast<unsigned long long>(st.fragmentsGenerated),
                 static_cast<unsigned long long>(st.captured));
