@@ -64,4 +64,31 @@ Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 ba
   return out;
 }
 
+Result<OracleChoice> optimalK(const RasterFrame& frame, const MethodDesc& method,
+                              const RenderOptions& options, uint64_t slots) {
+  auto oracle =
+      frameErrorCurves(frame, options.background, method.compositing, options.memoryLimitBytes);
+  if (!oracle) return makeError(method.name + ": the oracle's pre-pass: " + oracle.error().message);
+  OracleChoice out;
+  out.bytesAllocated = oracle->bytesAllocated;
+  if (slots < oracle->coveredPixels) {
+    out.n = std::move(oracle->n);
+    return out;
+  }
+  OracleOptions oo;
+  oo.publishedGreedy = method.publishedGreedy;
+  OracleAllocation a = allocateOptimal(oracle->curves, slots, oo);
+  OracleReport& r = out.report.emplace();
+  r.error = a.error;
+  r.lowerBound = a.lowerBound;
+  r.lagrangianBound = a.lagrangianBound;
+  r.exact = a.exact;
+  r.solver = a.solver;
+  r.nonconvexPixels = a.nonconvexPixels;
+  r.corePixels = a.corePixels;
+  out.n = std::move(oracle->n);
+  out.k = std::move(a.k);
+  return out;
+}
+
 }  // namespace mfr

@@ -103,42 +103,6 @@ ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method, const Alloc
   return image;
 }
 
-// The optimal k-buffer's pre-pass: n(p) and the oracle's k(p) with its bound over the error
-// curves of the method's compositing rule (no k when the budget cannot give every covered pixel
-// a slot: allocate() reports that).
-struct OracleChoice {
-  std::vector<uint32_t> n, k;
-  std::optional<OracleReport> report;
-  uint64_t bytesAllocated = 0;  // the pre-pass (A-buffer, error curves)
-};
-
-Result<OracleChoice> optimalK(const RasterFrame& frame, const MethodDesc& method,
-                              const RenderOptions& options, uint64_t slots) {
-  auto oracle =
-      frameErrorCurves(frame, options.background, method.compositing, options.memoryLimitBytes);
-  if (!oracle) return makeError(method.name + ": the oracle's pre-pass: " + oracle.error().message);
-  OracleChoice out;
-  out.bytesAllocated = oracle->bytesAllocated;
-  if (slots < oracle->coveredPixels) {
-    out.n = std::move(oracle->n);
-    return out;
-  }
-  OracleOptions oo;
-  oo.publishedGreedy = method.publishedGreedy;
-  OracleAllocation a = allocateOptimal(oracle->curves, slots, oo);
-  OracleReport& r = out.report.emplace();
-  r.error = a.error;
-  r.lowerBound = a.lowerBound;
-  r.lagrangianBound = a.lagrangianBound;
-  r.exact = a.exact;
-  r.solver = a.solver;
-  r.nonconvexPixels = a.nonconvexPixels;
-  r.corePixels = a.corePixels;
-  out.n = std::move(oracle->n);
-  out.k = std::move(a.k);
-  return out;
-}
-
 }  // namespace
 
 std::vector<float> nearestCosine(const RasterFrame& frame) {

@@ -43,14 +43,8 @@ double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The optimal k-buffer's k(p) from the CPU engine's oracle on the same view (render.cpp
-// optimalK): the A-buffer pre-pass, the error curves of the method's rule, the allocation; no k
-// when the budget cannot give every covered pixel a slot (allocate() reports that).
-struct OracleChoice {
-  std::vector<uint32_t> n, k;
-  std::optional<OracleReport> report;
-};
-
+// The optimal k-buffer's k(p) from the CPU engine's oracle (optimalK, mfr/cpu/optimal_oracle.hpp)
+// on the same view.
 Result<OracleChoice> cpuOracle(const View& view, const MethodDesc& method,
                                const RenderOptions& options, uint64_t slots) {
   RasterOptions ro;
@@ -58,26 +52,7 @@ Result<OracleChoice> cpuOracle(const View& view, const MethodDesc& method,
   ro.height = view.height;
   auto frame = RasterFrame::build(*view.scene, view.camera, ro);
   if (!frame) return frame.error();
-  auto oracle =
-      frameErrorCurves(*frame, options.background, method.compositing, options.memoryLimitBytes);
-  if (!oracle) return makeError(method.name + ": the oracle's pre-pass: " + oracle.error().message);
-  OracleChoice out;
-  if (slots >= oracle->coveredPixels) {
-    OracleOptions oo;
-    oo.publishedGreedy = method.publishedGreedy;
-    OracleAllocation a = allocateOptimal(oracle->curves, slots, oo);
-    OracleReport& r = out.report.emplace();
-    r.error = a.error;
-    r.lowerBound = a.lowerBound;
-    r.lagrangianBound = a.lagrangianBound;
-    r.exact = a.exact;
-    r.solver = a.solver;
-    r.nonconvexPixels = a.nonconvexPixels;
-    r.corePixels = a.corePixels;
-    out.k = std::move(a.k);
-  }
-  out.n = std::move(oracle->n);
-  return out;
+  return optimalK(*frame, method, options, slots);
 }
 
 class GlRenderEngine final : public Engine {

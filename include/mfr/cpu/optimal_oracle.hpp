@@ -12,6 +12,7 @@
 #include "mfr/core/result.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/method/method.hpp"
+#include "mfr/method/render_output.hpp"
 
 namespace mfr {
 
@@ -30,5 +31,18 @@ struct FrameErrorCurves {
 Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 background,
                                           Compositing compositing = Compositing::Hybrid,
                                           std::optional<uint64_t> memoryLimitBytes = std::nullopt);
+
+/// The optimal k-buffer's pre-pass and allocation, as both engines run it: n(p) and the oracle's
+/// k(p) with its bound over the error curves of the method's compositing rule, for `slots` = F(M)
+/// node slots (no k when the budget cannot give every covered pixel a slot: allocate() reports
+/// that). The GL engine takes its k(p) from here too (the oracle is a CPU pass).
+struct OracleChoice {
+  std::vector<uint32_t> n, k;
+  std::optional<OracleReport> report;
+  uint64_t bytesAllocated = 0;  // the pre-pass (A-buffer, error curves)
+};
+
+Result<OracleChoice> optimalK(const RasterFrame& frame, const MethodDesc& method,
+                              const RenderOptions& options, uint64_t slots);
 
 }  // namespace mfr
