@@ -207,14 +207,9 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
   // the same camera unless the caller hands one over), then the map
   if (deep) {
     if (!options.budgetBytes) return makeError(method.name + ": needs a budget");
-    std::shared_ptr<const learn::Model> model = method.model;
-    if (!model) {
-      auto builtin = builtinDkbModel();
-      if (!builtin) return builtin.error();
-      model = builtin.value();
-    } else if (auto fits = checkDkbModel(*model, "of " + method.name); !fits) {
-      return fits.error();
-    }
+    auto resolved = dkbModelFor(method);
+    if (!resolved) return resolved.error();
+    const std::shared_ptr<const learn::Model> model = std::move(resolved.value());
     // features and inference run fused per tile; the wall time is split between the two passes
     // in proportion to their CPU time
     double featureCpu = 0.0, inferenceCpu = 0.0;

@@ -137,14 +137,9 @@ class GlRenderEngine final : public Engine {
       }
       if (deep) {  // the deep k-buffer: features and network on GL (dkb_infer.comp)
         if (!options.budgetBytes) return makeError(method.name + ": needs a budget");
-        std::shared_ptr<const learn::Model> model = method.model;
-        if (!model) {
-          auto builtin = builtinDkbModel();
-          if (!builtin) return builtin.error();
-          model = builtin.value();
-        } else if (auto fits = checkDkbModel(*model, "of " + method.name); !fits) {
-          return fits.error();
-        }
+        auto resolved = dkbModelFor(method);
+        if (!resolved) return resolved.error();
+        const std::shared_ptr<const learn::Model> model = std::move(resolved.value());
         std::vector<float> weights;
         for (size_t l = 0; l < model->net.weights.size(); ++l) {
           const auto& w = model->net.weights[l];

@@ -65,4 +65,10 @@ Result<std::shared_ptr<const learn::Model>> builtinDkbModel() {
   return cached;
 }
 
+Result<std::shared_ptr<const learn::Model>> dkbModelFor(const MethodDesc& method) {
+  if (!method.model) return builtinDkbModel();
+  if (auto fits = checkDkbModel(*method.model, "of " + method.name); !fits) return fits.error();
+  return method.model;
+}
+
 }  // namespace mfr

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "mfr/core/result.hpp"
+#include "mfr/method/method.hpp"
 
 namespace mfr {
 
@@ -23,5 +24,9 @@ Result<void> checkDkbModel(const learn::Model& model, const std::string& name);
 /// decoded once. An error when the build had no model file, or when the model does not declare
 /// both kDkbFeatureSet and learn::kDkbTargetScaling (stale against the code: retrain it).
 Result<std::shared_ptr<const learn::Model>> builtinDkbModel();
+
+/// The model a deep k-buffer method runs: its own (MethodDesc::model, checked with
+/// checkDkbModel) or else the built-in one. Both engines take it from here.
+Result<std::shared_ptr<const learn::Model>> dkbModelFor(const MethodDesc& method);
 
 }  // namespace mfr
