@@ -33,5 +33,5 @@ target_compile_definitions(mfr_cli PRIVATE MFR_HAS_VIEW=1)
 if(MFR_BUILD_TESTS)
   add_test(NAME ViewerUnderXvfb
     COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/tests/view_test.sh $<TARGET_FILE:mfr_cli>)
-  set_tests_properties(ViewerUnderXvfb PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 180)
+  set_tests_properties(ViewerUnderXvfb PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 400)
 endif()

@@ -193,6 +193,39 @@ print(f"ok: file cameras, fly, open (a bad one: {bad['notice']}), occupancy d, v
 PY
 echo "ok: file cameras, fly, open, occupancy d, vkb == mfr render; compare line runs: $compare"
 
+# (f) every map in one action, the vkb fovea, and renders on the worker thread
+"$MFR" render procedural:layers --engine gl --method vkb --budget 1MB --width $S --height $S \
+  --fovea 20,30 -q -o fov_ref.png --k-map fov_kmap.png --importance-map fov_imp.png \
+  --depth-complexity fov_depth.png
+"$MFR" render procedural:layers --engine gl --method vkb --budget 1MB --width $S --height $S \
+  -q -o centre_ref.png
+cat >maps.json <<'JSON'
+[{"method": "vkb", "budget": "1MB", "importance": {"fovea": [20, 30]}},
+ {"copy_command": true, "screenshot_maps": "fov"},
+ {"importance": {"fovea": null}, "screenshot": "centre.png"}]
+JSON
+for thread in off on; do
+  rm -f fov-*.png centre.png
+  "$MFR" view procedural:layers --width $S --height $S --script maps.json --render-thread $thread \
+    --stats-json maps_$thread.json >maps_cmd.txt
+  cmp fov-image.png fov_ref.png || { echo "FAIL: maps ($thread): image != render --fovea"; exit 1; }
+  cmp fov-kmap.png fov_kmap.png || { echo "FAIL: maps ($thread): kmap != render --k-map"; exit 1; }
+  cmp fov-importance.png fov_imp.png ||
+    { echo "FAIL: maps ($thread): importance != render --importance-map"; exit 1; }
+  cmp fov-depth.png fov_depth.png ||
+    { echo "FAIL: maps ($thread): depth != render --depth-complexity"; exit 1; }
+  for m in truth flip; do [ -s fov-$m.png ] || { echo "FAIL: maps: no fov-$m.png"; exit 1; }; done
+  cmp centre.png centre_ref.png || { echo "FAIL: fovea null ($thread) != image centre"; exit 1; }
+  ! cmp -s fov_ref.png centre_ref.png || { echo "FAIL: the fovea changes nothing"; exit 1; }
+  grep -q -- "--fovea 20,30" maps_cmd.txt || { echo "FAIL: copied command lacks --fovea"; exit 1; }
+done
+"$MFR" view procedural:layers --width $S --height $S --method fkb --budget 256KB --frames 2 \
+  --render-thread on --screenshot thread.png
+"$MFR" render procedural:layers --engine gl --method fkb --budget 256KB --width $S --height $S \
+  -q -o thread_ref.png
+cmp thread.png thread_ref.png || { echo "FAIL: --render-thread on --frames != render"; exit 1; }
+echo "ok: screenshot_maps == render's image/k-map/importance/depth maps; --fovea; render thread"
+
 # (c) the window with its panel
 "$MFR" view procedural:layers --width $S --height $S --method kplus-array --budget 200KB \
   --mode wiper --frames 3 --screenshot ui.png --screenshot-ui

@@ -35,6 +35,10 @@ Runner addViewCommand(CLI::App& app) {
   cmd->add_flag("--screenshot-ui", args->screenshotUi, "--screenshot includes the panel");
   cmd->add_option("--script", args->script,
                   "JSON list of UI actions applied one per frame (see apps/mfr/view/script.hpp)");
+  cmd->add_option("--render-thread", args->renderThread,
+                  "Render on a worker thread so the window stays responsive: on, off or auto "
+                  "(default: on when interactive, off for --frames/--script)")
+      ->check(CLI::IsMember({"on", "off", "auto"}));
   cmd->add_option("--stats-json", args->statsJson,
                   "At exit, write each render's and each screenshot's statistics as JSON");
   return [args] {

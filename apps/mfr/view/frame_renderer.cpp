@@ -86,6 +86,7 @@ FrameRenderer::FrameRenderer(Engine& engine, const EngineContext& context, GLFWw
     : engine_(engine),
       context_(context),
       window_(window),
+      windowThread_(std::this_thread::get_id()),
       scene_(scene),
       options_(options),
       cache_(std::make_unique<Cached>()) {}
@@ -101,7 +102,9 @@ Frame FrameRenderer::update(const ViewSettings& s) {
   Cached& c = *cache_;
   const int w = options_.width, h = options_.height;
   {
-    EngineContext::Scope scope(context_, window_);
+    // a worker leaves the window's context alone: it is current on the window's thread
+    EngineContext::Scope scope(context_,
+                               std::this_thread::get_id() == windowThread_ ? window_ : nullptr);
     RenderOptions ro;
     ro.background = scene_.scene.background;
     ro.memoryLimitBytes = options_.memoryLimitBytes().value();

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include "../common.hpp"
 #include "engine_context.hpp"
@@ -31,7 +32,9 @@ class FrameRenderer {
   FrameRenderer(Engine& engine, const EngineContext& context, GLFWwindow* window,
                 const cli::PreparedScene& scene, const cli::SceneOptions& options);
   ~FrameRenderer();
-  /// Renders what changed since the last call and composes the display of settings.mode.
+  /// Renders what changed since the last call and composes the display of settings.mode. Callable
+  /// from one thread at a time: on the window's thread, or on a worker while the window's thread
+  /// keeps its own context (the engine's context is made current on the calling thread).
   Frame update(const ViewSettings& settings);
 
  private:
@@ -39,6 +42,7 @@ class FrameRenderer {
   Engine& engine_;
   const EngineContext& context_;
   GLFWwindow* window_;
+  std::thread::id windowThread_;  // where the window's context lives (the constructing thread)
   const cli::PreparedScene& scene_;
   cli::SceneOptions options_;
   std::unique_ptr<Cached> cache_;

@@ -79,6 +79,15 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
       ImGui::Checkbox("I_f", &ip.useFresnel);
       ImGui::SameLine();
       ImGui::Checkbox("noise", &ip.useNoise);
+      bool fovea = ip.fovea.has_value();  // Eq. 4 o: the image centre unless placed
+      if (ImGui::Checkbox("fovea o (Eq. 4; ctrl+click the image)", &fovea))
+        ip.fovea = fovea
+                       ? std::optional<glm::vec2>(glm::vec2(0.5f * info.width, 0.5f * info.height))
+                       : std::nullopt;
+      if (ip.fovea) {
+        ImGui::SliderFloat("fovea x", &ip.fovea->x, 0.0f, static_cast<float>(info.width), "%.0f");
+        ImGui::SliderFloat("fovea y", &ip.fovea->y, 0.0f, static_cast<float>(info.height), "%.0f");
+      }
     }
     if (checkMethodOption(MethodOption::Model, m)) {
       static char path[1024] = "";
@@ -99,6 +108,7 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
 
   // statistics
   ImGui::Separator();
+  if (info.rendering) ImGui::TextColored(ImVec4(1.0f, 0.8f, 0.3f, 1.0f), "rendering ...");
   if (!info.notice.empty())
     ImGui::TextColored(ImVec4(1.0f, 0.4f, 0.4f, 1.0f), "%s", info.notice.c_str());
   if (f && !f->error.empty())
@@ -155,6 +165,8 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
   if (ImGui::Button("reset camera")) s.camera.reset();
   ImGui::SameLine();
   if (ImGui::Button("screenshot")) requests.screenshot = true;
+  ImGui::SameLine();
+  if (ImGui::Button("all maps")) requests.screenshotMaps = true;
   ImGui::SameLine();
   if (ImGui::Button("copy command")) requests.copyCommand = true;
   ImGui::End();

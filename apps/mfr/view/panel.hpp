@@ -16,14 +16,16 @@ struct PanelInfo {
   std::string engine;
   int width = 0, height = 0;
   const Frame* frame = nullptr;
-  double frameMs = 0.0;  // last frame, wall time
-  int fileCameras = 0;   // the scene file's cameras
-  int fileCamera = -1;   // the one last chosen (-1: none)
-  std::string notice;    // one line: a scene that did not open
+  double frameMs = 0.0;    // last frame, wall time
+  int fileCameras = 0;     // the scene file's cameras
+  int fileCamera = -1;     // the one last chosen (-1: none)
+  std::string notice;      // one line: a scene that did not open
+  bool rendering = false;  // a render of newer settings is in flight (the image is the last one)
 };
 
 struct PanelRequests {
   bool screenshot = false;
+  bool screenshotMaps = false;  // the image and every map of the current settings
   bool copyCommand = false;
   int nextCamera = 0;                 // +1 / -1: the next / previous file camera
   std::optional<double> budgetShare;  // of the exact A-buffer's bytes

@@ -120,7 +120,16 @@ Result<void> applyStep(const nlohmann::json& step, ViewSettings& s, FrameActions
                      : name == "fresnel"    ? &s.importance.useFresnel
                      : name == "noise_term" ? &s.importance.useNoise
                                             : nullptr;
-        if (param) {
+        if (name == "fovea") {  // [x, y] in pixels, or null for the image centre
+          if (v.is_null()) {
+            s.importance.fovea.reset();
+            continue;
+          }
+          if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number() ||
+              !std::isfinite(v[0].get<double>()) || !std::isfinite(v[1].get<double>()))
+            return makeError("\"importance.fovea\": expected [x, y] in pixels or null");
+          s.importance.fovea = glm::vec2(v[0].get<float>(), v[1].get<float>());
+        } else if (param) {
           MFR_VIEW_GET(x, number(v, "importance." + name));
           *param = static_cast<float>(x);
         } else if (flag) {
@@ -142,6 +151,9 @@ Result<void> applyStep(const nlohmann::json& step, ViewSettings& s, FrameActions
     } else if (key == "screenshot") {
       MFR_VIEW_GET(path, text(value, key));
       actions.screenshots.push_back(path);
+    } else if (key == "screenshot_maps") {
+      MFR_VIEW_GET(prefix, text(value, key));
+      actions.screenshotMaps.push_back(prefix);
     } else if (key == "screenshot_ui") {
       MFR_VIEW_GET(path, text(value, key));
       actions.screenshotsUi.push_back(path);

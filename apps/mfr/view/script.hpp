@@ -10,9 +10,12 @@
 //   {"next_camera": 1}  (+1 next, -1 previous file camera)  {"open": "scene.gltf"}  (as a drop)
 //   {"occupancy_d": 2}  (+occupancy presets)  {"model": "net.mfrnn"}  (dkb*; "" the built-in)
 //   {"importance": {"alpha": 0.4, "n_limit": 20, "periphery_d": 3, "noise": 0.1,
-//                   "depth": true, "periphery": true, "fresnel": true, "noise_term": true}}  (vkb*)
+//                   "depth": true, "periphery": true, "fresnel": true, "noise_term": true,
+//                   "fovea": [x, y]}}  (vkb*; fovea in pixels, null: the image centre)
 //   {"budget_share": 0.5}  (the budget as a share of the exact A-buffer's bytes)
 //   {"screenshot": "a.png"}  {"screenshot_ui": "b.png"}  {"copy_command": true}
+//   {"screenshot_maps": "shot"}  (shot-image.png, shot-depth.png, shot-kmap.png, ... : the image
+//                                 and every map the method has, each as its view mode shows it)
 // Screenshots are taken after the frame's settings have been rendered.
 #pragma once
 
@@ -28,8 +31,9 @@
 namespace mfr::view {
 
 struct FrameActions {
-  std::vector<std::string> screenshots;    // image area
-  std::vector<std::string> screenshotsUi;  // whole window with the panel
+  std::vector<std::string> screenshots;     // image area
+  std::vector<std::string> screenshotsUi;   // whole window with the panel
+  std::vector<std::string> screenshotMaps;  // prefixes: the image and every map
   bool copyCommand = false;
   std::optional<int> fileCamera;      // an index into the scene's cameras
   int nextCamera = 0;                 // +1 / -1: the next / previous file camera

@@ -9,8 +9,9 @@ std::string ViewSettings::methodKey() const {
          std::to_string(ip.nLimit) + "," + std::to_string(ip.peripheryExponent) + "," +
          std::to_string(ip.noise) + "," + std::to_string(ip.seed) + "," +
          std::to_string(ip.useDepth) + std::to_string(ip.usePeriphery) +
-         std::to_string(ip.useFresnel) + std::to_string(ip.useNoise) + "|" + model + "|" +
-         camera.spec();
+         std::to_string(ip.useFresnel) + std::to_string(ip.useNoise) + "," +
+         (ip.fovea ? std::to_string(ip.fovea->x) + "," + std::to_string(ip.fovea->y) : "centre") +
+         "|" + model + "|" + camera.spec();
 }
 
 std::string ViewSettings::displayKey() const {

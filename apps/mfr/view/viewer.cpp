@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <deque>
 #include <fstream>
+#include <future>
 #include <map>
 #include <memory>
 #include <string>
@@ -75,6 +76,7 @@ std::string methodParameters(const ViewSettings& s) {
     if (ip.peripheryExponent != d.peripheryExponent)
       cmd += " --periphery-d " + number(ip.peripheryExponent);
     if (ip.noise != d.noise) cmd += " --noise " + number(ip.noise);
+    if (ip.fovea) cmd += " --fovea " + number(ip.fovea->x) + "," + number(ip.fovea->y);
     if (!ip.useDepth) cmd += " --no-depth-term";
     if (!ip.usePeriphery) cmd += " --no-periphery-term";
     if (!ip.useFresnel) cmd += " --no-fresnel-term";
@@ -139,6 +141,27 @@ nlohmann::json statsEntry(int frame, const ViewSettings& s, const Frame& f) {
   if (f.flipMean) j["flip_mean"] = *f.flipMean;
   if (f.psnr && std::isfinite(*f.psnr)) j["psnr"] = *f.psnr;
   return j;
+}
+
+/// The image and every map of the settings, each as its view mode shows it: PREFIX-MODE.png.
+/// Modes the method has no map for (importance of a fixed-k method) are left out.
+std::vector<std::string> screenshotMaps(FrameRenderer& renderer, const ViewSettings& settings,
+                                        const std::string& prefix, std::string& error) {
+  std::vector<std::string> written;
+  for (ViewMode mode : allViewModes()) {
+    if (mode == ViewMode::Wiper) continue;  // the image and the truth are written on their own
+    ViewSettings s = settings;
+    s.mode = mode;
+    const Frame f = renderer.update(s);
+    if (!f.error.empty()) continue;
+    const std::string path = prefix + "-" + viewModeName(mode) + ".png";
+    if (auto ok = writePng(path, f.display); !ok) {
+      error = ok.error().message;
+      break;
+    }
+    written.push_back(path);
+  }
+  return written;
 }
 
 }  // namespace
@@ -208,6 +231,10 @@ int runViewer(const ViewerArgs& a) {
   }
   glfwMakeContextCurrent(window);
   const bool scripted = frames > 0 || !steps.empty();
+  // interactive sessions render on a worker thread (the engine's own context is made current
+  // there), so the window keeps drawing and taking input while a frame renders; scripted sessions
+  // render in step unless --render-thread on asks otherwise
+  const bool renderThread = a.renderThread == "on" || (a.renderThread == "auto" && !scripted);
   glfwSwapInterval(scripted ? 0 : 1);
   IMGUI_CHECKVERSION();
   ImGui::CreateContext();
@@ -228,9 +255,22 @@ int runViewer(const ViewerArgs& a) {
     std::deque<std::pair<std::string, bool>> pendingShots;  // path, with the panel
     size_t step = 0;
     double frameMs = 0.0;
+    std::vector<double> windowFrameMs;  // each loop iteration's wall time (responsiveness)
     int screenshotCount = 0;
     std::map<int, bool> keysDown;
-    std::string notice;  // a scene that did not open, or a file camera that does not exist
+    std::string notice;           // a scene that did not open, or a file camera that does not exist
+    std::future<Frame> inFlight;  // the worker's render (renderThread)
+    std::string inFlightKey;
+    std::optional<ViewSettings> inFlightSettings;
+    bool idle = true;  // the image shows the current settings and no render is in flight
+    auto finishRender = [&](int n) {  // takes the worker's frame once it is done
+      if (!inFlight.valid()) return false;
+      frame = inFlight.get();
+      shownKey = inFlightKey;
+      texture.upload(frame.display);
+      renders.push_back(statsEntry(n, *inFlightSettings, frame));
+      return true;
+    };
     // the file camera `index` of the scene, with --zoom as `mfr render --view` applies it
     auto chooseFileCamera = [&](int index) {
       const std::vector<Camera>& cameras = prepared->scene.cameras;
@@ -259,6 +299,8 @@ int runViewer(const ViewerArgs& a) {
         notice = loaded.error().message;
         return;
       }
+      if (inFlight.valid()) inFlight.wait();  // the worker uses the old scene
+      inFlight = {};
       renderer.reset();  // it refers to the old scene
       *prepared = std::move(loaded.value());
       sceneOptions = o;
@@ -274,9 +316,10 @@ int runViewer(const ViewerArgs& a) {
       if (scripted)
         glfwPollEvents();
       else
-        glfwWaitEventsTimeout(0.1);  // idle: no busy loop when nothing happens
+        glfwWaitEventsTimeout(0.1);  // idle: no busy loop (the worker posts an event when done)
       FrameActions actions;
-      if (step < steps.size() && pendingShots.empty()) {  // a screenshot sees its own step
+      // a screenshot sees its own step, and a step the render of the one before
+      if (step < steps.size() && pendingShots.empty() && idle) {
         if (auto ok = applyStep(steps[step++], settings, actions); !ok) {
           exitCode = cli::fail("--script: " + ok.error().message);
           break;
@@ -307,7 +350,10 @@ int runViewer(const ViewerArgs& a) {
         if (pressed(GLFW_KEY_LEFT_BRACKET)) actions.nextCamera = -1;
         if (pressed(GLFW_KEY_R)) settings.camera.reset();
       }
-      if (!io.WantCaptureMouse && io.MousePos.x < w) {  // the camera, on the image
+      if (!io.WantCaptureMouse && io.MousePos.x < w && io.MousePos.y < h && io.KeyCtrl &&
+          ImGui::IsMouseClicked(ImGuiMouseButton_Left)) {  // ctrl+click: the fovea (Eq. 4 o)
+        settings.importance.fovea = glm::vec2(io.MousePos.x, io.MousePos.y);
+      } else if (!io.WantCaptureMouse && io.MousePos.x < w) {  // the camera, on the image
         if (ImGui::IsMouseDragging(ImGuiMouseButton_Left, 0.0f))
           settings.camera.orbit(-0.3f * io.MouseDelta.x, 0.3f * io.MouseDelta.y);
         if (ImGui::IsMouseDragging(ImGuiMouseButton_Right, 0.0f) ||
@@ -325,7 +371,8 @@ int runViewer(const ViewerArgs& a) {
                      frameMs,
                      static_cast<int>(prepared->scene.cameras.size()),
                      fileCamera,
-                     notice};
+                     notice,
+                     inFlight.valid()};
       const PanelRequests requests = drawPanel(static_cast<float>(w), static_cast<float>(fbW - w),
                                                static_cast<float>(fbH), settings, info);
       if (requests.nextCamera != 0) actions.nextCamera = requests.nextCamera;
@@ -352,12 +399,43 @@ int runViewer(const ViewerArgs& a) {
       ViewSettings shown = settings;
       if (ImGui::IsMouseDown(ImGuiMouseButton_Left) || ImGui::IsMouseDown(ImGuiMouseButton_Right))
         shown.compare = shown.compare && io.WantCaptureMouse;
-      if (shown.displayKey() != shownKey) {  // re-render only what changed
-        frame = renderer->update(shown);
-        shownKey = shown.displayKey();
-        texture.upload(frame.display);
-        renders.push_back(statsEntry(n, settings, frame));
-        updated = true;
+      if (inFlight.valid() &&
+          inFlight.wait_for(std::chrono::seconds(0)) == std::future_status::ready)
+        updated = finishRender(n);
+      if (shown.displayKey() != shownKey && !inFlight.valid()) {  // re-render only what changed
+        if (renderThread) {
+          inFlightKey = shown.displayKey();
+          inFlightSettings = settings;
+          inFlight = std::async(std::launch::async, [&r = *renderer, shown] {
+            Frame f = r.update(shown);
+            glfwPostEmptyEvent();  // wakes the event wait of the window's thread
+            return f;
+          });
+        } else {
+          frame = renderer->update(shown);
+          shownKey = shown.displayKey();
+          texture.upload(frame.display);
+          renders.push_back(statsEntry(n, settings, frame));
+          updated = true;
+        }
+      }
+      idle = !inFlight.valid() && shownKey == shown.displayKey();
+      if (requests.screenshotMaps)
+        actions.screenshotMaps.push_back("mfr-view-" + std::to_string(++screenshotCount));
+      if (!actions.screenshotMaps.empty() && inFlight.valid()) {  // the renderer is the worker's
+        inFlight.wait();
+        updated = finishRender(n) || updated;
+      }
+      for (const std::string& prefix : actions.screenshotMaps) {
+        std::string error;
+        for (const std::string& path : screenshotMaps(*renderer, shown, prefix, error)) {
+          nlohmann::json j = statsEntry(n, settings, frame);
+          j["path"] = path;
+          j["maps_of"] = prefix;
+          shots.push_back(j);
+          if (!scripted) std::printf("screenshot: %s\n", path.c_str());
+        }
+        if (!error.empty()) exitCode = cli::fail(error);
       }
       if (requests.copyCommand || actions.copyCommand) {
         const std::string cmd = renderCommand(sceneOptions, settings);
@@ -370,9 +448,9 @@ int runViewer(const ViewerArgs& a) {
         pendingShots.emplace_back("mfr-view-" + std::to_string(++screenshotCount) + ".png", false);
       for (const std::string& p : actions.screenshots) pendingShots.emplace_back(p, false);
       for (const std::string& p : actions.screenshotsUi) pendingShots.emplace_back(p, true);
-      const bool last =
-          frames > 0 ? n + 1 >= frames
-                     : !steps.empty() && step >= steps.size() && pendingShots.empty() && !updated;
+      const bool last = idle && (frames > 0 ? n + 1 >= frames
+                                            : !steps.empty() && step >= steps.size() &&
+                                                  pendingShots.empty() && !updated);
       if (last && !a.screenshot.empty()) pendingShots.emplace_back(a.screenshot, a.screenshotUi);
       texture.draw();
       ImGui::Render();
@@ -381,7 +459,7 @@ int runViewer(const ViewerArgs& a) {
       glClear(GL_COLOR_BUFFER_BIT);
       ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
       // screenshots of a frame whose panel already shows its render's statistics
-      while (!pendingShots.empty() && (!updated || last)) {
+      while (!pendingShots.empty() && idle && (!updated || last)) {
         const auto [path, ui] = pendingShots.front();
         pendingShots.pop_front();
         const Image8 shot =
@@ -409,10 +487,22 @@ int runViewer(const ViewerArgs& a) {
       glfwSwapBuffers(window);
       frameMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                     .count();
+      windowFrameMs.push_back(frameMs);
       if (exitCode != 0 || (last && pendingShots.empty())) break;
     }
+    if (inFlight.valid()) inFlight.wait();  // before the renderer and the engine go
+    inFlight = {};
     if (!a.statsJson.empty()) {
       nlohmann::json out{{"renders", renders}, {"screenshots", shots}};
+      if (!windowFrameMs.empty()) {  // how long the window waited for its frames
+        std::vector<double> sorted = windowFrameMs;
+        std::sort(sorted.begin(), sorted.end());
+        out["window_frames"] = {{"count", sorted.size()},
+                                {"median_ms", sorted[sorted.size() / 2]},
+                                {"p95_ms", sorted[sorted.size() * 95 / 100]},
+                                {"max_ms", sorted.back()},
+                                {"render_thread", renderThread}};
+      }
       if (auto written = writeFileAtomically(a.statsJson, out.dump(2) + "\n"); !written)
         exitCode = cli::fail(written.error().message);
     }

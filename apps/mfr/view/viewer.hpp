@@ -24,6 +24,7 @@ struct ViewerArgs {
   std::string script;
   std::string statsJson;
   bool listMethods = false;
+  std::string renderThread = "auto";  // on, off, auto (on when interactive)
 };
 
 /// Runs the viewer; the exit code (errors are one line on stderr).
