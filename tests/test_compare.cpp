@@ -538,6 +538,13 @@ TEST_F(CompareCli, SummaryAndReportPathOnStderrAndACsvRowPerRun) {
   std::stringstream s;
   s << html.rdbuf();
   EXPECT_NE(s.str().find("--budget 200KB,400KB"), std::string::npos);  // the command line
+  // the legend: every method of the run with its summary from the preset table, no other
+  for (const PresetInfo& p : presetTable()) {
+    const bool inRun = results().dump().find("\"" + p.name + "\"") != std::string::npos;
+    const std::string entry = "<dt><code>" + p.name + "</code></dt><dd>";
+    EXPECT_EQ(s.str().find(entry) != std::string::npos, inRun) << p.name;
+    if (inRun) EXPECT_NE(s.str().find(entry + p.summary.substr(0, 20)), std::string::npos);
+  }
 }
 
 // one line on stderr naming `needle`, exit code 1, nothing written

@@ -14,6 +14,7 @@ Runner addMetricsCommand(CLI::App& app);
 Runner addCompareCommand(CLI::App& app);
 Runner addDatasetCommand(CLI::App& app);
 Runner addTrainCommand(CLI::App& app);
+Runner addPresetsCommand(CLI::App& app);
 /// mfr view (built with the GL engine: MFR_BUILD_GL).
 Runner addViewCommand(CLI::App& app);
 

@@ -219,8 +219,8 @@ std::string appliesTo(MethodOption option) {
 
 std::string presetHelp() {
   std::string list;
-  for (const std::string& name : presetNames()) list += (list.empty() ? "" : ", ") + name;
-  return "Method: " + list + " (each bounded one also NAME+occupancy)";
+  for (const PresetInfo& p : presetTable()) list += "\n  " + p.name + ": " + p.summary;
+  return "Method (`mfr presets` lists the papers; each bounded one also NAME+occupancy):" + list;
 }
 
 int fail(const std::string& message) {

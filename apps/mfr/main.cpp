@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   const mfr::cli::Runner compare = mfr::cli::addCompareCommand(app);
   const mfr::cli::Runner dataset = mfr::cli::addDatasetCommand(app);
   const mfr::cli::Runner train = mfr::cli::addTrainCommand(app);
+  const mfr::cli::Runner presets = mfr::cli::addPresetsCommand(app);
 #ifdef MFR_HAS_VIEW
   const mfr::cli::Runner view = mfr::cli::addViewCommand(app);
 #endif
@@ -37,6 +38,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("compare")) return compare();
     if (app.got_subcommand("dataset")) return dataset();
     if (app.got_subcommand("train")) return train();
+    if (app.got_subcommand("presets")) return presets();
 #ifdef MFR_HAS_VIEW
     if (app.got_subcommand("view")) return view();
 #endif

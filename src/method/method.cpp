@@ -4,10 +4,166 @@
 
 namespace mfr {
 
+namespace {
+
+// The preset table: every preset's name, paper, one-line summary and fields. presetNames(),
+// methodPreset(), `mfr render --help`, `mfr info --presets` (the README's table, checked by a test)
+// and the compare report's legend all read it.
+struct PresetRow {
+  PresetInfo info;
+  void (*configure)(MethodDesc&);
+};
+
+void kPlusCore(MethodDesc& m) {  // the k+-buffer family: k+ culling test under a per-pixel lock
+  m.culling = CullingTest::KPlus;
+  m.perPixelLock = true;
+}
+
+const std::vector<PresetRow>& presetRows() {
+  static const std::vector<PresetRow> rows = {
+      {{"zbuffer", "k+-buffer (Vasilakis & Fudos 2014), k = 1",
+        "the nearest fragment only: the k+-buffer with k = 1"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::FixedK;
+         m.store = StoreChoice::MaxArray;
+         kPlusCore(m);
+         m.k = 1;
+       }},
+      {{"abuffer", "A-buffer (Carpenter 1984)",
+        "every fragment, sorted per pixel: the exact ground truth (no budget)"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::Unbounded;
+         m.store = StoreChoice::Append;
+       }},
+      {{"fkb", "k-buffer (Bavoil et al. 2007)",
+        "the same k for every pixel, max-array insertion without the k+ test"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::FixedK;
+         m.store = StoreChoice::MaxArray;
+         m.culling = CullingTest::None;
+       }},
+      {{"kplus-array", "k+-buffer (Vasilakis & Fudos 2014)",
+        "fixed k, max-array store, k+ culling test, per-pixel lock"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::FixedK;
+         m.store = StoreChoice::MaxArray;
+         kPlusCore(m);
+       }},
+      {{"kplus-heap", "k+-buffer (Vasilakis & Fudos 2014)",
+        "fixed k, max-heap store, k+ culling test, per-pixel lock"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::FixedK;
+         m.store = StoreChoice::MaxHeap;
+         kPlusCore(m);
+       }},
+      {{"kplus-sb", "k+-buffer K+B-SB (Vasilakis & Fudos 2014)",
+        "count pass, min(n(p), k) slots per pixel at prefix-sum offsets (memory-exact)"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::CountedK;
+         m.store = StoreChoice::PerPixel;
+         kPlusCore(m);
+       }},
+      {{"kplus-dynamic", "k+-buffer, dynamic k (Vasilakis & Fudos 2014)",
+        "k chosen from the depth-complexity histogram, min(n(p), k) slots per pixel"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::DynamicK;
+         m.store = StoreChoice::PerPixel;
+         kPlusCore(m);
+       }},
+      {{"vkb", "variable k-buffer (Vasilakis, Vardis, Papaioannou, Moustakas)",
+        "k(p) from the importance map (depth complexity x periphery x Fresnel + noise)"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::Importance;
+         m.store = StoreChoice::PerPixel;
+         kPlusCore(m);
+       }},
+      {{"vkb-fill", "variable k-buffer + mfr's slot filling",
+        "vkb, with the slots it leaves unused handed to the most important pixels"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::Importance;
+         m.store = StoreChoice::PerPixel;
+         kPlusCore(m);
+         m.fillUnusedSlots = true;
+       }},
+      {{"dkb", "deep k-buffer (DHOIT: Tsopouridis, Fudos, Vasilakis)",
+        "k(p) from the MLP's importance over 12 features; hybrid compositing"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::Importance;
+         m.importanceSource = ImportanceSource::Network;
+         m.store = StoreChoice::PerPixel;
+         kPlusCore(m);
+         m.compositing = Compositing::Hybrid;  // deep hybrid transparency (DHOIT sec. 3.3)
+       }},
+      {{"dkb-fill", "deep k-buffer + mfr's slot filling",
+        "dkb, with the slots it leaves unused handed to the most important pixels"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::Importance;
+         m.importanceSource = ImportanceSource::Network;
+         m.store = StoreChoice::PerPixel;
+         kPlusCore(m);
+         m.compositing = Compositing::Hybrid;
+         m.fillUnusedSlots = true;
+       }},
+      {{"optimal", "optimal k-buffer (DHOIT sec. 3.1.2; mfr's convex-hull allocator)",
+        "exact A-buffer pre-pass, k(p) minimising the summed squared error under the budget"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::Optimal;
+         m.store = StoreChoice::PerPixel;
+         kPlusCore(m);
+         m.compositing = Compositing::Hybrid;  // the oracle minimises the hybrid error
+       }},
+      {{"optimal-greedy", "optimal k-buffer, DHOIT sec. 3.1.2 Algorithm 1 as published",
+        "the paper's greedy min-heap allocation over the exact pre-pass"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::Optimal;
+         m.store = StoreChoice::PerPixel;
+         kPlusCore(m);
+         m.compositing = Compositing::Hybrid;
+         m.publishedGreedy = true;
+       }},
+      // the peer methods (README "Peer methods"): per-pixel accumulators, no fragment nodes
+      {{"wboit", "weighted blended OIT (McGuire & Bavoil 2013)",
+        "weighted sums and revealage per pixel, no fragment nodes"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::NoNodes;
+         m.store = StoreChoice::None;
+         m.compositing = Compositing::WeightedBlended;
+       }},
+      {{"mboit", "moment-based OIT (Muenstermann et al. 2018)",
+        "4 power moments of ln-transmittance per pixel, no fragment nodes"},
+       [](MethodDesc& m) {
+         m.allocation = AllocationPolicy::NoNodes;
+         m.store = StoreChoice::None;
+         m.compositing = Compositing::MomentBased;
+       }},
+      {{"mlab", "multi-layer alpha blending (Salvi & Vaidyanathan 2014)",
+        "k depth-ordered layers per pixel, the two farthest merged when full"},
+       [](MethodDesc& m) {
+         // k nodes per pixel from the budget like fkb, MLAB's store, the k+ family's lock
+         m.allocation = AllocationPolicy::FixedK;
+         m.store = StoreChoice::MultiLayer;
+         m.perPixelLock = true;
+         m.compositing = Compositing::MultiLayerAlpha;
+       }},
+  };
+  return rows;
+}
+
+}  // namespace
+
+const std::vector<PresetInfo>& presetTable() {
+  static const std::vector<PresetInfo> table = [] {
+    std::vector<PresetInfo> t;
+    for (const PresetRow& row : presetRows()) t.push_back(row.info);
+    return t;
+  }();
+  return table;
+}
+
 std::vector<std::string> presetNames() {
-  return {"zbuffer",        "abuffer", "fkb",      "kplus-array", "kplus-heap", "kplus-sb",
-          "kplus-dynamic",  "vkb",     "vkb-fill", "dkb",         "dkb-fill",   "optimal",
-          "optimal-greedy", "wboit",   "mboit",    "mlab"};
+  std::vector<std::string> names;
+  for (const PresetRow& row : presetRows()) names.push_back(row.info.name);
+  return names;
 }
 
 Result<MethodDesc> methodPreset(const std::string& fullName) {
@@ -20,67 +176,16 @@ Result<MethodDesc> methodPreset(const std::string& fullName) {
   }
   MethodDesc m;
   m.name = fullName;
-  if (name == "zbuffer") {
-    m.allocation = AllocationPolicy::FixedK;
-    m.store = StoreChoice::MaxArray;
-    m.culling = CullingTest::KPlus;
-    m.perPixelLock = true;
-    m.k = 1;
-  } else if (name == "abuffer") {
-    m.allocation = AllocationPolicy::Unbounded;
-    m.store = StoreChoice::Append;
-  } else if (name == "fkb") {
-    m.allocation = AllocationPolicy::FixedK;
-    m.store = StoreChoice::MaxArray;
-    m.culling = CullingTest::None;
-  } else if (name == "kplus-array" || name == "kplus-heap") {
-    m.allocation = AllocationPolicy::FixedK;
-    m.store = name == "kplus-array" ? StoreChoice::MaxArray : StoreChoice::MaxHeap;
-    m.culling = CullingTest::KPlus;
-    m.perPixelLock = true;
-  } else if (name == "kplus-sb" || name == "kplus-dynamic") {
-    m.allocation = name == "kplus-sb" ? AllocationPolicy::CountedK : AllocationPolicy::DynamicK;
-    m.store = StoreChoice::PerPixel;
-    m.culling = CullingTest::KPlus;
-    m.perPixelLock = true;
-  } else if (name == "vkb" || name == "vkb-fill") {
-    m.allocation = AllocationPolicy::Importance;
-    m.store = StoreChoice::PerPixel;
-    m.culling = CullingTest::KPlus;
-    m.perPixelLock = true;
-    m.fillUnusedSlots = name == "vkb-fill";
-  } else if (name == "dkb" || name == "dkb-fill") {
-    m.allocation = AllocationPolicy::Importance;
-    m.importanceSource = ImportanceSource::Network;
-    m.store = StoreChoice::PerPixel;
-    m.culling = CullingTest::KPlus;
-    m.perPixelLock = true;
-    m.compositing = Compositing::Hybrid;  // deep hybrid transparency (DHOIT sec. 3.3)
-    m.fillUnusedSlots = name == "dkb-fill";
-  } else if (name == "optimal" || name == "optimal-greedy") {
-    m.allocation = AllocationPolicy::Optimal;
-    m.store = StoreChoice::PerPixel;
-    m.culling = CullingTest::KPlus;
-    m.perPixelLock = true;
-    m.compositing = Compositing::Hybrid;  // the oracle minimises the hybrid error
-    m.publishedGreedy = name == "optimal-greedy";
-  } else if (name == "wboit" || name == "mboit") {
-    // the peer methods (README "Peer methods"): per-pixel accumulators, no fragment nodes
-    m.allocation = AllocationPolicy::NoNodes;
-    m.store = StoreChoice::None;
-    m.compositing = name == "wboit" ? Compositing::WeightedBlended : Compositing::MomentBased;
-  } else if (name == "mlab") {
-    // k nodes per pixel from the budget like fkb, MLAB's store, the k+ family's per-pixel lock
-    m.allocation = AllocationPolicy::FixedK;
-    m.store = StoreChoice::MultiLayer;
-    m.perPixelLock = true;
-    m.compositing = Compositing::MultiLayerAlpha;
-  } else {
+  const PresetRow* row = nullptr;
+  for (const PresetRow& r : presetRows())
+    if (r.info.name == name) row = &r;
+  if (row == nullptr) {
     std::string known;
     for (const std::string& n : presetNames()) known += (known.empty() ? "" : ", ") + n;
     return makeError("method " + quoteInput(fullName) + ": unknown (known: " + known +
                      ", each optionally with +occupancy)");
   }
+  row->configure(m);
   if (occupancy) {
     if (!kBufferFamilyRule(m.compositing))
       return makeError("method '" + fullName + "': occupancy culling applies to k-buffers only");
@@ -89,6 +194,17 @@ Result<MethodDesc> methodPreset(const std::string& fullName) {
     m.occupancyWords = 1;
   }
   return m;
+}
+
+std::string presetTableMarkdown() {
+  std::string md =
+      "| preset | follows | what it keeps | compositing | `+occupancy` |\n|---|---|---|---|---|\n";
+  for (const PresetInfo& p : presetTable()) {
+    const MethodDesc m = methodPreset(p.name).value();
+    md += "| `" + p.name + "` | " + p.paper + " | " + p.summary + " | " + toString(m.compositing) +
+          " | " + (methodPreset(p.name + "+occupancy") ? "yes" : "no") + " |\n";
+  }
+  return md;
 }
 
 const char* toString(AllocationPolicy a) {

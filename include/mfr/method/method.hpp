@@ -86,6 +86,19 @@ struct MethodDesc {
   bool publishedGreedy = false;
 };
 
+/// One row of the preset table (src/method/method.cpp): the name, the paper it follows and a
+/// one-line summary. The CLI help, `mfr info --presets`, the README's table and the compare
+/// report's legend are generated from it, so they cannot disagree.
+struct PresetInfo {
+  std::string name;
+  std::string paper;
+  std::string summary;
+};
+const std::vector<PresetInfo>& presetTable();
+
+/// The preset table as Markdown (the README's, between its `presets` markers).
+std::string presetTableMarkdown();
+
 /// Preset names: zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, vkb,
 /// vkb-fill, dkb, dkb-fill, optimal, optimal-greedy, each bounded one optionally followed by
 /// "+occupancy"; and the peer methods wboit, mboit, mlab (no +occupancy).
