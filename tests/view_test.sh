@@ -226,6 +226,47 @@ done
 cmp thread.png thread_ref.png || { echo "FAIL: --render-thread on --frames != render"; exit 1; }
 echo "ok: screenshot_maps == render's image/k-map/importance/depth maps; --fovea; render thread"
 
+# (g) real input events (xdotool through the X server): a left drag orbits, W flies forward,
+# ctrl+click places the vkb fovea, Esc quits; an interactive session, so renders run on the worker
+if command -v xdotool >/dev/null; then
+  "$MFR" view procedural:spheres --width $S --height $S --method vkb --budget 400KB \
+    --stats-json input.json >/dev/null 2>input_err.txt &
+  pid=$!
+  wid=$(timeout 60 xdotool search --sync --onlyvisible --name "mfr view" | head -1)
+  [ -n "$wid" ] || { echo "FAIL: input session: no window"; cat input_err.txt; exit 1; }
+  settle() { sleep "${1:-4}"; }  # renders of a 128x128 view take < 2 s here, even when loaded
+  settle 6
+  xdotool mousemove --window "$wid" 64 64 mousedown 1
+  for i in 1 2 3 4 5 6; do xdotool mousemove --window "$wid" $((64 + i * 8)) 64; sleep 0.1; done
+  xdotool mouseup 1
+  settle
+  xdotool keydown --window "$wid" w; sleep 0.5; xdotool keyup --window "$wid" w
+  settle
+  xdotool mousemove --window "$wid" 30 40 keydown ctrl click 1 keyup ctrl
+  settle
+  xdotool key --window "$wid" Escape
+  rc=0; wait $pid || rc=$?
+  [ "$rc" -eq 0 ] || { echo "FAIL: input session exit $rc"; cat input_err.txt; exit 1; }
+  python3 - <<'PY'
+import json
+renders = json.load(open("input.json"))["renders"]
+cams = [[float(x) for x in r["camera"].split(",")] for r in renders]
+eye, target = lambda c: c[0:3], lambda c: c[3:6]
+start = cams[0]
+orbited = [c for c in cams if target(c) == target(start) and eye(c) != eye(start)]
+assert orbited, f"the drag did not orbit: {cams}"
+flown = [c for c in cams if target(c) != target(start)]
+assert flown, f"W did not fly: {cams}"
+fovea = [r["fovea"] for r in renders if "fovea" in r]
+assert fovea and abs(fovea[-1][0] - 30) <= 1 and abs(fovea[-1][1] - 40) <= 1, renders[-1]
+print(f"ok: real input: {len(renders)} renders, drag orbited, W flew, ctrl+click fovea {fovea[-1]}")
+PY
+elif [ "${CI:-}" = "true" ]; then
+  echo "FAIL (CI=true): xdotool not installed (Debian: xdotool)"; exit 1
+else
+  echo "SKIP: real input events: xdotool not installed"
+fi
+
 # (c) the window with its panel
 "$MFR" view procedural:layers --width $S --height $S --method kplus-array --budget 200KB \
   --mode wiper --frames 3 --screenshot ui.png --screenshot-ui

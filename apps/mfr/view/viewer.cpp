@@ -123,6 +123,7 @@ nlohmann::json statsEntry(int frame, const ViewSettings& s, const Frame& f) {
   j["mode"] = viewModeName(s.mode);
   j["budget_bytes"] = s.budgetBytes;
   j["camera"] = s.camera.spec();
+  if (s.importance.fovea) j["fovea"] = {s.importance.fovea->x, s.importance.fovea->y};
   j["truth_bytes"] = f.truthBytes;
   j["error"] = f.error;
   j["update_ms"] = f.renderMs;
@@ -311,7 +312,8 @@ int runViewer(const ViewerArgs& a) {
       shownKey.clear();
       notice.clear();
     };
-    for (int n = 0; !glfwWindowShouldClose(window); ++n) {
+    int framesShown = 0;
+    for (int n = 0; !glfwWindowShouldClose(window); framesShown = ++n) {
       const auto start = std::chrono::steady_clock::now();
       if (scripted)
         glfwPollEvents();
@@ -490,8 +492,7 @@ int runViewer(const ViewerArgs& a) {
       windowFrameMs.push_back(frameMs);
       if (exitCode != 0 || (last && pendingShots.empty())) break;
     }
-    if (inFlight.valid()) inFlight.wait();  // before the renderer and the engine go
-    inFlight = {};
+    if (inFlight.valid()) finishRender(framesShown);  // waits; before the renderer goes
     if (!a.statsJson.empty()) {
       nlohmann::json out{{"renders", renders}, {"screenshots", shots}};
       if (!windowFrameMs.empty()) {  // how long the window waited for its frames
