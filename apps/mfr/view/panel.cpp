@@ -31,6 +31,7 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
   ImGui::SetNextWindowSize(ImVec2(width, height));
   ImGui::Begin("mfr view", nullptr,
                ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse);
+  ImGui::PushItemWidth(width * 0.42f);  // widgets leave room for their labels on the right
   ImGui::Text("%s  %dx%d  engine %s", info.scene.c_str(), info.width, info.height,
               info.engine.c_str());
 
@@ -169,6 +170,7 @@ PanelRequests drawPanel(float x, float width, float height, ViewSettings& s,
   if (ImGui::Button("all maps")) requests.screenshotMaps = true;
   ImGui::SameLine();
   if (ImGui::Button("copy command")) requests.copyCommand = true;
+  ImGui::PopItemWidth();
   ImGui::End();
   return requests;
 }
