@@ -1,34 +1,69 @@
 // bench_dkb: the deep k-buffer's per-frame overhead (Deep hybrid OIT, sec. 4.1, Table 1: "NN
-// feature extraction" and "importance computation"), at --size^2 with the built-in model.
+// feature extraction" and "importance computation"), at --size^2 with the built-in model, on
+// every instruction-set path this CPU has (core/isa.hpp), next to a kplus-dynamic frame of the
+// same view and budget (the paper's point: the network is cheap next to rendering).
 //
 // For each scene (procedural:hairball; IridescentDishWithOlives from ../shared/scenes at zoom 1.6
-// with global alpha 0.5, skipped when absent), medians of --reps runs of:
-//   count     the count pass with the image's depth range (countWithDepthRange)
-//   fused     the runtime importance pass: per tile, features + one inference batch
-//             (predictImportance), wall time, with the CPU time of its two parts
-//   features  a full-screen feature pass alone (accumulateFeatures + pixelFeatures)
-//   infer     batch inference alone over the covered pixels' features (predictRows)
-// and the inference rate in M pixels/s. CSV: dkb.csv.
+// with global alpha 0.5, skipped when absent), --budget (default 40 MB), medians of --reps
+// interleaved runs of:
+//   kplus     a whole kplus-dynamic frame (all passes)
+//   count     the dkb frame's count pass (n(p) and the depth range)
+//   features  the dkb frame's feature pass, wall time
+//   infer     the dkb frame's inference pass, wall time (features and inference run fused per
+//             tile; the fused wall time is split in proportion to each part's CPU time)
+//   dkb       the whole dkb frame
+//   infer-only  batch inference alone over the covered pixels' features (predictRows), and its
+//             rate in M pixels/s
+// and (features + infer) / kplus, the issue's goal (<= 25%). CSV: dkb.csv; chart: dkb.png
+// (features + inference per path and scene, with the kplus-dynamic frame).
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
 
 #include "bench_common.hpp"
+#include "mfr/core/isa.hpp"
+#include "mfr/core/plot.hpp"
+#include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/learn/model_file.hpp"
+#include "mfr/method/memory_model.hpp"
 
 namespace {
 
 using namespace mfr;
 using namespace mfr::bench;
 
-constexpr Program kProgram{.name = "bench_dkb", .csv = "dkb.csv"};
+constexpr Program kProgram{.name = "bench_dkb",
+                           .csv = "dkb.csv",
+                           .options = " [--budget BYTES]",
+                           .optionsHelp = "  --budget BYTES  the frames' budget (default 40MB)\n"};
+
+struct PathRuns {
+  Isa isa;
+  Case dkb;
+  std::vector<double> inferOnly;
+};
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const Args args = parseArgs(argc, argv, kProgram);
+  uint64_t budget = 40ull << 20;
+  std::vector<char*> rest = {argv[0]};
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
+      auto parsed = parseByteSize(argv[++i]);
+      if (!parsed) {
+        printError(kProgram, parsed.error().message);
+        return 2;
+      }
+      budget = *parsed;
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+  const Args args = parseArgs(static_cast<int>(rest.size()), rest.data(), kProgram);
   auto model = builtinDkbModel();
   if (!model) {
     printError(kProgram, model.error().message);
@@ -36,16 +71,27 @@ int main(int argc, char** argv) {
   }
   const learn::Model& net = *model.value();
   Csv csv = openCsv(kProgram, args,
-                    "scene,width,height,covered,fragments,count_ms,fused_ms,fused_feature_cpu_ms,"
-                    "fused_inference_cpu_ms,features_ms,inference_ms,inference_mpix_s");
-  std::printf("bench_dkb: deep k-buffer feature pass and inference, %s\n",
-              runDescription(args, resolveThreads(args.threads)).c_str());
+                    "scene,width,height,budget,isa,covered,fragments,kplus_dynamic_ms,count_ms,"
+                    "features_ms,inference_ms,dkb_ms,overhead_percent,inference_only_ms,"
+                    "inference_mpix_s");
+  std::vector<Isa> paths = {Isa::Scalar};
+  for (Isa isa : {Isa::Avx2, Isa::Avx512})
+    if (static_cast<int>(isa) <= static_cast<int>(detectedIsa())) paths.push_back(isa);
+  std::printf("bench_dkb: deep k-buffer feature pass and inference, %s, budget %s, paths:",
+              runDescription(args, resolveThreads(args.threads)).c_str(),
+              formatBytes(budget).c_str());
+  for (Isa isa : paths) std::printf(" %s", std::string(isaName(isa)).c_str());
+  std::printf(" (active %s)\n", std::string(isaName(activeIsa())).c_str());
   const std::string dish = std::string(MFR_SCENES_DIR) +
                            "/khronos/IridescentDishWithOlives/glTF/IridescentDishWithOlives.gltf";
   const std::vector<SceneCase> scenes = {{"hairball", "procedural:hairball", false},
                                          {"IridescentDishWithOlives", dish, true}};
-  Table table({"scene", "covered px", "fragments", "count ms", "fused ms", "(feature cpu",
-               "inference cpu)", "features ms", "inference ms", "Mpix/s"});
+  Table table({"scene", "isa", "covered px", "kplus-dyn ms", "count ms", "features ms",
+               "inference ms", "dkb ms", "(f+i)/kplus", "infer-only ms", "Mpix/s"});
+  table.leftAlign(1);
+  std::vector<PlotSeries> series;
+  const glm::vec3 colors[] = {
+      {0.85f, 0.3f, 0.1f}, {0.1f, 0.45f, 0.8f}, {0.2f, 0.6f, 0.2f}, {0.5f, 0.3f, 0.7f}};
   FrameStore store(kProgram);
   bool failed = false;
   for (const SceneCase& sc : scenes) {
@@ -72,55 +118,98 @@ int main(int argc, char** argv) {
       continue;
     }
     const RasterFrame& frame = built.value();
-    std::vector<double> count, fused, fusedFeature, fusedInference, features, inference;
+    RenderOptions options;
+    options.budgetBytes = budget;
+    const auto makeCase = [&](const char* preset) {
+      Case c;
+      c.frame = &frame;
+      c.method = methodPreset(preset).value();
+      c.options = options;
+      return c;
+    };
+    Case kplus = makeCase("kplus-dynamic");
+    std::vector<PathRuns> runs;
+    for (Isa isa : paths) runs.push_back({isa, makeCase("dkb"), {}});
+    // the inference-only input: the covered pixels' features (the same on every path)
     ImageFeatureStats image;
-    size_t covered = 0;
-    for (int rep = 0; rep < args.reps; ++rep) {
-      auto start = Clock::now();
-      const std::vector<uint32_t> n = countWithDepthRange(frame, image);
-      count.push_back(msSince(start));
-      const uint64_t slots = image.fragments / 2;
-      double f = 0.0, i = 0.0;
-      start = Clock::now();
-      const std::vector<float> importance = predictImportance(frame, net, image, slots, &f, &i);
-      fused.push_back(msSince(start));
-      fusedFeature.push_back(f);
-      fusedInference.push_back(i);
-      start = Clock::now();
-      const std::vector<FeatureAccumulator> acc = accumulateFeatures(frame);
-      std::vector<float> rows;
-      rows.reserve(image.coveredPixels * kDkbFeatureCount);
-      for (const FeatureAccumulator& a : acc) {
-        if (a.n == 0) continue;
-        const PixelFeatures pf = pixelFeatures(a, image, slots);
-        rows.insert(rows.end(), pf.begin(), pf.end());
-      }
-      features.push_back(msSince(start));
-      covered = rows.size() / kDkbFeatureCount;
-      std::vector<float> out(covered);
-      start = Clock::now();
-      learn::predictRows(net.net, rows.data(), covered, out.data());
-      inference.push_back(msSince(start));
+    countWithDepthRange(frame, image);
+    const uint64_t slots =
+        MemoryModel::of(methodPreset("dkb").value()).fragmentSlots(budget, frame.pixelCount());
+    std::vector<float> rows;
+    for (const FeatureAccumulator& a : accumulateFeatures(frame)) {
+      if (a.n == 0) continue;
+      const PixelFeatures pf = pixelFeatures(a, image, slots);
+      rows.insert(rows.end(), pf.begin(), pf.end());
     }
-    const double inferMs = median(inference);
-    const std::vector<std::string> row = {sc.label,
-                                          num(covered),
-                                          num(image.fragments),
-                                          fixed(median(count), 1),
-                                          fixed(median(fused), 1),
-                                          fixed(median(fusedFeature), 1),
-                                          fixed(median(fusedInference), 1),
-                                          fixed(median(features), 1),
-                                          fixed(inferMs, 1),
-                                          fixed(covered / inferMs / 1000.0, 2)};
-    table.add(row);
-    csv.row({sc.label, std::to_string(args.size), std::to_string(args.size),
-             std::to_string(covered), std::to_string(image.fragments), fixed(median(count), 3),
-             fixed(median(fused), 3), fixed(median(fusedFeature), 3),
-             fixed(median(fusedInference), 3), fixed(median(features), 3), fixed(inferMs, 3),
-             fixed(covered / inferMs / 1000.0, 3)});
+    const size_t covered = rows.size() / kDkbFeatureCount;
+    std::vector<float> out(covered);
+    // interleaved rounds: the kplus-dynamic frame, then every path's dkb frame and inference
+    const Isa before = activeIsa();
+    for (int rep = 0; rep < args.reps; ++rep) {
+      std::vector<Case> one = {kplus};
+      runInterleaved(one, 1);
+      kplus = std::move(one[0]);
+      for (PathRuns& r : runs) {
+        setActiveIsa(r.isa);
+        std::vector<Case> c = {r.dkb};
+        runInterleaved(c, 1);
+        r.dkb = std::move(c[0]);
+        const auto start = Clock::now();
+        learn::predictRows(net.net, rows.data(), covered, out.data());
+        r.inferOnly.push_back(msSince(start));
+      }
+    }
+    setActiveIsa(before);
+    if (kplus.error || kplus.totalSamples.empty()) {
+      printError(kProgram, sc.label + ": kplus-dynamic: " + kplus.error.value_or("no run"));
+      failed = true;
+      continue;
+    }
+    PlotSeries overhead{sc.label + " features + inference", {}, {}, colors[series.size() % 4]};
+    PlotSeries frameMs{sc.label + " kplus-dynamic frame", {}, {}, colors[(series.size() + 1) % 4]};
+    for (size_t i = 0; i < runs.size(); ++i) {
+      const PathRuns& r = runs[i];
+      if (r.dkb.error) {
+        printError(kProgram, sc.label + ": dkb: " + *r.dkb.error);
+        failed = true;
+        continue;
+      }
+      const double f = r.dkb.pass("features"), inf = r.dkb.pass("inference");
+      const double ratio = 100.0 * (f + inf) / kplus.totalMs();
+      const double inferMs = median(r.inferOnly);
+      const std::string isa(isaName(r.isa));
+      table.add({sc.label, isa, num(covered), fixed(kplus.totalMs(), 1),
+                 fixed(r.dkb.pass("count"), 1), fixed(f, 1), fixed(inf, 1),
+                 fixed(r.dkb.totalMs(), 1), fixed(ratio, 1) + "%", fixed(inferMs, 1),
+                 fixed(covered / inferMs / 1000.0, 2)});
+      csv.row({sc.label, std::to_string(args.size), std::to_string(args.size),
+               std::to_string(budget), isa, std::to_string(covered),
+               std::to_string(r.dkb.stats.fragmentsGenerated), fixed(kplus.totalMs(), 3),
+               fixed(r.dkb.pass("count"), 3), fixed(f, 3), fixed(inf, 3), fixed(r.dkb.totalMs(), 3),
+               fixed(ratio, 2), fixed(inferMs, 3), fixed(covered / inferMs / 1000.0, 3)});
+      overhead.x.push_back(static_cast<double>(r.isa));
+      overhead.y.push_back(f + inf);
+      frameMs.x.push_back(static_cast<double>(r.isa));
+      frameMs.y.push_back(kplus.totalMs());
+    }
+    series.push_back(overhead);
+    series.push_back(frameMs);
   }
   table.print();
   std::printf("CSV: %s\n", csv.path().string().c_str());
+  if (!series.empty()) {
+    PlotOptions po;
+    po.title = "deep k-buffer: features + inference vs a kplus-dynamic frame";
+    po.xLabel = "instruction set (0 scalar, 1 avx2, 2 avx512)";
+    po.yLabel = "ms";
+    auto png = plotLines(series, po);
+    const std::filesystem::path pngPath = std::filesystem::path(args.out) / "dkb.png";
+    if (!png || !writePng(pngPath.string(), *png).ok()) {
+      printError(kProgram, "cannot write " + pngPath.string());
+      failed = true;
+    } else {
+      std::printf("PNG: %s\n", pngPath.string().c_str());
+    }
+  }
   return failed ? 1 : 0;
 }

@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "mfr/core/color.hpp"
+#include "mfr/core/isa.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/optimal_oracle.hpp"
 #include "mfr/cpu/render.hpp"
@@ -137,6 +138,24 @@ TEST(DeepKBuffer, ImportanceEqualsAnIndependentFeaturePassAndBatchInference) {
   learn::predictRows(model->net, rows.data(), covered.size(), predicted.data());
   for (size_t i = 0; i < covered.size(); ++i)
     ASSERT_NEAR(out.importance.importance[covered[i]], predicted[i], 1e-5) << covered[i];
+}
+
+TEST(DeepKBuffer, WideAndScalarPathsPredictTheSameImportanceWithinFloatRounding) {
+  if (detectedIsa() == Isa::Scalar) GTEST_SKIP() << "this CPU has neither AVX2 + FMA nor AVX-512";
+  const HairballFrame h = hairball();
+  const Isa before = activeIsa();
+  setActiveIsa(Isa::Scalar);
+  const RenderOutput scalar = renderDkb(h.frame, "dkb", 600000);
+  setActiveIsa(detectedIsa());
+  const RenderOutput wide = renderDkb(h.frame, "dkb", 600000);
+  setActiveIsa(before);
+  ASSERT_EQ(scalar.importance.importance.size(), wide.importance.importance.size());
+  size_t covered = 0;
+  for (size_t p = 0; p < wide.importance.importance.size(); ++p) {
+    covered += scalar.importance.importance[p] > 0.0f;
+    ASSERT_NEAR(wide.importance.importance[p], scalar.importance.importance[p], 1e-5) << p;
+  }
+  EXPECT_GT(covered, 1000u);
 }
 
 TEST(DeepKBuffer, SumOfKNeverExceedsTheBudgetAndFillKeepsOnePerCoveredPixel) {

@@ -65,11 +65,9 @@ std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const 
   if (importance && m.importanceSource == ImportanceSource::Network) b["importance"] = 4 * pixels;
   if (m.allocation == AllocationPolicy::Optimal) {
     b["oracle_k"] = 4 * pixels;
-    // exact A-buffer (its own buffers), its nodes, offsets and counts kept, error curves
-    const uint64_t abuffer = 8 * abufferFragments + (4 + 4 + 8 + 1 + 4) * pixels;
-    const uint64_t kept = 8 * abufferFragments + (8 + 4) * pixels;
+    // n(p) and the error curves (the A-buffer is tile-local: one tile's nodes per worker)
     const uint64_t curves = 8 * abufferFragments + sizeof(std::vector<double>) * pixels;
-    b["oracle_prepass"] = abuffer + kept + curves;
+    b["oracle_prepass"] = 4 * pixels + curves;
   }
   return b;
 }

@@ -187,17 +187,22 @@ TEST(Preflight, AbufferChecksItsPerPixelBuffersThenItsNodePool) {
       << stages[1].message;
 }
 
-TEST(Preflight, OptimalOracleChecksItsAbufferAndItsErrorCurves) {
+TEST(Preflight, OptimalOracleChecksItsErrorCurvesAfterThePerPixelBuffers) {
+  // the pre-pass's A-buffer is tile-local: its whole-frame memory is n(p) and the curves
   const mfr::RasterFrame frame = frameOf("procedural:spheres?count=20", 64);
   const std::vector<Stage> stages = climbLimits(frame, "optimal", 200u << 10);
-  bool curves = false, prepass = false;
+  bool curves = false, perPixel = false;
+  uint64_t fragments = 0;
+  for (uint32_t c : mfr::countFragments(frame)) fragments += c;
   for (const Stage& s : stages) {
-    curves = curves || contains(s.message, "optimal: the oracle's pre-pass: the error curves of");
-    prepass =
-        prepass ||
-        contains(s.message, "optimal: the oracle's pre-pass: abuffer at 64 x 64 pixels: its ");
+    perPixel = perPixel || contains(s.message, "optimal at 64 x 64 pixels: its per-pixel buffers");
+    if (contains(s.message, "optimal: the oracle's pre-pass: the error curves of " +
+                                std::to_string(fragments) + " fragments")) {
+      curves = true;
+      EXPECT_GE(s.needed, 8 * fragments) << s.message;  // a double per fragment at least
+    }
   }
-  EXPECT_TRUE(curves && prepass) << "stages: " << stages.size();
+  EXPECT_TRUE(curves && perPixel) << "stages: " << stages.size();
   for (size_t i = 1; i < stages.size(); ++i) EXPECT_GT(stages[i].needed, stages[i - 1].needed);
 }
 

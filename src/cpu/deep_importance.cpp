@@ -49,28 +49,38 @@ std::vector<float> predictImportance(const RasterFrame& frame, const learn::Mode
                                      double* featureMs, double* inferenceMs) {
   std::vector<float> importance(frame.pixelCount(), 0.0f);
   std::atomic<uint64_t> featureNs{0}, inferenceNs{0};
+  const double inverseWidth = 1.0 / frame.width();
   frame.forEachTile([&](int tile) {
     auto start = Clock::now();
     const TileRect r = frame.tileRect(tile);
     const int w = r.x1 - r.x0 + 1, h = r.y1 - r.y0 + 1;
-    std::vector<FeatureAccumulator> local(static_cast<size_t>(w) * h);
+    const uint32_t origin = static_cast<uint32_t>(r.y0) * frame.width() + r.x0;
+    // the tile's scratch, reused by the worker from tile to tile
+    thread_local std::vector<FeatureAccumulator> local;
+    thread_local std::vector<int> covered;
+    thread_local Eigen::MatrixXf inputs;
+    local.assign(static_cast<size_t>(w) * h, FeatureAccumulator{});
     frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
-                                           const int x = static_cast<int>(f.pixel % frame.width());
-                                           const int y = static_cast<int>(f.pixel / frame.width());
-                                           local[(y - r.y0) * w + (x - r.x0)].add(f.depth, f.rgba);
+                                           // row and column in the tile without an integer
+                                           // division: (d + 0.5) / width is exact enough
+                                           const uint32_t d = f.pixel - origin;
+                                           const uint32_t y =
+                                               static_cast<uint32_t>((d + 0.5) * inverseWidth);
+                                           const uint32_t x = d - y * frame.width();
+                                           local[y * w + x].add(f.depth, f.rgba);
                                          }});
     // the tile's covered pixels, in row order, are one batch (the same for any thread count)
-    std::vector<int> covered;
+    covered.clear();
     for (int i = 0; i < w * h; ++i)
       if (local[i].n > 0) covered.push_back(i);
     if (covered.empty()) {
       addNs(featureNs, start);
       return;
     }
-    Eigen::MatrixXf inputs(kDkbFeatureCount, static_cast<Eigen::Index>(covered.size()));
+    inputs.resize(kDkbFeatureCount, static_cast<Eigen::Index>(covered.size()));
     for (size_t j = 0; j < covered.size(); ++j) {
       const PixelFeatures f = pixelFeatures(local[covered[j]], image, slots);
-      for (int c = 0; c < kDkbFeatureCount; ++c) inputs(c, static_cast<Eigen::Index>(j)) = f[c];
+      std::copy(f.begin(), f.end(), inputs.col(static_cast<Eigen::Index>(j)).data());
     }
     addNs(featureNs, start);
     start = Clock::now();

@@ -1,10 +1,20 @@
-// The optimal k-buffer's pre-pass (DHOIT sec. 3.1.2): exact A-buffer, sorted pixels, error curves.
+// The optimal k-buffer's pre-pass (DHOIT sec. 3.1.2): every pixel's fragments, sorted, and their
+// error curves.
+//
+// The curves are built tile by tile: a count pass gives n(p); then each worker rasterizes one tile
+// with full shading into a tile-local A-buffer (the tile's n(p) summed, nodes grouped by pixel),
+// sorts each pixel's nodes and writes its curve. The nodes are exactly the A-buffer's (every
+// fragment, the same shading, makeNode) and their sorted order does not depend on the arrival
+// order, so the curves are those of a whole-frame A-buffer without its 8 bytes per fragment
+// (twice, with the kept copy) ever existing at once: the pre-pass holds n(p), the curves and one
+// tile's nodes per worker.
 #include "mfr/cpu/optimal_oracle.hpp"
 
 #include <algorithm>
 #include <string>
 
 #include "mfr/core/memory_limit.hpp"
+#include "mfr/cpu/fragment.hpp"
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/optimal_allocation.hpp"
 
@@ -13,54 +23,55 @@ namespace mfr {
 Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 background,
                                           Compositing compositing,
                                           std::optional<uint64_t> memoryLimitBytes) {
-  RenderOptions exact;
-  exact.keepStores = true;
-  exact.background = background;
-  exact.memoryLimitBytes = memoryLimitBytes;  // the A-buffer checks its own buffers
-  auto truth = render(frame, methodPreset("abuffer").value(), exact);
-  if (!truth) return truth.error();
-  {  // memory pre-flight of the curves (8 bytes per fragment, a vector per pixel) on top of the
-     // A-buffer's output
-    uint64_t fragments = 0;
-    for (uint32_t c : truth->counts) fragments += c;
-    const uint64_t held =
-        truth->nodes.capacity() * sizeof(FragmentNode) +
-        truth->offsets.capacity() * sizeof(uint64_t) +
-        (truth->counts.capacity() + truth->kMap.capacity() + truth->depthComplexity.capacity()) *
-            sizeof(uint32_t) +
-        truth->image.pixels.capacity() * sizeof(glm::vec3);
-    const uint64_t curves = saturatingAdd(saturatingMul(fragments, sizeof(double)),
-                                          saturatingMul(frame.pixelCount(), 24 + 16));
-    MFR_TRY(checkMemory(
-        saturatingAdd(held, curves), memoryLimitBytes.value_or(defaultMemoryLimit()),
-        "the error curves of " + std::to_string(fragments) + " fragments at " +
-            std::to_string(frame.width()) + " x " + std::to_string(frame.height()) + " pixels"));
-  }
   FrameErrorCurves out;
-  out.curves.resize(frame.pixelCount());
-  frame.forEachTile([&](int tile) {
-    const TileRect r = frame.tileRect(tile);
-    std::vector<FragmentNode> local;
-    for (int y = r.y0; y <= r.y1; ++y)
-      for (int x = r.x0; x <= r.x1; ++x) {
-        const size_t p = static_cast<size_t>(y) * frame.width() + x;
-        const FragmentNode* first = truth->nodes.data() + truth->offsets[p];
-        local.assign(first, first + truth->counts[p]);
-        std::sort(local.begin(), local.end());
-        out.curves[p] = errorCurve(local.data(), truth->counts[p], background, compositing);
-      }
-  });
-  out.bytesAllocated =
-      truth->stats.bytesAllocated + truth->nodes.capacity() * sizeof(FragmentNode) +
-      truth->offsets.capacity() * sizeof(uint64_t) + truth->counts.capacity() * sizeof(uint32_t) +
-      out.curves.capacity() * sizeof(std::vector<double>);
-  for (const std::vector<double>& c : out.curves)
-    out.bytesAllocated += c.capacity() * sizeof(double);
-  out.n = std::move(truth->depthComplexity);
+  out.n = countFragments(frame);
   for (uint32_t c : out.n) {
     out.coveredPixels += c > 0;
     out.fragments += c;
   }
+  // memory pre-flight: n(p) and the curves (8 bytes per fragment, a vector per pixel)
+  const uint64_t curveBytes =
+      saturatingAdd(saturatingMul(out.fragments, sizeof(double)),
+                    saturatingMul(frame.pixelCount(), sizeof(std::vector<double>)));
+  MFR_TRY(checkMemory(saturatingAdd(curveBytes, out.n.capacity() * sizeof(uint32_t)),
+                      memoryLimitBytes.value_or(defaultMemoryLimit()),
+                      "the error curves of " + std::to_string(out.fragments) + " fragments at " +
+                          std::to_string(frame.width()) + " x " + std::to_string(frame.height()) +
+                          " pixels"));
+  out.curves.resize(frame.pixelCount());
+  const double inverseWidth = 1.0 / frame.width();
+  frame.forEachTile([&](int tile) {
+    const TileRect r = frame.tileRect(tile);
+    const int w = r.x1 - r.x0 + 1, h = r.y1 - r.y0 + 1;
+    // tile-local A-buffer: pixel i's nodes at first[i] .. first[i] + n
+    std::vector<uint32_t> first(static_cast<size_t>(w) * h + 1, 0), filled(first.size() - 1, 0);
+    for (int y = r.y0, i = 0; y <= r.y1; ++y)
+      for (int x = r.x0; x <= r.x1; ++x, ++i)
+        first[i + 1] = first[i] + out.n[static_cast<size_t>(y) * frame.width() + x];
+    std::vector<FragmentNode> nodes(first.back());
+    const uint32_t origin = static_cast<uint32_t>(r.y0) * frame.width() + r.x0;
+    frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
+                                           // row and column in the tile without an integer
+                                           // division: (d + 0.5) / width is exact enough
+                                           const uint32_t d = f.pixel - origin;
+                                           const uint32_t y =
+                                               static_cast<uint32_t>((d + 0.5) * inverseWidth);
+                                           const uint32_t i = y * w + (d - y * frame.width());
+                                           nodes[first[i] + filled[i]++] = makeNode(f);
+                                         }});
+    for (int y = r.y0, i = 0; y <= r.y1; ++y)
+      for (int x = r.x0; x <= r.x1; ++x, ++i) {
+        const size_t p = static_cast<size_t>(y) * frame.width() + x;
+        MFR_CHECK(filled[i] == out.n[p]);  // the count pass and the shaded pass agree
+        FragmentNode* begin = nodes.data() + first[i];
+        std::sort(begin, begin + filled[i]);
+        out.curves[p] = errorCurve(begin, filled[i], background, compositing);
+      }
+  });
+  out.bytesAllocated =
+      out.n.capacity() * sizeof(uint32_t) + out.curves.capacity() * sizeof(std::vector<double>);
+  for (const std::vector<double>& c : out.curves)
+    out.bytesAllocated += c.capacity() * sizeof(double);
   return out;
 }
 

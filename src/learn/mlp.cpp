@@ -17,6 +17,10 @@
 //    caller's rows through Eigen's packing GEMM and keeps every elementwise operation on its own
 //    (aligned) temporaries, so the alignment of the caller's pointers does not matter either.
 //  - train is single-threaded; Eigen is built without OpenMP here, so its products are too.
+//  - Inference (predict, predictRows) takes the path of activeIsa(): on AVX2 / AVX-512 the wide
+//    kernels of learn/mlp_kernels.hpp (every sample summed in one fixed order, so a sample's
+//    result is the same in any batch), on the scalar path Eigen's forward pass above. The two
+//    agree within float rounding (fused multiply-adds, another summation order).
 #include "mfr/learn/mlp.hpp"
 
 #include <tbb/parallel_for.h>
@@ -27,6 +31,8 @@
 #include <limits>
 #include <numeric>
 #include <random>
+
+#include "learn/mlp_kernels.hpp"
 
 namespace mfr::learn {
 namespace {
@@ -96,6 +102,61 @@ Eigen::MatrixXf forward(const Mlp& net, const Eigen::Ref<const Eigen::MatrixXf>&
     a = std::move(z);
   }
   return a;
+}
+
+/// Samples per wide-kernel batch: the activations of a batch (widest layer x kWideBatch floats,
+/// twice) stay in L2.
+constexpr size_t kWideBatch = 128;
+
+detail::DenseLayerKernel wideKernel(Isa isa) {
+  switch (isa) {
+    case Isa::Avx512:
+      return detail::denseLayerAvx512();
+    case Isa::Avx2:
+      return detail::denseLayerAvx2();
+    case Isa::Scalar:
+      break;
+  }
+  return nullptr;
+}
+
+/// The network over `count` sample-major rows with a wide kernel: per batch of kWideBatch samples,
+/// the rows transposed to the kernels' feature-major layout, the layers, then the sigmoid.
+void forwardWide(const Mlp& net, detail::DenseLayerKernel dense, const float* rows, size_t count,
+                 float* out) {
+  const int inputs = net.inputs(), outputs = net.outputs();
+  const int widest = *std::max_element(net.sizes.begin(), net.sizes.end());
+  constexpr int stride = static_cast<int>(kWideBatch);
+  static_assert(kWideBatch % detail::kBatchAlign == 0);
+  // per-thread activations, reused across calls (a tile's batch is one call)
+  thread_local std::vector<float> bufferA, bufferB;
+  const size_t bufferSize = static_cast<size_t>(widest) * stride;
+  if (bufferA.size() < bufferSize) {
+    bufferA.resize(bufferSize);
+    bufferB.resize(bufferSize);
+  }
+  float* a = bufferA.data();
+  float* b = bufferB.data();
+  const size_t layers = net.weights.size();
+  for (size_t start = 0; start < count; start += kWideBatch) {
+    const size_t n = std::min(kWideBatch, count - start);
+    const float* x = rows + start * static_cast<size_t>(inputs);
+    for (int i = 0; i < inputs; ++i) {
+      float* dst = a + static_cast<size_t>(i) * stride;
+      for (size_t j = 0; j < n; ++j) dst[j] = x[j * static_cast<size_t>(inputs) + i];
+      std::fill(dst + n, dst + stride, 0.0f);  // padding: finite, ignored
+    }
+    for (size_t l = 0; l < layers; ++l) {
+      dense(net.weights[l].data(), net.biases[l].data(), net.sizes[l + 1], net.sizes[l], a, b,
+            stride, !isOutputLayer(net, l));
+      std::swap(a, b);
+    }
+    float* y = out + start * static_cast<size_t>(outputs);
+    for (int o = 0; o < outputs; ++o)
+      for (size_t j = 0; j < n; ++j)
+        y[j * static_cast<size_t>(outputs) + o] =
+            1.0f / (1.0f + std::exp(-a[static_cast<size_t>(o) * stride + j]));
+  }
 }
 
 /// Adds the regularisation's gradient to `grads` and returns its value. The first hidden layer is
@@ -198,12 +259,24 @@ Mlp makeMlp(const std::vector<int>& sizes, uint64_t seed) {
 }
 
 Eigen::MatrixXf predict(const Mlp& net, const Eigen::MatrixXf& inputs) {
+  return predict(net, inputs, activeIsa());
+}
+
+Eigen::MatrixXf predict(const Mlp& net, const Eigen::MatrixXf& inputs, Isa isa) {
   checkShapes(net);
   MFR_CHECK(inputs.rows() == net.inputs());
   Eigen::MatrixXf out(net.outputs(), inputs.cols());
+  // never a path the CPU lacks
+  if (static_cast<int>(isa) > static_cast<int>(detectedIsa())) isa = detectedIsa();
+  const detail::DenseLayerKernel dense = wideKernel(isa);
   for (Index start = 0; start < inputs.cols(); start += kChunk) {
     const Index n = std::min(kChunk, inputs.cols() - start);
-    out.middleCols(start, n) = forward(net, inputs.middleCols(start, n));
+    if (dense) {
+      forwardWide(net, dense, inputs.col(start).data(), static_cast<size_t>(n),
+                  out.col(start).data());
+    } else {
+      out.middleCols(start, n) = forward(net, inputs.middleCols(start, n));
+    }
   }
   return out;
 }
@@ -213,9 +286,15 @@ void predictRows(const Mlp& net, const float* rows, size_t count, float* out) {
   const size_t chunk = static_cast<size_t>(kChunk);
   const size_t chunks = (count + chunk - 1) / chunk;
   const Index inputs = net.inputs(), outputs = net.outputs();
+  const detail::DenseLayerKernel dense = wideKernel(activeIsa());
   tbb::parallel_for(size_t{0}, chunks, [&](size_t c) {
     const size_t start = c * chunk;
     const Index n = static_cast<Index>(std::min(chunk, count - start));
+    if (dense) {
+      forwardWide(net, dense, rows + start * static_cast<size_t>(inputs), static_cast<size_t>(n),
+                  out + start * static_cast<size_t>(outputs));
+      return;
+    }
     // sample-major rows are the columns of a column-major (inputs x n) matrix
     const Eigen::Map<const Eigen::MatrixXf> x(rows + start * static_cast<size_t>(inputs), inputs,
                                               n);

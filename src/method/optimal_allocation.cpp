@@ -3,10 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <queue>
 
 #include "mfr/core/color.hpp"
+#include "mfr/core/result.hpp"
 
 namespace mfr {
 
@@ -87,69 +89,241 @@ struct HullSolution {
   double lambda = 0.0;  // drop per slot of the first segment not bought whole (0: all bought)
 };
 
-// The hull allocator (see the header); also returns the critical multiplier lambda.
-HullSolution hullAllocation(const std::vector<std::vector<double>>& curves, uint64_t slots) {
-  HullSolution out;
-  std::vector<uint32_t>& k = out.k;
-  k.assign(curves.size(), 0);
-  uint64_t used = 0;
+// The hull allocator buys the segments of every pixel's lower convex hull in the order (drop per
+// slot descending, then pixel and position in its chain), whole while they fit, then the critical
+// and later ones partially. Sorting every segment of a large frame costs seconds and tens of
+// bytes per fragment, so the order is materialised only where it matters:
+//
+//   hull       per pixel, the hull's vertices k (flat, at the pixel's own offset; <= n(p) each).
+//              A chain is cut before the first segment whose drop exceeds its predecessor's (only
+//              rounding makes that happen): such a segment reaches its turn before the pixel
+//              gets to its start, is skipped, and so is everything after it.
+//   level 1    cost (slots) per bucket of the top 16 bits of the drop's order key: the buckets
+//              above the one where the cumulative cost first exceeds the budget are bought whole;
+//   level 2    the same on the next 16 bits inside that bucket;
+//   chunks     the segments sharing the critical 32-bit prefix are sorted exactly and processed
+//              one by one as the straightforward loop does, then the lower keys in chunks of at
+//              least OracleOptions::hullChunkSegments until the budget is spent.
+// The result (k and lambda) is the straightforward sorted loop's, bit for bit.
+class HullAllocator {
+ public:
+  HullAllocator(const std::vector<std::vector<double>>& curves, uint64_t slots,
+                uint64_t chunkSegments)
+      : curves_(curves), slots_(slots), chunkSegments_(std::max<uint64_t>(chunkSegments, 1)) {}
+
+  HullSolution run() {
+    HullSolution out;
+    out.k.assign(curves_.size(), 0);
+    k_ = &out.k;
+    buildHulls();
+    // level 1
+    std::vector<uint64_t> cost1(kBuckets, 0), count1(kBuckets, 0);
+    forEachSegment([&](const Segment& s) {
+      cost1[s.key >> 48] += s.to - s.from;
+      ++count1[s.key >> 48];
+    });
+    const int64_t budget = static_cast<int64_t>(slots_) - static_cast<int64_t>(used_);
+    int64_t cum = 0;
+    const int b1 = criticalBucket(cost1, budget, cum);
+    if (b1 < 0) {  // every segment fits
+      forEachSegment([&](const Segment& s) { buy(s); });
+      return out;
+    }
+    // level 2 inside b1, buying whole what lies above b1
+    std::vector<uint64_t> cost2(kBuckets, 0);
+    forEachSegment([&](const Segment& s) {
+      const uint64_t top = s.key >> 48;
+      if (top > static_cast<uint64_t>(b1)) {
+        buy(s);
+      } else if (top == static_cast<uint64_t>(b1)) {
+        cost2[(s.key >> 32) & 0xffff] += s.to - s.from;
+      }
+    });
+    int64_t cum2 = 0;
+    const int b2 = criticalBucket(cost2, budget - cum, cum2);
+    MFR_CHECK(b2 >= 0);
+    const uint64_t prefix = (static_cast<uint64_t>(b1) << 16) | static_cast<uint64_t>(b2);
+    // chunk 0: the critical 32-bit prefix, buying whole what lies above it in b1
+    std::vector<Segment> chunk;
+    forEachSegment([&](const Segment& s) {
+      const uint64_t top32 = s.key >> 32;
+      if ((top32 >> 16) != static_cast<uint64_t>(b1)) return;
+      if (top32 > prefix) {
+        buy(s);
+      } else if (top32 == prefix) {
+        chunk.push_back(s);
+      }
+    });
+    process(chunk, out.lambda);
+    // lower keys, in chunks: [lower, upper)
+    uint64_t upper = prefix << 32;
+    int bucket = b1;
+    while (!done() && upper > 0) {
+      uint64_t lower = static_cast<uint64_t>(bucket) << 48, count = 0;
+      if (lower == upper) {
+        --bucket;
+        lower = static_cast<uint64_t>(bucket) << 48;
+        count = count1[bucket];
+      }
+      while (bucket > 0 && count < chunkSegments_) {
+        --bucket;
+        lower = static_cast<uint64_t>(bucket) << 48;
+        count += count1[bucket];
+      }
+      chunk.clear();
+      forEachSegment([&](const Segment& s) {
+        if (s.key >= lower && s.key < upper) chunk.push_back(s);
+      });
+      process(chunk, out.lambda);
+      upper = lower;
+    }
+    return out;
+  }
+
+ private:
+  static constexpr int kBuckets = 1 << 16;
+
   struct Segment {
+    uint64_t key;    // order key of dropPerSlot: larger first
+    uint64_t index;  // position in the flat hull array: pixel, then chain order
     double dropPerSlot;
     uint32_t pixel, from, to;  // k values
   };
-  std::vector<Segment> segments;
-  std::vector<uint32_t> hull;
-  for (size_t p = 0; p < curves.size(); ++p) {
-    const std::vector<double>& e = curves[p];
-    if (e.empty()) continue;
-    k[p] = 1;
-    ++used;
-    // lower convex hull of (k, e(k)), k = 1..n (monotone chain)
-    hull.clear();
-    for (uint32_t x = 1; x <= e.size(); ++x) {
-      while (hull.size() >= 2) {
-        const uint32_t a = hull[hull.size() - 2], b = hull.back();
-        // drop b if it lies on or above the line from a to x
-        const double cross = (e[b - 1] - e[a - 1]) * (x - a) - (e[x - 1] - e[a - 1]) * (b - a);
-        if (cross >= 0.0) {
-          hull.pop_back();
-        } else {
-          break;
+
+  // unsigned order of the key = numeric order of the double (no NaN; -0 taken as 0)
+  static uint64_t orderKey(double d) {
+    if (d == 0.0) d = 0.0;
+    uint64_t bits = 0;
+    std::memcpy(&bits, &d, sizeof bits);
+    return (bits >> 63) ? ~bits : bits | (uint64_t{1} << 63);
+  }
+
+  // highest bucket where the cumulative cost (from the top) first exceeds `budget`; -1 if none.
+  // `cum` receives the cost of the buckets above it.
+  static int criticalBucket(const std::vector<uint64_t>& cost, int64_t budget, int64_t& cum) {
+    cum = 0;
+    for (int b = kBuckets - 1; b >= 0; --b) {
+      if (cost[b] == 0) continue;
+      if (cum + static_cast<int64_t>(cost[b]) > budget) return b;
+      cum += static_cast<int64_t>(cost[b]);
+    }
+    return -1;
+  }
+
+  void buildHulls() {
+    start_.assign(curves_.size() + 1, 0);
+    uint64_t total = 0;
+    for (size_t p = 0; p < curves_.size(); ++p) {
+      start_[p] = total;
+      total += curves_[p].size();
+    }
+    start_.back() = total;
+    hull_.resize(total);
+    length_.assign(curves_.size(), 0);
+    for (size_t p = 0; p < curves_.size(); ++p) {
+      const std::vector<double>& e = curves_[p];
+      if (e.empty()) continue;
+      (*k_)[p] = 1;
+      ++used_;
+      // lower convex hull of (k, e(k)), k = 1..n (monotone chain)
+      uint32_t* hull = hull_.data() + start_[p];
+      uint32_t size = 0;
+      for (uint32_t x = 1; x <= e.size(); ++x) {
+        while (size >= 2) {
+          const uint32_t a = hull[size - 2], b = hull[size - 1];
+          // drop b if it lies on or above the line from a to x
+          const double cross = (e[b - 1] - e[a - 1]) * (x - a) - (e[x - 1] - e[a - 1]) * (b - a);
+          if (cross >= 0.0) {
+            --size;
+          } else {
+            break;
+          }
         }
+        hull[size++] = x;
       }
-      hull.push_back(x);
+      // cut the chain before its first rising drop
+      uint32_t live = 1;
+      double previous = std::numeric_limits<double>::infinity();
+      for (; live < size; ++live) {
+        const double d = dropPerSlot(e, hull[live - 1], hull[live]);
+        if (d > previous) break;
+        previous = d;
+      }
+      length_[p] = live;
     }
-    for (size_t i = 1; i < hull.size(); ++i)
-      segments.push_back({(e[hull[i - 1] - 1] - e[hull[i] - 1]) / (hull[i] - hull[i - 1]),
-                          static_cast<uint32_t>(p), hull[i - 1], hull[i]});
   }
-  // convex hulls: within a pixel the drops decrease, so the global order respects each chain
-  std::stable_sort(segments.begin(), segments.end(), [](const Segment& a, const Segment& b) {
-    return a.dropPerSlot > b.dropPerSlot;
-  });
-  bool critical = false;
-  for (const Segment& s : segments) {
-    if (k[s.pixel] != s.from) continue;  // an earlier segment of this pixel was cut short
-    const uint64_t cost = s.to - s.from;
-    if (used + cost <= slots) {
-      k[s.pixel] = s.to;
-      used += cost;
-      continue;
-    }
-    if (!critical) {
-      critical = true;
-      out.lambda = std::max(0.0, s.dropPerSlot);
-    }
-    if (used >= slots) break;
-    // partial: the best k in (from, from + affordable]
-    const std::vector<double>& e = curves[s.pixel];
-    uint32_t best = s.from;
-    for (uint32_t x = s.from + 1; x <= s.from + (slots - used); ++x)
-      if (e[x - 1] < e[best - 1]) best = x;
-    used += best - s.from;
-    k[s.pixel] = best;
+
+  static double dropPerSlot(const std::vector<double>& e, uint32_t from, uint32_t to) {
+    return (e[from - 1] - e[to - 1]) / (to - from);
   }
-  return out;
+
+  template <class F>
+  void forEachSegment(F&& f) const {
+    for (size_t p = 0; p < curves_.size(); ++p) {
+      const uint32_t* hull = hull_.data() + start_[p];
+      for (uint32_t i = 1; i < length_[p]; ++i) {
+        Segment s;
+        s.dropPerSlot = dropPerSlot(curves_[p], hull[i - 1], hull[i]);
+        s.key = orderKey(s.dropPerSlot);
+        s.index = start_[p] + i;
+        s.pixel = static_cast<uint32_t>(p);
+        s.from = hull[i - 1];
+        s.to = hull[i];
+        f(s);
+      }
+    }
+  }
+
+  // a segment above the critical one: bought whole (its chain's earlier segments are too)
+  void buy(const Segment& s) {
+    (*k_)[s.pixel] = std::max((*k_)[s.pixel], s.to);
+    used_ += s.to - s.from;
+  }
+
+  bool done() const { return critical_ && used_ >= slots_; }
+
+  // the straightforward loop over a chunk sorted in the global order
+  void process(std::vector<Segment>& chunk, double& lambda) {
+    std::sort(chunk.begin(), chunk.end(), [](const Segment& a, const Segment& b) {
+      return a.key != b.key ? a.key > b.key : a.index < b.index;
+    });
+    std::vector<uint32_t>& k = *k_;
+    for (const Segment& s : chunk) {
+      if (k[s.pixel] != s.from) continue;  // an earlier segment of this pixel was cut short
+      const uint64_t cost = s.to - s.from;
+      if (used_ + cost <= slots_) {
+        k[s.pixel] = s.to;
+        used_ += cost;
+        continue;
+      }
+      if (!critical_) {
+        critical_ = true;
+        lambda = std::max(0.0, s.dropPerSlot);
+      }
+      if (used_ >= slots_) return;
+      // partial: the best k in (from, from + affordable]
+      const std::vector<double>& e = curves_[s.pixel];
+      uint32_t best = s.from;
+      for (uint32_t x = s.from + 1; x <= s.from + (slots_ - used_); ++x)
+        if (e[x - 1] < e[best - 1]) best = x;
+      used_ += best - s.from;
+      k[s.pixel] = best;
+    }
+  }
+
+  const std::vector<std::vector<double>>& curves_;
+  const uint64_t slots_;
+  const uint64_t chunkSegments_;
+  std::vector<uint32_t>* k_ = nullptr;
+  std::vector<uint64_t> start_;  // per pixel, its hull's offset in hull_ (prefix of n)
+  std::vector<uint32_t> hull_, length_;
+  uint64_t used_ = 0;
+  bool critical_ = false;
+};
+
+HullSolution hullAllocation(const std::vector<std::vector<double>>& curves, uint64_t slots,
+                            uint64_t chunkSegments) {
+  return HullAllocator(curves, slots, chunkSegments).run();
 }
 
 // Exact minimum over k_p in options[p] (ascending), sum k <= capacity + sum options[p][0], by
@@ -203,7 +377,12 @@ bool exactCore(const std::vector<std::vector<double>>& curves, const std::vector
 
 std::vector<uint32_t> allocateOptimalHull(const std::vector<std::vector<double>>& curves,
                                           uint64_t slots) {
-  return hullAllocation(curves, slots).k;
+  return allocateOptimalHull(curves, slots, OracleOptions{});
+}
+
+std::vector<uint32_t> allocateOptimalHull(const std::vector<std::vector<double>>& curves,
+                                          uint64_t slots, const OracleOptions& options) {
+  return hullAllocation(curves, slots, options.hullChunkSegments).k;
 }
 
 bool errorCurveIsConvex(const std::vector<double>& e) {
@@ -231,7 +410,7 @@ OracleAllocation allocateOptimal(const std::vector<std::vector<double>>& curves,
     return out;
   }
 
-  HullSolution hull = hullAllocation(curves, slots);
+  HullSolution hull = hullAllocation(curves, slots, options.hullChunkSegments);
   const double lambda = hull.lambda;
   // Lagrangian bound: sum_p min_k (err_p(k) + lambda k) - lambda F <= any feasible error
   std::vector<double> floorCost(curves.size(), 0.0);

@@ -34,7 +34,9 @@ struct Model;
 std::vector<uint32_t> countWithDepthRange(const RasterFrame& frame, ImageFeatureStats& image);
 
 /// I(p) for every pixel (0 where n(p) = 0); `slots` = F(M). `featureMs` and `inferenceMs` receive
-/// the time spent in each part, summed over workers (CPU time, not wall time).
+/// the time spent in each part, summed over workers (CPU time): the statistics split the fused
+/// pass's wall time between "features" and "inference" in proportion to them. The network runs
+/// on activeIsa()'s path (learn/mlp.hpp).
 std::vector<float> predictImportance(const RasterFrame& frame, const learn::Model& model,
                                      const ImageFeatureStats& image, uint64_t slots,
                                      double* featureMs = nullptr, double* inferenceMs = nullptr);

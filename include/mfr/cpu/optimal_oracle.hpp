@@ -1,6 +1,8 @@
 // The optimal k-buffer's pre-pass over a frame (DHOIT sec. 3.1.2): an exact A-buffer, each pixel's
-// fragments sorted, and its hybrid error curve err_p(k) (optimal_allocation.hpp). The curves do
-// not depend on the budget, so one pre-pass serves any number of budgets (mfr dataset).
+// fragments sorted, and its hybrid error curve err_p(k) (optimal_allocation.hpp). The A-buffer is
+// tile-local (a count pass, then one tile's fragments per worker), so only n(p) and the curves
+// exist for the whole frame. The curves do not depend on the budget, so one pre-pass serves any
+// number of budgets (mfr dataset).
 #pragma once
 
 #include <cstdint>
@@ -21,7 +23,7 @@ struct FrameErrorCurves {
   std::vector<uint32_t> n;                  // n(p)
   uint64_t coveredPixels = 0;
   uint64_t fragments = 0;  // sum n(p)
-  /// Bytes the pre-pass allocated: the A-buffer's buffers, its kept nodes and the curves.
+  /// Bytes the pre-pass allocated for the whole frame: n(p) and the curves.
   uint64_t bytesAllocated = 0;
 };
 

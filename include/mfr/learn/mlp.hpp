@@ -15,6 +15,7 @@
 
 #include <Eigen/Core>
 
+#include "mfr/core/isa.hpp"
 #include "mfr/core/result.hpp"
 
 namespace mfr::learn {
@@ -37,8 +38,13 @@ void checkShapes(const Mlp& net);
 /// He-uniform weights, zero biases, deterministic from the seed.
 Mlp makeMlp(const std::vector<int>& sizes, uint64_t seed);
 
-/// Forward pass of a batch: `inputs` is (sizes[0] x count); returns (sizes.back() x count).
+/// Forward pass of a batch: `inputs` is (sizes[0] x count); returns (sizes.back() x count). On
+/// the instruction set of activeIsa(): the AVX2 / AVX-512 kernels, or Eigen on the scalar path
+/// (they agree within float rounding; each is deterministic for any batch and thread count).
 Eigen::MatrixXf predict(const Mlp& net, const Eigen::MatrixXf& inputs);
+
+/// The same on a given path (lowered to what the CPU has): for tests comparing the paths.
+Eigen::MatrixXf predict(const Mlp& net, const Eigen::MatrixXf& inputs, Isa isa);
 
 /// Inference over `count` samples stored row by row (count x inputs floats, sample-major, as the
 /// feature pass writes them) into `out` (count x outputs), in fixed-size chunks on oneTBB workers:

@@ -61,7 +61,14 @@ struct OracleOptions {
   uint64_t maxDpCells = uint64_t{1} << 28;
   /// Published greedy (DHOIT Algorithm 1) instead of the exact oracle; the bound is still given.
   bool publishedGreedy = false;
+  /// The hull allocator sorts the segments below the critical one in chunks of at least this
+  /// many (the result does not depend on it; tests lower it to cover the chunking).
+  uint64_t hullChunkSegments = uint64_t{1} << 20;
 };
+
+/// allocateOptimalHull with the chunking of `options` (the same k for any chunk size).
+std::vector<uint32_t> allocateOptimalHull(const std::vector<std::vector<double>>& curves,
+                                          uint64_t slots, const OracleOptions& options);
 
 /// An allocation with what is known of its distance to the true minimum.
 struct OracleAllocation {
