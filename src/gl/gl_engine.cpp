@@ -1286,12 +1286,17 @@ Result<GlAllocationTotals> GlEngine::allocateByImportance(const ImportanceParams
   if (s.device->failure) return *s.device->failure;
   if (fb.failure) return *fb.failure;
   timedPass(passes, "importance total", [&] {
-    glUseProgram(s.progImportanceTotal);
-    glProgramUniform1ui(s.progImportanceTotal, loc(s.progImportanceTotal, "uPixels"), pixels);
+    const GLuint q = s.progImportanceTotal;
+    glUseProgram(q);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImportance, s.deviceImportance);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImportanceTotal, total);
-    glDispatchCompute(1, 1, 1);
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    // in order, kTotalChunk pixels per dispatch (the running sum stays in `total`)
+    for (uint32_t first = 0; first < pixels; first += std::min(kTotalChunk, pixels - first)) {
+      glProgramUniform1ui(q, loc(q, "uFirst"), first);
+      glProgramUniform1ui(q, loc(q, "uEnd"), first + std::min(kTotalChunk, pixels - first));
+      glDispatchCompute(1, 1, 1);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
   });
   const GLuint totals = fb.make("allocation totals", kAllocTotalWords * 4);
   clearUint(totals, 0);

@@ -297,6 +297,29 @@ TEST(GlSeamDevice, VariableKAllocationInComputeShadersIsTheCpuEngines) {
     }
 }
 
+// Above 65535 pixels (llvmpipe ends a shader's loops after 65535 iterations in all: I_tot's
+// serial sum runs in several dispatches), the importance allocation is still the CPU engine's.
+TEST(GlSeamDevice, ImportanceAllocationBeyond65535Pixels) {
+  MFR_GL_ENGINE(gl);
+  const Scene scene = loadScene("procedural:layers").value();
+  const View view{&scene, frameBounds(sceneBounds(scene)), 320, 256};
+  CpuEngine cpu(EngineOptions{2, 16});
+  const MethodDesc method = methodPreset("vkb").value();
+  RenderOptions options;
+  options.budgetBytes = 40u << 20;  // (k(p) 123-168: every pixel's I(p) counts in I_tot)
+  RenderOptions cpuOptions = options;
+  cpuOptions.capture = CaptureMode::FragmentParallel;
+  auto g = gl->render(view, method, options);
+  auto r = cpu.render(view, method, cpuOptions);
+  ASSERT_TRUE(g.ok()) << g.error().message;
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_EQ(g->stats.bytesUsed, r->stats.bytesUsed);
+  EXPECT_EQ(g->stats.fragmentSlots, r->stats.fragmentSlots);
+  EXPECT_EQ(g->importance.importance, r->importance.importance);
+  EXPECT_EQ(g->kMap, r->kMap);
+  EXPECT_EQ(g->image.pixels, r->image.pixels);
+}
+
 // The budget checks after the GPU's totals: a budget with room for the per-pixel words but not for
 // one node per covered pixel, or for an explicit k, gives the CPU engine's words.
 TEST(GlSeamDevice, BudgetErrorsFromTheGpuTotalsAreTheCpuEngines) {

@@ -83,6 +83,7 @@ MFR_GL_CONST(uint, kAllocTotalWords, 4u)        // sum of k(p) materialised, as 
 MFR_GL_CONST(uint, kAllocCapped, 0u)            // alloc_k.comp: k(p) = min(n(p), k)
 MFR_GL_CONST(uint, kAllocByImportance, 1u)      // alloc_k.comp: k(p) = floor(I(p) / I_tot F(M))
 MFR_GL_CONST(uint, kImportanceWords, 5u)        // per pixel I, I_d, I_per, I_f, noise (floats)
+MFR_GL_CONST(uint, kTotalChunk, 32768u)         // importance_total.comp: pixels per dispatch
 MFR_GL_CONST(uint, kCosineNone, 0u)             // importance.comp: |n.v| source
 MFR_GL_CONST(uint, kCosineNearest, 1u)          // the nearest pass's unorm8 (kNearestWords)
 MFR_GL_CONST(uint, kCosineFloats, 2u)           // a previous frame's floats
