@@ -1,5 +1,7 @@
 // The GL engine behind the Engine seam (mfr/gl/gl_render_engine.hpp). The k of a fixed-k method
-// and the budget checks come from the shared allocate() (the same errors as the CPU engine); the
+// and the budget checks come from the shared allocate() or, for the counted, dynamic and
+// importance-map k computed in compute shaders, from its checks of the GPU's totals (boundedK,
+// checkBoundedSlots, checkCoveredPixels: the same errors as the CPU engine); the
 // memory charged is MemoryModel's (a lock word per pixel for the fixed-k stores, which take the
 // per-pixel spin-lock; the A-buffer appends with atomics); what GL allocated is bytes_allocated.
 #include "mfr/gl/gl_render_engine.hpp"
@@ -144,7 +146,13 @@ class GlRenderEngine final : public Engine {
         auto totals = gv->engine().allocateByImportance(method.importance, previous, slots,
                                                         method.store, &passes);
         if (!totals) return totals.error();
-        MFR_CHECK(totals->reservedSlots <= slots);  // floor(P(p) F(M)) sums to at most F(M)
+        // floor(P(p) F(M)) sums to at most F(M) with IEEE double arithmetic (as on the host);
+        // a driver whose double division rounds otherwise could exceed it by a few slots
+        if (totals->reservedSlots > slots)
+          return makeError("--engine gl: " + method.name +
+                           ": the GPU's importance allocation took " +
+                           std::to_string(totals->reservedSlots) + " slots of " +
+                           std::to_string(slots) + " (double arithmetic not IEEE on this driver)");
       } else {
         auto k = boundedK(layout, method, memory, options.budgetBytes, *summary);
         if (!k) return k.error();
