@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <optional>
 #include <utility>
 
 #include "gl/shader_sources.hpp"
@@ -26,6 +27,7 @@ static_assert((static_cast<uint64_t>(kFarDepthBits) << 32) == kFarNode);
 static_assert(static_cast<uint32_t>(AlphaMode::Opaque) == kAlphaOpaque);
 static_assert(static_cast<uint32_t>(AlphaMode::Mask) == kAlphaMask);
 static_assert(kTableWords == kTableBoundBase + 257u && kTableBoundBase == kTableCoarseBase + 4096u);
+static_assert(kAllocHistogramBins == kHistogramBins && kAllocSummaryWords == kHistogramBins + 1);
 
 uint64_t GlRenderOutput::totalBufferBytes() const {
   uint64_t total = 0;
@@ -114,22 +116,26 @@ GLint loc(GLuint program, const char* name) {
   return glGetUniformLocation(program, name);
 }
 
-// Buffers of one frame, deleted with it; their sizes go to the ledger.
+// Buffers of one frame, deleted with it; their sizes go to the ledger. The first buffer GL could
+// not allocate is `failure` (later makes return 0; the frame's passes are skipped).
 struct FrameBuffers {
   std::vector<GLuint> buffers, textures;
   std::map<std::string, uint64_t>* ledger = nullptr;
+  std::optional<Error> failure;
   ~FrameBuffers() {
     if (!buffers.empty()) glDeleteBuffers(static_cast<GLsizei>(buffers.size()), buffers.data());
     if (!textures.empty()) glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
   }
   GLuint make(const std::string& name, uint64_t bytes, const void* data = nullptr) {
-    GLuint b = 0;
-    glCreateBuffers(1, &b);
-    glNamedBufferData(b, static_cast<GLsizeiptr>(std::max<uint64_t>(bytes, 16)), data,
-                      GL_DYNAMIC_COPY);
-    buffers.push_back(b);
+    if (failure) return 0;
+    auto b = createCheckedBuffer(name, bytes, data);
+    if (!b) {
+      failure = b.error();
+      return 0;
+    }
+    buffers.push_back(*b);
     (*ledger)[name] += bytes;
-    return b;
+    return *b;
   }
   // an r32ui imageBuffer view of a buffer, bound to an image unit
   void bindImage(GLuint buffer, GLuint unit) {
@@ -153,7 +159,47 @@ void dispatchGroups(uint64_t groups) {
   glDispatchCompute(static_cast<GLuint>(x), static_cast<GLuint>(y), 1);
 }
 
+// runs a pass and appends its wall time (glFinish included) to `passes`
+template <class Body>
+void timedPass(std::vector<GlPassTime>* passes, const char* name, Body&& body) {
+  const auto t0 = std::chrono::steady_clock::now();
+  body();
+  glFinish();
+  if (passes)
+    passes->push_back(
+        {name, 0.0,
+         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count()});
+}
+
+std::string glErrorText(GLenum e) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%x", e);
+  return buf;
+}
+
 }  // namespace
+
+Result<unsigned> createCheckedBuffer(const std::string& name, uint64_t bytes, const void* data,
+                                     bool staticDraw) {
+  const uint64_t size = std::max<uint64_t>(bytes, 16);
+  if (size > static_cast<uint64_t>(INT64_MAX))
+    return makeError("--engine gl: the " + name + " buffer needs " + std::to_string(bytes) +
+                     " B, beyond GL's buffer sizes");
+  GLuint b = 0;
+  glCreateBuffers(1, &b);
+  glNamedBufferData(b, static_cast<GLsizeiptr>(size), data,
+                    staticDraw ? GL_STATIC_DRAW : GL_DYNAMIC_COPY);
+  const GLenum e = glGetError();
+  if (e == GL_NO_ERROR && b != 0) return b;
+  glDeleteBuffers(1, &b);
+  while (glGetError() != GL_NO_ERROR) {
+  }
+  return makeError(
+      "--engine gl: out of GPU memory: the " + name + " buffer (" + std::to_string(bytes) +
+      " B) could not be allocated (" +
+      (e == GL_OUT_OF_MEMORY ? std::string("GL_OUT_OF_MEMORY") : "GL error " + glErrorText(e)) +
+      ")");
+}
 
 Result<unsigned> compileShaderSource(unsigned stage, const std::string& name,
                                      const std::string& source) {
@@ -190,16 +236,30 @@ struct GlEngine::State {
          progResolve = 0, progDepthRange = 0, progOccFill = 0, progOccCount = 0, progNearest = 0,
          progWboit = 0, progWboitResolve = 0, progMboitMoments = 0, progMboitColor = 0,
          progMboitResolve = 0, progMlab = 0, progMlabResolve = 0, progDkbFeatures = 0,
-         progDkbInfer = 0;
+         progDkbInfer = 0, progAllocHistogram = 0, progImportance = 0, progImportanceTotal = 0,
+         progAllocK = 0, progAllocPack = 0;
+  // the fixed-k capture with 64-bit atomics (0: the driver lacks GL_NV_shader_atomic_int64)
+  GLuint progKBufferAtomic64 = 0, progSwapWords = 0;
   GLuint query = 0;
+  // the variable-k allocation the compute shaders computed (countOnDevice, allocateCapped,
+  // allocateByImportance), kept for render() and the read-backs of the output
+  std::map<std::string, uint64_t> deviceLedger;
+  std::unique_ptr<FrameBuffers> device;
+  GLuint deviceCounts = 0, deviceCapacity = 0, deviceReserved = 0, deviceWords = 0,
+         deviceImportance = 0, deviceNearest = 0;
+  uint64_t deviceSlots = 0, deviceReservedSlots = 0;
+  bool deviceByImportance = false;
   uint64_t maxBlockBytes = 0;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
   std::map<std::string, uint64_t> sceneBytes;
 
   ~State() {
-    for (GLuint p : {progCount, progABuffer, progKBuffer, progScan, progScanAdd, progResolve,
-                     progDepthRange, progOccFill, progOccCount, progNearest, progWboit,
-                     progWboitResolve, progMboitMoments, progMboitColor, progMboitResolve, progMlab,
-                     progMlabResolve, progDkbFeatures, progDkbInfer})
+    for (GLuint p : {progCount,           progABuffer,         progKBuffer,      progScan,
+                     progScanAdd,         progResolve,         progDepthRange,   progOccFill,
+                     progOccCount,        progNearest,         progWboit,        progWboitResolve,
+                     progMboitMoments,    progMboitColor,      progMboitResolve, progMlab,
+                     progMlabResolve,     progDkbFeatures,     progDkbInfer,     progAllocHistogram,
+                     progImportance,      progImportanceTotal, progAllocK,       progAllocPack,
+                     progKBufferAtomic64, progSwapWords})
       if (p) glDeleteProgram(p);
     if (!sceneBuffers.empty())
       glDeleteBuffers(static_cast<GLsizei>(sceneBuffers.size()), sceneBuffers.data());
@@ -208,14 +268,17 @@ struct GlEngine::State {
     if (query) glDeleteQueries(1, &query);
   }
 
+  std::optional<Error> uploadFailure;  // the first scene buffer GL could not allocate
   GLuint upload(const std::string& name, uint64_t bytes, const void* data) {
-    GLuint b = 0;
-    glCreateBuffers(1, &b);
-    glNamedBufferData(b, static_cast<GLsizeiptr>(std::max<uint64_t>(bytes, 16)), data,
-                      GL_STATIC_DRAW);
-    sceneBuffers.push_back(b);
+    if (uploadFailure) return 0;
+    auto b = createCheckedBuffer(name, bytes, data, /*staticDraw=*/true);
+    if (!b) {
+      uploadFailure = b.error();
+      return 0;
+    }
+    sceneBuffers.push_back(*b);
     sceneBytes[name] += bytes;
-    return b;
+    return *b;
   }
 
   void setRasterUniforms(GLuint p) const {
@@ -266,6 +329,71 @@ struct GlEngine::State {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindScanSums, scanned);
     dispatchGroups((count + kScanGroupSize - 1) / kScanGroupSize);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+  }
+
+  // k(p) by alloc_k.comp (the uniforms set by the caller; `totals` cleared), then the prefix sum
+  // and the packed per-pixel words; the totals read back
+  Result<GlAllocationTotals> allocateK(FrameBuffers& fb, GLuint totals, GLuint importance,
+                                       GLuint total, StoreChoice store,
+                                       std::vector<GlPassTime>* passes) {
+    const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(width) * height);
+    const uint64_t groups = (uint64_t{pixels} + kResolveGroupSize - 1) / kResolveGroupSize;
+    deviceCapacity = device->make("k(p)", uint64_t{pixels} * 4);
+    deviceReserved = device->make("k(p) allocated", uint64_t{pixels} * 4);
+    if (device->failure) return *device->failure;
+    if (fb.failure) return *fb.failure;
+    timedPass(passes, "k(p)", [&] {
+      glUseProgram(progAllocK);
+      glProgramUniform1ui(progAllocK, loc(progAllocK, "uPixels"), pixels);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocCounts, deviceCounts);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocSummary, totals);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocK, deviceCapacity);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocReserved, deviceReserved);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImportance, importance);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImportanceTotal, total);
+      dispatchGroups(groups);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    });
+    uint32_t words[kAllocTotalWords] = {};
+    glGetNamedBufferSubData(totals, 0, sizeof words, words);
+    deviceSlots = (uint64_t{words[1]} << 32) | words[0];
+    deviceReservedSlots = (uint64_t{words[3]} << 32) | words[2];
+    const GLuint offsets = fb.make("allocation offsets", uint64_t{pixels} * 4);
+    timedPass(passes, "prefix sum", [&] { scan(fb, deviceCapacity, offsets, pixels); });
+    uint32_t storeMode = 0;
+    switch (store) {
+      case StoreChoice::MaxHeap:
+        storeMode = 1;
+        break;
+      case StoreChoice::PerPixel:
+        storeMode = 2;
+        break;
+      case StoreChoice::Append:
+      case StoreChoice::MaxArray:
+      case StoreChoice::MultiLayer:
+      case StoreChoice::None:
+        storeMode = 0;
+        break;
+    }
+    deviceWords = device->make("allocation", uint64_t{pixels} * 8);
+    if (device->failure) return *device->failure;
+    if (fb.failure) return *fb.failure;
+    timedPass(passes, "allocation words", [&] {
+      glUseProgram(progAllocPack);
+      glProgramUniform1ui(progAllocPack, loc(progAllocPack, "uPixels"), pixels);
+      glProgramUniform1ui(progAllocPack, loc(progAllocPack, "uStore"), storeMode);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocCounts, deviceCounts);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocK, deviceCapacity);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocOffsets, offsets);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocWords, deviceWords);
+      dispatchGroups(groups);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                      GL_BUFFER_UPDATE_BARRIER_BIT);
+    });
+    if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+      return makeError("--engine gl: the variable-k allocation failed (GL error " + glErrorText(e) +
+                       ")");
+    return GlAllocationTotals{deviceSlots, deviceReservedSlots};
   }
 };
 
@@ -368,6 +496,16 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto kbuffer = raster("capture_kbuffer.frag", kbufferPrelude);
   if (!kbuffer) return kbuffer.error();
   s->progKBuffer = *kbuffer;
+  if (hasAtomic64(context)) {
+    auto atomic64 = raster("capture_kbuffer_atomic64.frag",
+                           "#extension GL_ARB_gpu_shader_int64 : require\n"
+                           "#extension GL_NV_shader_atomic_int64 : require\n");
+    if (!atomic64) return atomic64.error();
+    s->progKBufferAtomic64 = *atomic64;
+    auto swap = linkProgram("swap_node_words.comp", {{GL_COMPUTE_SHADER, "swap_node_words.comp"}});
+    if (!swap) return swap.error();
+    s->progSwapWords = *swap;
+  }
   auto depthRange = raster("depth_range.frag");
   if (!depthRange) return depthRange.error();
   s->progDepthRange = *depthRange;
@@ -419,6 +557,17 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto resolve = linkProgram("resolve.comp", {{GL_COMPUTE_SHADER, "resolve.comp"}});
   if (!resolve) return resolve.error();
   s->progResolve = *resolve;
+  for (const auto& [file, program] :
+       {std::pair<const char*, GLuint*>{"alloc_histogram.comp", &s->progAllocHistogram},
+        {"importance.comp", &s->progImportance},
+        {"importance_total.comp", &s->progImportanceTotal},
+        {"alloc_k.comp", &s->progAllocK},
+        {"alloc_pack.comp", &s->progAllocPack}}) {
+    auto linked = linkProgram(file, {{GL_COMPUTE_SHADER, file}});
+    if (!linked) return linked.error();
+    *program = *linked;
+  }
+  if (s->progKBufferAtomic64) s->setRasterUniforms(s->progKBufferAtomic64);
   for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill,
                    s->progNearest, s->progWboit, s->progMboitMoments, s->progMboitColor,
                    s->progMlab, s->progDkbFeatures})
@@ -500,6 +649,7 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   glNamedFramebufferParameteri(s->fbo, GL_FRAMEBUFFER_DEFAULT_WIDTH, width);
   glNamedFramebufferParameteri(s->fbo, GL_FRAMEBUFFER_DEFAULT_HEIGHT, height);
   glCreateQueries(GL_TIME_ELAPSED, 1, &s->query);
+  if (s->uploadFailure) return *s->uploadFailure;
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
     return makeError("GL engine: scene upload failed (GL error 0x" + [&] {
       char buf[16];
@@ -515,9 +665,15 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       method.allocation == AllocationPolicy::Unbounded && method.store == StoreChoice::Append;
   const Allocation* alloc = options.allocation;
   const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
-  const bool perPixel = alloc != nullptr;
-  if (perPixel && (alloc->capacity.size() != pixels || alloc->offsets.size() != pixels ||
-                   alloc->kind.size() != pixels))
+  // the allocation the compute shaders left in the engine's buffers (allocateCapped,
+  // allocateByImportance), else the host's
+  const bool device = options.deviceAllocation;
+  if (device && !s.device)
+    return makeError("--engine gl: " + method.name + ": no allocation on the device");
+  const bool perPixel = alloc != nullptr || device;
+  const uint64_t allocSlots = device ? s.deviceSlots : alloc ? alloc->slots : 0;
+  if (alloc && (alloc->capacity.size() != pixels || alloc->offsets.size() != pixels ||
+                alloc->kind.size() != pixels))
     return makeError("--engine gl: " + method.name + ": an allocation of another size");
   const bool isKBuffer =
       (perPixel && method.allocation != AllocationPolicy::Unbounded &&
@@ -562,8 +718,8 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
                             static_cast<uint64_t>(std::max(method.occupancyWords, 0)) * 4});
     if (uint64_t{pixels} * perPixelBytes > s.maxBlockBytes)
       return tooLarge("per-pixel", uint64_t{pixels} * perPixelBytes);
-    if (perPixel && alloc->slots * kNodeBytes > s.maxBlockBytes)  // (keeps the uint offsets exact)
-      return tooLarge("node", alloc->slots * kNodeBytes);
+    if (perPixel && allocSlots * kNodeBytes > s.maxBlockBytes)  // (keeps the uint offsets exact)
+      return tooLarge("node", allocSlots * kNodeBytes);
   }
 
   GlRenderOutput out;
@@ -574,6 +730,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     FrameBuffers fb;
     fb.ledger = &out.bufferBytes;
     auto pass = [&](const char* name, auto&& body) {
+      if (fb.failure) return;  // a buffer GL could not allocate: reported below
       const auto t0 = std::chrono::steady_clock::now();
       glBeginQuery(GL_TIME_ELAPSED, s.query);
       body();
@@ -587,7 +744,14 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     };
 
     // the per-pixel allocation: (first slot, k(p) | heap bit), a texel buffer
-    if (perPixel) {
+    if (device) {
+      out.bufferBytes["allocation"] += uint64_t{pixels} * 8;
+      GLuint t = 0;
+      glCreateTextures(GL_TEXTURE_BUFFER, 1, &t);
+      glTextureBuffer(t, GL_RG32UI, s.deviceWords);
+      fb.textures.push_back(t);
+      glBindTextureUnit(kBindAllocation, t);
+    } else if (perPixel) {
       std::vector<uint32_t> words(uint64_t{pixels} * 2);
       for (uint32_t p = 0; p < pixels; ++p) {
         words[2 * p] = static_cast<uint32_t>(alloc->offsets[p]);
@@ -603,9 +767,11 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     }
 
     // count: n(p) by imageAtomicAdd
-    const bool counted = options.counts && options.counts->size() == pixels;
-    const GLuint counts =
-        fb.make("counts", uint64_t{pixels} * 4, counted ? options.counts->data() : nullptr);
+    const bool counted = device || (options.counts && options.counts->size() == pixels);
+    const GLuint counts = fb.make("counts", uint64_t{pixels} * 4,
+                                  counted && !device ? options.counts->data() : nullptr);
+    if (device)  // n(p) of countOnDevice, copied on the GPU
+      glCopyNamedBufferSubData(s.deviceCounts, counts, 0, 0, uint64_t{pixels} * 4);
     if (!counted) {
       clearUint(counts, 0);
       pass("count", [&] {
@@ -676,7 +842,7 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
       });
     } else {
-      nodeCount = perPixel ? alloc->slots : uint64_t{pixels} * k;
+      nodeCount = perPixel ? allocSlots : uint64_t{pixels} * k;
       const uint32_t words = static_cast<uint32_t>(method.occupancyWords);
       const GLuint stats = fb.make("capture counters", 8);
       clearUint(stats, 0);
@@ -722,12 +888,18 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
           glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
         });
       }
+      // a fixed k without tail or occupancy takes 64-bit atomicMin where the driver has them
+      const bool atomic = s.progKBufferAtomic64 != 0 && !perPixel && !hybrid && words == 0;
+      out.atomic64 = atomic;
       nodes = fb.make("nodes", nodeCount * kNodeBytes);
-      const uint32_t far[2] = {kFarDepthBits, 0u};
+      // the far node; as uint64 words (colour, depth) for the atomic capture
+      const uint32_t far[2] = {atomic ? 0u : kFarDepthBits, atomic ? kFarDepthBits : 0u};
       glClearNamedBufferData(nodes, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT, far);
+      // (the lock words stay allocated and charged with the atomics: bytes_used does not depend
+      // on the capture's synchronisation)
       const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
       clearUint(locks, kLockFree);
-      const GLuint p = s.progKBuffer;
+      const GLuint p = atomic ? s.progKBufferAtomic64 : s.progKBuffer;
       glProgramUniform1ui(p, loc(p, "uK"), k);
       glProgramUniform1ui(p, loc(p, "uStore"),
                           method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
@@ -744,6 +916,15 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
         s.drawScene();
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
       });
+      if (atomic)
+        pass("node words", [&] {
+          const GLuint q = s.progSwapWords;
+          glUseProgram(q);
+          glProgramUniform1ui(q, loc(q, "uCount"), static_cast<GLuint>(nodeCount));
+          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+          dispatchGroups((nodeCount + kResolveGroupSize - 1) / kResolveGroupSize);
+          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+        });
       uint32_t culled[2] = {0, 0};
       glGetNamedBufferSubData(stats, 0, 8, culled);
       out.culledOccupancy = culled[0];
@@ -801,8 +982,10 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
     if (const GLenum e = glGetError(); e != GL_NO_ERROR) {
       char buf[16];
       std::snprintf(buf, sizeof buf, "%x", e);
+      if (fb.failure) return *fb.failure;
       return makeError("--engine gl: " + method.name + " failed (GL error 0x" + buf + ")");
     }
+    if (fb.failure) return *fb.failure;
     if (!timed) continue;
 
     // read back
@@ -830,9 +1013,20 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
           out.nodeCounts[p] = out.counts[p];
         }
       } else {
+        std::vector<uint32_t> words;
+        if (device) {
+          words.resize(uint64_t{pixels} * 2);
+          glGetNamedBufferSubData(s.deviceWords, 0, uint64_t{pixels} * 8ll, words.data());
+        }
         for (uint32_t p = 0; p < pixels; ++p) {
-          out.nodeOffsets[p] = perPixel ? alloc->offsets[p] : uint64_t{p} * k;
-          out.nodeCounts[p] = std::min(out.counts[p], perPixel ? alloc->capacity[p] : k);
+          const uint64_t first = device  ? words[2 * p]
+                                 : alloc ? alloc->offsets[p]
+                                         : uint64_t{p} * k;
+          const uint32_t capacity = device  ? words[2 * p + 1] & ~kAllocHeapBit
+                                    : alloc ? alloc->capacity[p]
+                                            : k;
+          out.nodeOffsets[p] = first;
+          out.nodeCounts[p] = std::min(out.counts[p], capacity);
         }
       }
     }
@@ -852,6 +1046,7 @@ Result<std::vector<uint32_t>> GlEngine::count() {
   fb.bindImage(counts, kBindCounts);
   s.drawScene();
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
+  if (fb.failure) return *fb.failure;
   std::vector<uint32_t> n(pixels);
   glGetNamedBufferSubData(counts, 0, static_cast<GLsizeiptr>(pixels * 4), n.data());
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
@@ -870,6 +1065,7 @@ Result<std::vector<float>> GlEngine::nearestCosine() {
   const uint32_t init[3] = {kFarDepthBits, 0u, 0u};
   glClearNamedBufferData(nearest, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
   const GLuint locks = fb.make("locks", pixels * 4);
+  if (fb.failure) return *fb.failure;
   clearUint(locks, kLockFree);
   glUseProgram(s.progNearest);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNearest, nearest);
@@ -912,6 +1108,7 @@ Result<std::vector<float>> GlEngine::dkbImportance(const std::vector<float>& wei
   const GLuint locks = fb.make("locks", pixels * 4);
   const GLuint net = fb.make("network", weights.size() * 4, weights.data());
   const GLuint importance = fb.make("importance", pixels * 4);
+  if (fb.failure) return *fb.failure;
   std::vector<uint32_t> words(pixels * kDkbAccWords);
   timed("features", [&] {
     static_assert(kDkbAccWords == 7);
@@ -960,6 +1157,217 @@ Result<std::vector<float>> GlEngine::dkbImportance(const std::vector<float>& wei
     return makeError("--engine gl: the deep k-buffer's importance failed (GL error " +
                      std::to_string(e) + ")");
   return out;
+}
+
+Result<CountSummary> GlEngine::countOnDevice(std::vector<GlPassTime>* passes) {
+  State& s = *state_;
+  const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
+  s.device = std::make_unique<FrameBuffers>();
+  s.deviceLedger.clear();
+  s.device->ledger = &s.deviceLedger;
+  s.deviceCapacity = s.deviceReserved = s.deviceWords = s.deviceImportance = s.deviceNearest = 0;
+  s.deviceSlots = s.deviceReservedSlots = 0;
+  s.deviceByImportance = false;
+  s.deviceCounts = s.device->make("counts", uint64_t{pixels} * 4);
+  if (s.device->failure) return *s.device->failure;
+  clearUint(s.deviceCounts, 0);
+  timedPass(passes, "count", [&] {
+    glUseProgram(s.progCount);
+    s.device->bindImage(s.deviceCounts, kBindCounts);
+    s.drawScene();
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  });
+  std::map<std::string, uint64_t> ledger;
+  FrameBuffers fb;
+  fb.ledger = &ledger;
+  const GLuint summary = fb.make("histogram", kAllocSummaryWords * 4);
+  if (fb.failure) return *fb.failure;
+  clearUint(summary, 0);
+  std::vector<uint32_t> words(kAllocSummaryWords);
+  timedPass(passes, "histogram", [&] {
+    glUseProgram(s.progAllocHistogram);
+    glProgramUniform1ui(s.progAllocHistogram, loc(s.progAllocHistogram, "uPixels"), pixels);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocCounts, s.deviceCounts);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocSummary, summary);
+    dispatchGroups((uint64_t{pixels} + kResolveGroupSize - 1) / kResolveGroupSize);
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glGetNamedBufferSubData(summary, 0, kAllocSummaryWords * 4, words.data());
+  });
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+    return makeError("--engine gl: the count pass failed (GL error " + glErrorText(e) + ")");
+  CountSummary out;
+  out.histogram.assign(words.begin(), words.begin() + kAllocHistogramBins);
+  out.maxN = words[kAllocHistogramBins];
+  out.covered = pixels - out.histogram[0];
+  return out;
+}
+
+Result<GlAllocationTotals> GlEngine::allocateCapped(uint32_t k, StoreChoice store,
+                                                    std::vector<GlPassTime>* passes) {
+  State& s = *state_;
+  if (!s.device) return makeError("--engine gl: allocateCapped before countOnDevice");
+  std::map<std::string, uint64_t> ledger;
+  FrameBuffers fb;
+  fb.ledger = &ledger;
+  const GLuint totals = fb.make("allocation totals", kAllocTotalWords * 4);
+  clearUint(totals, 0);
+  glProgramUniform1ui(s.progAllocK, loc(s.progAllocK, "uMode"), kAllocCapped);
+  glProgramUniform1ui(s.progAllocK, loc(s.progAllocK, "uK"), k);
+  s.deviceByImportance = false;
+  return s.allocateK(fb, totals, totals, totals, store, passes);  // (no importance: unread)
+}
+
+Result<GlAllocationTotals> GlEngine::allocateByImportance(const ImportanceParams& params,
+                                                          const std::vector<float>& previousCosine,
+                                                          uint64_t slots, StoreChoice store,
+                                                          std::vector<GlPassTime>* passes) {
+  State& s = *state_;
+  if (!s.device) return makeError("--engine gl: allocateByImportance before countOnDevice");
+  const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
+  const uint64_t groups = (uint64_t{pixels} + kResolveGroupSize - 1) / kResolveGroupSize;
+  std::map<std::string, uint64_t> ledger;
+  FrameBuffers fb;
+  fb.ledger = &ledger;
+  // this frame's nearest |n.v| (the output's, and the Fresnel term's unless a previous frame's
+  // is given)
+  static_assert(kNearestWords == 3);
+  s.deviceNearest = s.device->make("nearest", uint64_t{pixels} * kNearestWords * 4);
+  const uint32_t init[3] = {kFarDepthBits, 0u, 0u};
+  glClearNamedBufferData(s.deviceNearest, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
+  const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+  if (s.device->failure) return *s.device->failure;
+  if (fb.failure) return *fb.failure;
+  clearUint(locks, kLockFree);
+  timedPass(passes, "nearest_normal", [&] {
+    glUseProgram(s.progNearest);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNearest, s.deviceNearest);
+    fb.bindImage(locks, kBindLocks);
+    s.drawScene();
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  });
+  const bool previous = previousCosine.size() == pixels;
+  const GLuint cosine = previous
+                            ? fb.make("previous |n.v|", uint64_t{pixels} * 4, previousCosine.data())
+                            : s.deviceNearest;
+  s.deviceImportance = s.device->make("importance", uint64_t{pixels} * kImportanceWords * 4);
+  const GLuint p = s.progImportance;
+  const float width = static_cast<float>(s.width), height = static_cast<float>(s.height);
+  // the host's constants of mfr::computeImportance, rounded as there
+  const glm::vec2 fovea = params.fovea.value_or(glm::vec2(s.width * 0.5f, s.height * 0.5f));
+  const float diagonal = 1.1f * std::sqrt(width * width + height * height);
+  const float d = params.peripheryExponent;
+  const int dInt = d >= 0.0f && d <= 64.0f && std::floor(d) == d ? static_cast<int>(d) : -1;
+  const uint64_t seedMix = params.seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull;
+  glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+  glProgramUniform1ui(p, loc(p, "uWidth"), static_cast<GLuint>(s.width));
+  glProgramUniform1f(p, loc(p, "uAlpha"), params.alpha);
+  glProgramUniform1f(p, loc(p, "uOneMinusAlpha"), 1.0f - params.alpha);
+  glProgramUniform1f(p, loc(p, "uNLimit"), params.nLimit);
+  glProgramUniform2f(p, loc(p, "uFovea"), fovea.x, fovea.y);
+  glProgramUniform1f(p, loc(p, "uDiagonal"), diagonal);
+  glProgramUniform1f(p, loc(p, "uExponent"), d);
+  glProgramUniform1i(p, loc(p, "uExponentInt"), dInt);
+  glProgramUniform1f(p, loc(p, "uNoise"), params.noise);
+  glProgramUniform2ui(p, loc(p, "uSeedMix"), static_cast<GLuint>(seedMix),
+                      static_cast<GLuint>(seedMix >> 32));
+  glProgramUniform1ui(p, loc(p, "uUse"),
+                      (params.useDepth ? 1u : 0u) | (params.usePeriphery ? 2u : 0u) |
+                          (params.useFresnel ? 4u : 0u) | (params.useNoise ? 8u : 0u));
+  glProgramUniform1ui(p, loc(p, "uCosine"), previous ? kCosineFloats : kCosineNearest);
+  timedPass(passes, "importance", [&] {
+    glUseProgram(p);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAllocCounts, s.deviceCounts);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImportance, s.deviceImportance);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCosine, cosine);
+    dispatchGroups(groups);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  });
+  const GLuint total = fb.make("importance total", 8);
+  if (s.device->failure) return *s.device->failure;
+  if (fb.failure) return *fb.failure;
+  timedPass(passes, "importance total", [&] {
+    const GLuint q = s.progImportanceTotal;
+    glUseProgram(q);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImportance, s.deviceImportance);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImportanceTotal, total);
+    // in order, kTotalChunk pixels per dispatch (the running sum stays in `total`)
+    for (uint32_t first = 0; first < pixels; first += std::min(kTotalChunk, pixels - first)) {
+      glProgramUniform1ui(q, loc(q, "uFirst"), first);
+      glProgramUniform1ui(q, loc(q, "uEnd"), first + std::min(kTotalChunk, pixels - first));
+      glDispatchCompute(1, 1, 1);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    }
+  });
+  const GLuint totals = fb.make("allocation totals", kAllocTotalWords * 4);
+  clearUint(totals, 0);
+  glProgramUniform1ui(s.progAllocK, loc(s.progAllocK, "uMode"), kAllocByImportance);
+  glProgramUniform1d(s.progAllocK, loc(s.progAllocK, "uSlots"), static_cast<double>(slots));
+  s.deviceByImportance = true;
+  return s.allocateK(fb, totals, s.deviceImportance, total, store, passes);
+}
+
+Result<Allocation> GlEngine::readDeviceAllocation() {
+  State& s = *state_;
+  if (!s.device || !s.deviceWords) return makeError("--engine gl: no allocation on the device");
+  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  std::vector<uint32_t> words(pixels * 2);
+  glGetNamedBufferSubData(s.deviceWords, 0, static_cast<GLsizeiptr>(pixels * 8), words.data());
+  Allocation a;
+  a.capacity.resize(pixels);
+  a.offsets.resize(pixels);
+  a.kind.resize(pixels);
+  for (uint64_t p = 0; p < pixels; ++p) {
+    a.offsets[p] = words[2 * p];
+    a.capacity[p] = words[2 * p + 1] & ~kAllocHeapBit;
+    a.kind[p] = (words[2 * p + 1] & kAllocHeapBit) ? StoreKind::MaxHeap : StoreKind::MaxArray;
+  }
+  a.slots = s.deviceSlots;
+  a.reservedSlots = s.deviceByImportance ? s.deviceReservedSlots : s.deviceSlots;
+  if (s.deviceByImportance) {
+    a.reservedK.resize(pixels);
+    glGetNamedBufferSubData(s.deviceReserved, 0, static_cast<GLsizeiptr>(pixels * 4),
+                            a.reservedK.data());
+  }
+  return a;
+}
+
+Result<ImportanceMaps> GlEngine::readImportance() {
+  State& s = *state_;
+  if (!s.device || !s.deviceImportance)
+    return makeError("--engine gl: no importance map on the device");
+  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  std::vector<float> words(pixels * kImportanceWords);
+  glGetNamedBufferSubData(s.deviceImportance, 0, static_cast<GLsizeiptr>(words.size() * 4),
+                          words.data());
+  ImportanceMaps m;
+  for (std::vector<float>* v : {&m.importance, &m.depth, &m.periphery, &m.fresnel, &m.noise})
+    v->resize(pixels);
+  for (uint64_t p = 0; p < pixels; ++p) {
+    const float* w = &words[p * kImportanceWords];
+    m.importance[p] = w[0];
+    m.depth[p] = w[1];
+    m.periphery[p] = w[2];
+    m.fresnel[p] = w[3];
+    m.noise[p] = w[4];
+  }
+  return m;
+}
+
+Result<std::vector<float>> GlEngine::readNearestCosine() {
+  State& s = *state_;
+  if (!s.device || !s.deviceNearest) return makeError("--engine gl: no nearest pass on the device");
+  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  std::vector<uint32_t> words(pixels * kNearestWords);
+  glGetNamedBufferSubData(s.deviceNearest, 0, static_cast<GLsizeiptr>(words.size() * 4),
+                          words.data());
+  std::vector<float> cosine(pixels);
+  for (uint64_t p = 0; p < pixels; ++p)
+    cosine[p] = static_cast<float>(words[p * kNearestWords + 2]) / 255.0f;
+  return cosine;
+}
+
+bool hasAtomic64(const GlContext& context) {
+  return context.extensions().arbGpuShaderInt64 && context.extensions().nvShaderAtomicInt64;
 }
 
 std::string interlockExtension(const GlContext& context) {

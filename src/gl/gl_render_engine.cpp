@@ -1,5 +1,7 @@
 // The GL engine behind the Engine seam (mfr/gl/gl_render_engine.hpp). The k of a fixed-k method
-// and the budget checks come from the shared allocate() (the same errors as the CPU engine); the
+// and the budget checks come from the shared allocate() or, for the counted, dynamic and
+// importance-map k computed in compute shaders, from its checks of the GPU's totals (boundedK,
+// checkBoundedSlots, checkCoveredPixels: the same errors as the CPU engine); the
 // memory charged is MemoryModel's (a lock word per pixel for the fixed-k stores, which take the
 // per-pixel spin-lock; the A-buffer appends with atomics); what GL allocated is bytes_allocated.
 #include "mfr/gl/gl_render_engine.hpp"
@@ -76,7 +78,9 @@ class GlRenderEngine final : public Engine {
             {"GL_NV_fragment_shader_interlock", yes(c.nvFragmentShaderInterlock)},
             {"GL_INTEL_fragment_shader_ordering", yes(c.intelFragmentShaderOrdering)},
             {"GL_ARB_gpu_shader_int64", yes(c.arbGpuShaderInt64)},
-            {"GL_NV_shader_atomic_int64", yes(c.nvShaderAtomicInt64)}};
+            {"GL_NV_shader_atomic_int64", yes(c.nvShaderAtomicInt64)},
+            // the fixed-k k-buffer without tail or occupancy: 64-bit atomicMin or the lock
+            {"fixed_k_capture", hasAtomic64(context_) ? "atomic64" : "lock"}};
   }
 
   Result<std::unique_ptr<PreparedView>> prepare(const View& view) override {
@@ -118,7 +122,47 @@ class GlRenderEngine final : public Engine {
     RenderOutput out;
     std::optional<Allocation> perPixel;
     std::vector<uint32_t> n;  // variable k: n(p) measured first, reused by the frame
-    if (variable) {
+    // counted, dynamic and importance-map k: count, histogram, importance, k(p), prefix sum in
+    // compute shaders; the host reads a few totals and checks them with allocate()'s words
+    const bool onDevice =
+        method.allocation == AllocationPolicy::CountedK ||
+        method.allocation == AllocationPolicy::DynamicK ||
+        (method.allocation == AllocationPolicy::Importance &&
+         method.importanceSource != ImportanceSource::Network && !method.fillUnusedSlots);
+    std::optional<uint32_t> deviceGlobalK;
+    if (onDevice) {
+      MFR_TRY(budgetSlots(layout, method, memory, options.budgetBytes));  // before any pass
+      std::vector<GlPassTime> passes;
+      auto summary = gv->engine().countOnDevice(&passes);
+      if (!summary) return summary.error();
+      if (method.allocation == AllocationPolicy::Importance) {
+        MFR_TRY(checkCoveredPixels(layout, method, memory, options.budgetBytes, summary->covered));
+        const uint64_t slots = memory.fragmentSlots(*options.budgetBytes, pixels);
+        static const std::vector<float> none;
+        const std::vector<float>& previous =
+            options.previousNearestCosine && options.previousNearestCosine->size() == pixels
+                ? *options.previousNearestCosine
+                : none;
+        auto totals = gv->engine().allocateByImportance(method.importance, previous, slots,
+                                                        method.store, &passes);
+        if (!totals) return totals.error();
+        // floor(P(p) F(M)) sums to at most F(M) with IEEE double arithmetic (as on the host);
+        // a driver whose double division rounds otherwise could exceed it by a few slots
+        if (totals->reservedSlots > slots)
+          return makeError("--engine gl: " + method.name +
+                           ": the GPU's importance allocation took " +
+                           std::to_string(totals->reservedSlots) + " slots of " +
+                           std::to_string(slots) + " (double arithmetic not IEEE on this driver)");
+      } else {
+        auto k = boundedK(layout, method, memory, options.budgetBytes, *summary);
+        if (!k) return k.error();
+        auto totals = gv->engine().allocateCapped(*k, method.store, &passes);
+        if (!totals) return totals.error();
+        MFR_TRY(checkBoundedSlots(layout, method, memory, options.budgetBytes, *k, totals->slots));
+        deviceGlobalK = *k;
+      }
+      for (const GlPassTime& t : passes) hostPasses.push_back({t.name + " (allocation)", t.wallMs});
+    } else if (variable) {
       std::vector<uint32_t> oracleK;
       auto t0 = std::chrono::steady_clock::now();
       if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes) {
@@ -183,15 +227,28 @@ class GlRenderEngine final : public Engine {
     go.readNodes = options.keepStores;
     go.warmUp = gv->firstRender();
     go.allocation = perPixel ? &*perPixel : nullptr;
+    go.deviceAllocation = onDevice;
     // (GL's own n(p) only: the optimal k-buffer's comes from the CPU oracle)
     go.counts = n.empty() || method.allocation == AllocationPolicy::Optimal ? nullptr : &n;
     auto gl = gv->engine().render(method, go);
     if (!gl) return gl.error();
     GlRenderOutput& g = gl.value();
     // the A-buffer's slots are its fragments: the budget check needs the count pass's n(p)
-    auto a = perPixel ? Result<Allocation>(std::move(*perPixel))
-                      : allocate(layout, method, memory, options.budgetBytes, g.counts, {}, {});
+    auto a = onDevice   ? gv->engine().readDeviceAllocation()
+             : perPixel ? Result<Allocation>(std::move(*perPixel))
+                        : allocate(layout, method, memory, options.budgetBytes, g.counts, {}, {});
     if (!a) return a.error();
+    if (onDevice) {  // the output's maps, read back
+      a->globalK = deviceGlobalK;
+      if (method.allocation == AllocationPolicy::Importance) {
+        auto maps = gv->engine().readImportance();
+        if (!maps) return maps.error();
+        out.importance = std::move(maps.value());
+        auto cosine = gv->engine().readNearestCosine();
+        if (!cosine) return cosine.error();
+        out.nearestCosine = std::move(cosine.value());
+      }
+    }
 
     out.image = std::move(g.image);
     RenderStats& s = out.stats;
@@ -232,6 +289,8 @@ class GlRenderEngine final : public Engine {
       s.engineCounters["gpu_ms_" + t.name] = t.gpuMs;
     }
     s.engineCounters["sync_interlock"] = interlock_ ? 1 : 0;  // the k-buffer capture's sync
+    // the fixed-k capture with 64-bit atomicMin instead of the lock (where the driver has them)
+    s.engineCounters["atomic64"] = g.atomic64 ? 1 : 0;
     out.kMap = a->reservedK.empty() ? std::move(a->capacity) : std::move(a->reservedK);
     out.depthComplexity = std::move(g.counts);
     if (options.keepStores) {

@@ -95,6 +95,108 @@ void fillByImportance(const std::vector<uint32_t>& n, const std::vector<float>& 
   }
 }
 
+Result<uint64_t> budgetSlots(const PixelLayout& frame, const MethodDesc& method,
+                             const MemoryModel& memory, std::optional<uint64_t> budget) {
+  const uint64_t pixels = frame.pixels();
+  const uint64_t overhead = memory.overhead(pixels);
+  const std::string& name = method.name;
+  if (method.allocation == AllocationPolicy::NoNodes) {  // wboit, mboit: accumulators only
+    if (budget && *budget < overhead)
+      return makeError("budget " + bytesText(*budget) + ": too small for " + name + " at " +
+                       sizeText(frame) + " (its per-pixel buffers take " + bytesText(overhead) +
+                       ")");
+    return uint64_t{0};
+  }
+  if (budget && *budget < overhead + memory.node)
+    return makeError("budget " + bytesText(*budget) + ": too small for " + name + " at " +
+                     sizeText(frame) + " (its per-pixel buffers take " + bytesText(overhead) +
+                     ", leaving no room for a fragment)");
+  return budget ? memory.fragmentSlots(*budget, pixels) : UINT64_MAX;
+}
+
+namespace {
+
+// the budget cannot give one node to every (covered) pixel
+Error tooSmallFor(const PixelLayout& frame, const MethodDesc& method, const MemoryModel& memory,
+                  uint64_t budget, const char* which, uint64_t count) {
+  return makeError("budget " + bytesText(budget) + ": too small for one fragment per " + which +
+                   " with " + method.name + " at " + sizeText(frame) + " (needs " +
+                   bytesText(memory.overhead(frame.pixels()) + count * memory.node) + ")");
+}
+
+}  // namespace
+
+Result<uint32_t> boundedK(const PixelLayout& frame, const MethodDesc& method,
+                          const MemoryModel& memory, std::optional<uint64_t> budget,
+                          const CountSummary& counts) {
+  const std::string& name = method.name;
+  const uint64_t pixels = frame.pixels();
+  auto slots = budgetSlots(frame, method, memory, budget);
+  if (!slots) return slots.error();
+  const uint64_t slotsInBudget = *slots;
+  uint64_t k = 0;
+  if (method.allocation == AllocationPolicy::CountedK && method.k) {
+    k = *method.k;
+  } else if (method.allocation == AllocationPolicy::CountedK) {
+    if (!budget) return makeError(name + ": needs a budget or an explicit k");
+    k = std::max<uint64_t>(1, std::min<uint64_t>(slotsInBudget / pixels, 1u << 20));
+  } else {
+    if (!budget && !method.k) return makeError(name + ": needs a budget");
+    MFR_CHECK(counts.histogram.size() == kHistogramBins);
+    const std::vector<uint64_t>& histogram = counts.histogram;
+    // never above the largest n(p): a larger k buys nothing
+    const uint64_t kLimit =
+        std::min<uint64_t>({method.k.value_or(kHistogramBins - 1), kHistogramBins - 1,
+                            std::max<uint64_t>(1, counts.maxN)});
+    // the largest k that fits, scanning from high to low; exact because k never exceeds the last
+    // bin
+    for (uint64_t candidate = kLimit; candidate >= 1 && k == 0; --candidate) {
+      uint64_t need = 0;
+      for (uint64_t bin = 1; bin < kHistogramBins; ++bin)
+        need += histogram[bin] * std::min(bin, candidate);
+      if (need <= slotsInBudget) k = candidate;
+    }
+    if (k == 0) return tooSmallFor(frame, method, memory, *budget, "covered pixel", counts.covered);
+  }
+  if (k == 0) return makeError(name + ": k must be at least 1");
+  return static_cast<uint32_t>(k);
+}
+
+Result<void> checkBoundedSlots(const PixelLayout& frame, const MethodDesc& method,
+                               const MemoryModel& memory, std::optional<uint64_t> budget,
+                               uint32_t k, uint64_t slots) {
+  auto inBudget = budgetSlots(frame, method, memory, budget);
+  if (!inBudget) return inBudget.error();
+  if (slots > *inBudget)
+    return makeError("budget " + bytesText(*budget) + ": " + method.name +
+                     " with k = " + std::to_string(k) + " needs " +
+                     bytesText(memory.overhead(frame.pixels()) + slots * memory.node) + " at " +
+                     sizeText(frame));
+  return {};
+}
+
+Result<void> checkCoveredPixels(const PixelLayout& frame, const MethodDesc& method,
+                                const MemoryModel& memory, std::optional<uint64_t> budget,
+                                uint64_t covered) {
+  auto inBudget = budgetSlots(frame, method, memory, budget);
+  if (!inBudget) return inBudget.error();
+  if (!budget) return makeError(method.name + ": needs a budget");
+  if (*inBudget < covered)
+    return tooSmallFor(frame, method, memory, *budget, "covered pixel", covered);
+  return {};
+}
+
+CountSummary summarizeCounts(const std::vector<uint32_t>& n) {
+  CountSummary s;
+  s.histogram.assign(kHistogramBins, 0);
+  for (uint32_t c : n) {
+    ++s.histogram[std::min<uint64_t>(c, kHistogramBins - 1)];
+    s.maxN = std::max<uint64_t>(s.maxN, c);
+    s.covered += c > 0;
+  }
+  return s;
+}
+
 Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
                             const MemoryModel& memory, std::optional<uint64_t> budget,
                             const std::vector<uint32_t>& n, const std::vector<float>& importanceIn,
@@ -118,19 +220,13 @@ Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
   a.kind.assign(pixels, StoreKind::MaxArray);
 
   const uint64_t nodeBytes = memory.node;
+  auto inBudget = budgetSlots(frame, method, memory, budget);
+  if (!inBudget) return inBudget.error();
   if (method.allocation == AllocationPolicy::NoNodes) {  // wboit, mboit: accumulators only
-    if (budget && *budget < overhead)
-      return makeError("budget " + bytesText(*budget) + ": too small for " + name + " at " +
-                       sizeText(frame) + " (its per-pixel buffers take " + bytesText(overhead) +
-                       ")");
     a.offsets.assign(pixels, 0);
     return a;
   }
-  if (budget && *budget < overhead + nodeBytes)
-    return makeError("budget " + bytesText(*budget) + ": too small for " + name + " at " +
-                     sizeText(frame) + " (its per-pixel buffers take " + bytesText(overhead) +
-                     ", leaving no room for a fragment)");
-  const uint64_t slotsInBudget = budget ? memory.fragmentSlots(*budget, pixels) : UINT64_MAX;
+  const uint64_t slotsInBudget = *inBudget;
 
   auto sumCapped = [&](uint64_t k) {
     uint64_t s = 0;
@@ -139,11 +235,8 @@ Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
   };
   uint64_t covered = 0;
   for (uint32_t c : n) covered += c > 0;
-  // the budget cannot give one node to every (covered) pixel
   auto tooSmall = [&](const char* which, uint64_t count) {
-    return makeError("budget " + bytesText(*budget) + ": too small for one fragment per " + which +
-                     " with " + name + " at " + sizeText(frame) + " (needs " +
-                     bytesText(overhead + count * nodeBytes) + ")");
+    return tooSmallFor(frame, method, memory, *budget, which, count);
   };
 
   switch (method.allocation) {
@@ -175,41 +268,17 @@ Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
     }
     case AllocationPolicy::CountedK:
     case AllocationPolicy::DynamicK: {
-      uint64_t k = 0;
-      if (method.allocation == AllocationPolicy::CountedK && method.k) {
-        k = *method.k;
-      } else if (method.allocation == AllocationPolicy::CountedK) {
-        if (!budget) return makeError(name + ": needs a budget or an explicit k");
-        k = std::max<uint64_t>(1, std::min<uint64_t>(slotsInBudget / pixels, 1u << 20));
-      } else {
-        if (!budget && !method.k) return makeError(name + ": needs a budget");
-        // histogram of n(p) (last bin: n >= bins - 1), then the largest k that fits, scanning
-        // from high to low; exact because k never exceeds the last bin
-        std::vector<uint64_t> histogram(kHistogramBins, 0);
-        for (uint32_t c : n) ++histogram[std::min<uint64_t>(c, kHistogramBins - 1)];
-        a.scratchBytes += histogram.capacity() * sizeof(uint64_t);
-        // never above the largest n(p): a larger k buys nothing
-        uint64_t maxN = 1;
-        for (uint32_t c : n) maxN = std::max<uint64_t>(maxN, c);
-        const uint64_t kLimit =
-            std::min<uint64_t>({method.k.value_or(kHistogramBins - 1), kHistogramBins - 1, maxN});
-        for (uint64_t candidate = kLimit; candidate >= 1 && k == 0; --candidate) {
-          uint64_t need = 0;
-          for (uint64_t bin = 1; bin < kHistogramBins; ++bin)
-            need += histogram[bin] * std::min(bin, candidate);
-          if (need <= slotsInBudget) k = candidate;
-        }
-        if (k == 0) return tooSmall("covered pixel", covered);
-      }
-      if (k == 0) return makeError(name + ": k must be at least 1");
-      a.slots = sumCapped(k);
-      if (a.slots > slotsInBudget)
-        return makeError("budget " + bytesText(*budget) + ": " + name +
-                         " with k = " + std::to_string(k) + " needs " +
-                         bytesText(overhead + a.slots * nodeBytes) + " at " + sizeText(frame));
-      a.globalK = static_cast<uint32_t>(k);
-      for (size_t p = 0; p < pixels; ++p)
-        a.capacity[p] = static_cast<uint32_t>(std::min<uint64_t>(n[p], k));
+      const CountSummary summary = method.allocation == AllocationPolicy::DynamicK
+                                       ? summarizeCounts(n)
+                                       : CountSummary{{}, 0, covered};
+      if (method.allocation == AllocationPolicy::DynamicK)
+        a.scratchBytes += summary.histogram.capacity() * sizeof(uint64_t);
+      auto k = boundedK(frame, method, memory, budget, summary);
+      if (!k) return k.error();
+      a.slots = sumCapped(*k);
+      MFR_TRY(checkBoundedSlots(frame, method, memory, budget, *k, a.slots));
+      a.globalK = *k;
+      for (size_t p = 0; p < pixels; ++p) a.capacity[p] = std::min(n[p], *k);
       break;
     }
     case AllocationPolicy::Importance: {

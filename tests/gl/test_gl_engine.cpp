@@ -222,6 +222,31 @@ TEST_P(GlVsCpu, KBufferHeapK5NodesAndImageEqualTheCpuKPlusHeap) {
   printPasses(gl);
 }
 
+// The fixed-k capture's synchronisation is chosen at run time: 64-bit atomicMin where the driver
+// has GL_NV_shader_atomic_int64 (a tail or occupancy culling keeps the lock), else the spin-lock;
+// either way the CPU engine's nearest sets and image. llvmpipe has no 64-bit atomics: there it
+// checks that the lock is taken and the atomic variant is not compiled.
+TEST_P(GlVsCpu, FixedKCaptureWithAtomic64WhereOfferedElseTheLock) {
+  const bool offered = hasAtomic64(sharedContext().value());
+  for (const char* preset : {"kplus-array", "kplus-heap", "kplus-array+occupancy"}) {
+    SCOPED_TRACE(preset);
+    MethodDesc method = methodPreset(preset).value();
+    method.k = 3;
+    const RenderOutput cpu = cpuRender(method);
+    const GlRenderOutput gl = glRender(method);
+    EXPECT_EQ(gl.atomic64, offered && method.occupancyWords == 0);
+    expectSameNodes(cpu, gl);
+    expectSameImage(cpu.image, gl.image);
+  }
+  MethodDesc hybrid = methodPreset("kplus-array").value();
+  hybrid.k = 3;
+  hybrid.compositing = Compositing::Hybrid;
+  EXPECT_FALSE(glRender(hybrid).atomic64);
+  if (!offered)
+    std::cout << "  " << sharedContext()->renderer()
+              << ": no GL_NV_shader_atomic_int64, the fixed-k capture takes the lock\n";
+}
+
 // Occupancy culling (d = 1 and 2 words): the same nearest sets, and since the maps and the test
 // do not depend on arrival order, the same number of fragments culled by the occupancy test.
 TEST_P(GlVsCpu, OccupancyCullingEqualsTheCpuEngine) {
@@ -387,6 +412,31 @@ TEST(GlEngine, ABufferAboveTheStorageBlockLimitIsAnError) {
   }
 }
 
+// A buffer GL cannot allocate (far beyond any memory and GL_MAX_SHADER_STORAGE_BLOCK_SIZE): one
+// line naming the buffer and its bytes, no GL error left pending; a small one succeeds.
+TEST(GlEngine, OutOfMemoryNamesTheBufferAndItsBytes) {
+  MFR_REQUIRE_GL();
+  sharedContext()->makeCurrent();
+  const uint64_t huge = uint64_t{1} << 46;  // 64 TiB
+  auto b = createCheckedBuffer("test nodes", huge);
+  ASSERT_FALSE(b.ok());
+  const std::string& m = b.error().message;
+  EXPECT_EQ(m.find("--engine gl: out of GPU memory: the test nodes buffer (" +
+                   std::to_string(huge) + " B)"),
+            0u)
+      << m;
+  EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  std::cout << "  " << m << "\n";
+  auto small = createCheckedBuffer("small", 1024);
+  ASSERT_TRUE(small.ok()) << small.error().message;
+  // the engine still renders afterwards
+  auto scene = loadScene("procedural:layers");
+  ASSERT_TRUE(scene.ok());
+  auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 16, 16);
+  ASSERT_TRUE(engine.ok()) << engine.error().message;
+  EXPECT_TRUE(engine->render(methodPreset("abuffer").value()).ok());
+}
+
 TEST(GlEngine, ShaderCompileErrorNamesTheShaderAndCarriesItsLog) {
   MFR_REQUIRE_GL();
   auto shader = compileShaderSource(0x8B30 /* GL_FRAGMENT_SHADER */, "broken.frag",
@@ -401,7 +451,9 @@ TEST(GlEngine, ShaderCompileErrorNamesTheShaderAndCarriesItsLog) {
   for (const char* name :
        {"raster.vert", "raster.geom", "raster_common.glsl", "count.frag", "capture_abuffer.frag",
         "capture_kbuffer.frag", "prefix_sum.comp", "prefix_sum_add.comp", "resolve.comp",
-        "depth_range.frag", "occupancy_fill.frag", "occupancy_count.comp", "shared_layout.h"})
+        "depth_range.frag", "occupancy_fill.frag", "occupancy_count.comp", "shared_layout.h",
+        "alloc_histogram.comp", "importance.comp", "importance_total.comp", "alloc_k.comp",
+        "alloc_pack.comp"})
     EXPECT_FALSE(embeddedShader(name).empty()) << name;
 }
 

@@ -20,6 +20,7 @@
 
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/gl/gl_render_engine.hpp"
+#include "mfr/method/memory_model.hpp"
 #include "mfr/scene/load.hpp"
 
 namespace mfr::gl {
@@ -201,6 +202,161 @@ TEST(GlSeamDeep, ImportanceWithinFloatRoundingOfTheCpuEngine) {
                          std::to_string(g->stats.bytesUsed) + " vs " +
                          std::to_string(r->stats.bytesUsed));
     }
+}
+
+// Counted, dynamic and importance-map k on the GPU (count, histogram, importance map, I_tot, k(p),
+// prefix sum in compute shaders; the host reads totals only): the allocation is the CPU engine's
+// (k(p) and bytes_used identical), the importance map bit for bit its float arithmetic, with the
+// default parameters and with others (a non-integer periphery exponent takes GLSL's pow, a
+// previous frame's |n.v|). No host allocation pass in the pass list.
+TEST(GlSeamDevice, VariableKAllocationInComputeShadersIsTheCpuEngines) {
+  MFR_GL_ENGINE(gl);
+  struct Case {
+    const char* method;
+    int variant;  // importance: 0 default, 1 fovea + d 2.5 + no noise, 2 a previous |n.v|
+  };
+  for (const char* sceneName :
+       {"procedural:layers", "procedural:hairball?strands=150", "procedural:bottles?count=4"})
+    for (const Case c : {Case{"kplus-sb", 0}, Case{"kplus-dynamic", 0}, Case{"kplus-heap", 0},
+                         Case{"vkb", 0}, Case{"vkb", 1}, Case{"vkb", 2}}) {
+      SCOPED_TRACE(std::string(c.method) + " " + std::to_string(c.variant) + " " + sceneName);
+      const Scene scene = loadScene(sceneName).value();
+      const Camera camera =
+          scene.defaultCamera ? *scene.defaultCamera : frameBounds(sceneBounds(scene));
+      const View view{&scene, camera, 97, 83};
+      CpuEngine cpu(EngineOptions{2, 16});
+      MethodDesc method = methodPreset(c.method).value();
+      if (method.allocation == AllocationPolicy::FixedK) {  // kplus-heap as a counted k
+        method.allocation = AllocationPolicy::CountedK;
+        method.k = 20;  // above 16: the K+B-SB rule picks the heap where a pixel overflows
+        method.store = StoreChoice::PerPixel;
+      }
+      if (c.variant == 1) {
+        method.importance.fovea = glm::vec2(20.25f, 61.5f);
+        method.importance.peripheryExponent = 2.5f;
+        method.importance.useNoise = false;
+        method.importance.alpha = 0.3f;
+      }
+      std::vector<float> previous;
+      RenderOptions options;
+      options.budgetBytes = method.k ? 700u << 10 : 250u << 10;
+      if (c.variant == 2) {
+        for (uint64_t p = 0; p < uint64_t{97} * 83; ++p)
+          previous.push_back(static_cast<float>(p % 251) / 250.0f);
+        options.previousNearestCosine = &previous;
+      }
+      RenderOptions cpuOptions = options;
+      cpuOptions.capture = CaptureMode::FragmentParallel;
+      auto g = gl->render(view, method, options);
+      auto r = cpu.render(view, method, cpuOptions);
+      ASSERT_TRUE(g.ok()) << g.error().message;
+      ASSERT_TRUE(r.ok()) << r.error().message;
+      EXPECT_EQ(g->stats.bytesUsed, r->stats.bytesUsed);
+      EXPECT_EQ(g->stats.fragmentSlots, r->stats.fragmentSlots);
+      EXPECT_EQ(g->stats.globalK, r->stats.globalK);
+      EXPECT_EQ(g->stats.captured, r->stats.captured);
+      EXPECT_EQ(g->depthComplexity, r->depthComplexity);
+      EXPECT_EQ(g->kMap, r->kMap);
+      size_t importanceDiffers = 0;
+      float maxDiff = 0.0f;
+      for (auto [gm, rm] : {std::pair{&g->importance.importance, &r->importance.importance},
+                            {&g->importance.depth, &r->importance.depth},
+                            {&g->importance.periphery, &r->importance.periphery},
+                            {&g->importance.fresnel, &r->importance.fresnel},
+                            {&g->importance.noise, &r->importance.noise}}) {
+        ASSERT_EQ(gm->size(), rm->size());
+        for (size_t p = 0; p < gm->size(); ++p) {
+          importanceDiffers += (*gm)[p] != (*rm)[p];
+          maxDiff = std::max(maxDiff, std::abs((*gm)[p] - (*rm)[p]));
+        }
+      }
+      // bit for bit, except GLSL's float pow for a non-integer exponent (a few ulp)
+      if (c.variant == 1) {
+        EXPECT_LE(maxDiff, 1e-6f);
+      } else {
+        EXPECT_EQ(importanceDiffers, 0u) << "max diff " << maxDiff;
+      }
+      if (method.allocation == AllocationPolicy::Importance) {
+        EXPECT_EQ(g->nearestCosine, r->nearestCosine);
+      }
+      const float tolerance = method.compositing == Compositing::Hybrid ? 1e-6f : 0.0f;
+      for (size_t p = 0; p < g->image.pixels.size(); ++p)
+        for (int ch = 0; ch < 3; ++ch)
+          ASSERT_LE(std::abs(g->image.pixels[p][ch] - r->image.pixels[p][ch]), tolerance)
+              << "pixel " << p;
+      bool histogram = false, hostAllocate = false;
+      for (const PassTime& t : g->stats.passes) {
+        histogram |= t.name == "histogram (allocation)";
+        hostAllocate |= t.name == "allocate (host)";
+      }
+      EXPECT_TRUE(histogram);
+      EXPECT_FALSE(hostAllocate);
+      RecordProperty(std::string(c.method) + "_" + std::to_string(c.variant) + "_" + sceneName,
+                     "importance values differing " + std::to_string(importanceDiffers) +
+                         ", max diff " + (std::ostringstream() << maxDiff).str());
+    }
+}
+
+// Above 65535 pixels (llvmpipe ends a shader's loops after 65535 iterations in all: I_tot's
+// serial sum runs in several dispatches), the importance allocation is still the CPU engine's.
+TEST(GlSeamDevice, ImportanceAllocationBeyond65535Pixels) {
+  MFR_GL_ENGINE(gl);
+  const Scene scene = loadScene("procedural:layers").value();
+  const View view{&scene, frameBounds(sceneBounds(scene)), 320, 256};
+  CpuEngine cpu(EngineOptions{2, 16});
+  const MethodDesc method = methodPreset("vkb").value();
+  RenderOptions options;
+  options.budgetBytes = 40u << 20;  // (k(p) 123-168: every pixel's I(p) counts in I_tot)
+  RenderOptions cpuOptions = options;
+  cpuOptions.capture = CaptureMode::FragmentParallel;
+  auto g = gl->render(view, method, options);
+  auto r = cpu.render(view, method, cpuOptions);
+  ASSERT_TRUE(g.ok()) << g.error().message;
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  EXPECT_EQ(g->stats.bytesUsed, r->stats.bytesUsed);
+  EXPECT_EQ(g->stats.fragmentSlots, r->stats.fragmentSlots);
+  EXPECT_EQ(g->importance.importance, r->importance.importance);
+  EXPECT_EQ(g->kMap, r->kMap);
+  EXPECT_EQ(g->image.pixels, r->image.pixels);
+}
+
+// The budget checks after the GPU's totals: a budget with room for the per-pixel words but not for
+// one node per covered pixel, or for an explicit k, gives the CPU engine's words.
+TEST(GlSeamDevice, BudgetErrorsFromTheGpuTotalsAreTheCpuEngines) {
+  MFR_GL_ENGINE(gl);
+  const Scene scene = loadScene("procedural:layers").value();
+  const View view{&scene, frameBounds(sceneBounds(scene)), 40, 36};
+  CpuEngine cpu;
+  auto counts = cpu.countFragments(**cpu.prepare(view));
+  ASSERT_TRUE(counts.ok());
+  const int covered = static_cast<int>(
+      std::count_if(counts->begin(), counts->end(), [](uint32_t n) { return n > 0; }));
+  ASSERT_GT(covered, 100);
+  // (nodes beyond the per-pixel words; explicit k or none)
+  struct Case {
+    const char* name;
+    int extra;
+    std::optional<uint32_t> k;
+  };
+  for (const Case c : {Case{"kplus-sb", 3, {}}, Case{"kplus-dynamic", 3, {}}, Case{"vkb", 3, {}},
+                       Case{"vkb", covered - 1, {}}, Case{"kplus-dynamic", covered - 1, {}},
+                       Case{"kplus-sb", 700, 100}}) {
+    const char* name = c.name;
+    const int extra = c.extra;
+    SCOPED_TRACE(std::string(name) + " " + std::to_string(extra));
+    MethodDesc m = methodPreset(name).value();
+    if (c.k) m.k = *c.k;  // explicit: the sum of min(n(p), k) does not fit
+    const MemoryModel memory = MemoryModel::of(m, true);
+    RenderOptions o;
+    o.budgetBytes = memory.overhead(40 * 36) + extra * memory.node;
+    RenderOptions cpuOptions = o;  // (the GL k-buffers' lock words: the CPU's fragment-parallel)
+    cpuOptions.capture = CaptureMode::FragmentParallel;
+    auto g = gl->render(view, m, o);
+    auto r = cpu.render(view, m, cpuOptions);
+    ASSERT_FALSE(r.ok());
+    ASSERT_FALSE(g.ok());
+    EXPECT_EQ(g.error().message, r.error().message);
+  }
 }
 
 TEST(GlSeamErrors, MethodsNotInTheGlEngineAndBudgetsAreOneLine) {

@@ -22,6 +22,7 @@
 #include "mfr/gl/gl_context.hpp"
 #include "mfr/method/allocation.hpp"
 #include "mfr/method/fragment_node.hpp"
+#include "mfr/method/importance.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/scene.hpp"
@@ -43,6 +44,15 @@ struct GlRenderOptions {
   const Allocation* allocation = nullptr;
   // n(p) measured before (count()): uploaded instead of running the count pass again
   const std::vector<uint32_t>* counts = nullptr;
+  // the allocation the compute shaders left in the engine's buffers (countOnDevice, then
+  // allocateCapped or allocateByImportance) and its n(p), instead of `allocation` and `counts`
+  bool deviceAllocation = false;
+};
+
+/// What the host reads back of a variable-k allocation computed on the GPU: two totals.
+struct GlAllocationTotals {
+  uint64_t slots = 0;          // sum of min(k(p), n(p)): the nodes materialised
+  uint64_t reservedSlots = 0;  // sum of k(p) as allocated (importance: may exceed n(p))
 };
 
 struct GlRenderOutput {
@@ -58,6 +68,7 @@ struct GlRenderOutput {
   uint64_t totalBufferBytes() const;
   uint64_t culledOccupancy = 0;    // k-buffers: rejected by the occupancy test (order-independent)
   uint64_t culledKPlus = 0;        // k-buffers: rejected by the k+ test (depends on arrival order)
+  bool atomic64 = false;           // the fixed-k capture took 64-bit atomicMin (no lock)
   std::vector<GlPassTime> passes;  // count, prefix sum, capture, resolve (timed run)
 };
 
@@ -96,6 +107,29 @@ class GlEngine {
   Result<std::vector<float>> dkbImportance(const std::vector<float>& weights, uint64_t slots,
                                            std::vector<GlPassTime>* passes = nullptr);
 
+  /// Variable k on the GPU, step 1: the count pass into a buffer the engine keeps, and the
+  /// histogram of n(p) and its maximum in a compute shader (alloc_histogram.comp); the host reads
+  /// kHistogramBins + 1 words (mfr::boundedK picks the dynamic k from them).
+  Result<CountSummary> countOnDevice(std::vector<GlPassTime>* passes = nullptr);
+  /// Step 2, counted or dynamic k: k(p) = min(n(p), k) (alloc_k.comp), its prefix sum
+  /// (prefix_sum.comp) and the per-pixel words (alloc_pack.comp; `store` as mfr::allocate's).
+  Result<GlAllocationTotals> allocateCapped(uint32_t k, StoreChoice store,
+                                            std::vector<GlPassTime>* passes = nullptr);
+  /// Step 2, the variable k-buffer: the nearest |n.v| pass, the importance map
+  /// (importance.comp; `previousCosine` when it has a value per pixel, else this frame's |n.v|),
+  /// I_tot (importance_total.comp), k(p) = floor(I(p) / I_tot * slots) (alloc_k.comp), prefix
+  /// sum and per-pixel words. `slots` = F(M).
+  Result<GlAllocationTotals> allocateByImportance(const ImportanceParams& params,
+                                                  const std::vector<float>& previousCosine,
+                                                  uint64_t slots, StoreChoice store,
+                                                  std::vector<GlPassTime>* passes = nullptr);
+  /// The device allocation read back (k(p), offsets, store kinds, reserved k(p) for importance,
+  /// the totals; no globalK): the output's k map and statistics.
+  Result<Allocation> readDeviceAllocation();
+  /// The importance maps and the nearest |n.v| of allocateByImportance, read back for the output.
+  Result<ImportanceMaps> readImportance();
+  Result<std::vector<float>> readNearestCosine();
+
   int width() const;
   int height() const;
   /// The camera with the fitted clip planes (what RasterFrame::build uses).
@@ -106,6 +140,17 @@ class GlEngine {
   explicit GlEngine(std::unique_ptr<State> state);
   std::unique_ptr<State> state_;
 };
+
+/// A GL buffer of `bytes` (at least 16) with `data` (or undefined contents), checked with
+/// glGetError: when GL cannot allocate it (GL_OUT_OF_MEMORY), one line naming the buffer and its
+/// bytes. Every buffer of the engine is made through it. Needs the context current.
+Result<unsigned> createCheckedBuffer(const std::string& name, uint64_t bytes,
+                                     const void* data = nullptr, bool staticDraw = false);
+
+/// True when the context offers 64-bit atomics on storage buffers (GL_NV_shader_atomic_int64 with
+/// GL_ARB_gpu_shader_int64): the fixed-k k-buffer (no tail, no occupancy) then captures with
+/// atomicMin instead of the spin-lock (capture_kbuffer_atomic64.frag).
+bool hasAtomic64(const GlContext& context);
 
 /// The fragment shader interlock extension the context offers, in the order
 /// GL_ARB_fragment_shader_interlock, GL_NV_fragment_shader_interlock,

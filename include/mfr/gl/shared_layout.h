@@ -75,6 +75,28 @@ MFR_GL_CONST(uint, kBindDkbWeights, 1u)
 MFR_GL_CONST(uint, kBindDkbImportance, 2u)
 MFR_GL_CONST(uint, kBindImage2, 4u)  // mlab resolve output (kBindImage is mlab's fill counts)
 
+// variable-k allocation in compute shaders (alloc_histogram.comp, importance.comp,
+// importance_total.comp, alloc_k.comp, alloc_pack.comp)
+MFR_GL_CONST(uint, kAllocHistogramBins, 1024u)  // mfr::kHistogramBins
+MFR_GL_CONST(uint, kAllocSummaryWords, 1025u)   // the histogram of n(p), then max n(p)
+MFR_GL_CONST(uint, kAllocTotalWords, 4u)        // sum of k(p) materialised, as allocated (lo, hi)
+MFR_GL_CONST(uint, kAllocCapped, 0u)            // alloc_k.comp: k(p) = min(n(p), k)
+MFR_GL_CONST(uint, kAllocByImportance, 1u)      // alloc_k.comp: k(p) = floor(I(p) / I_tot F(M))
+MFR_GL_CONST(uint, kImportanceWords, 5u)        // per pixel I, I_d, I_per, I_f, noise (floats)
+MFR_GL_CONST(uint, kTotalChunk, 32768u)         // importance_total.comp: pixels per dispatch
+MFR_GL_CONST(uint, kCosineNone, 0u)             // importance.comp: |n.v| source
+MFR_GL_CONST(uint, kCosineNearest, 1u)          // the nearest pass's unorm8 (kNearestWords)
+MFR_GL_CONST(uint, kCosineFloats, 2u)           // a previous frame's floats
+MFR_GL_CONST(uint, kBindAllocCounts, 0u)        // n(p)
+MFR_GL_CONST(uint, kBindAllocSummary, 1u)       // histogram (alloc_histogram), totals (alloc_k)
+MFR_GL_CONST(uint, kBindAllocK, 2u)             // k(p) materialised: min(k(p), n(p))
+MFR_GL_CONST(uint, kBindAllocReserved, 3u)      // k(p) as allocated (alloc_k)
+MFR_GL_CONST(uint, kBindAllocWords, 3u)         // (first slot, k(p) | heap bit) (alloc_pack)
+MFR_GL_CONST(uint, kBindImportance, 4u)         // kImportanceWords per pixel
+MFR_GL_CONST(uint, kBindImportanceTotal, 5u)    // I_tot (double)
+MFR_GL_CONST(uint, kBindCosine, 6u)             // |n.v| (kCosineNearest or kCosineFloats)
+MFR_GL_CONST(uint, kBindAllocOffsets, 7u)       // exclusive prefix sum of k(p) (alloc_pack)
+
 // material record (12 uint words; floats as their bits): base colour R, G, B, A; the texture's
 // first texel in the texel buffer (kNoTexture: none), its width, height; alpha mode
 // (mfr::AlphaMode); cutoff; alpha override flag, override value; padding

@@ -38,6 +38,34 @@ struct Allocation {
   uint64_t scratchBytes = 0;        // temporary buffers of the policy (histogram, k before caps)
 };
 
+/// What a counted-k or dynamic-k allocation needs of n(p): a few numbers, so that an engine can
+/// count and allocate on the GPU and check the budget on the host with allocate()'s words.
+struct CountSummary {
+  std::vector<uint64_t> histogram;  // kHistogramBins bins of n(p), the last n >= kHistogramBins - 1
+  uint64_t maxN = 0;                // the largest n(p)
+  uint64_t covered = 0;             // pixels with n(p) > 0
+};
+CountSummary summarizeCounts(const std::vector<uint32_t>& fragmentCounts);
+
+/// allocate()'s first check, before any pass: the per-pixel words (and, unless the method keeps
+/// no nodes, one node) fit the budget. F(M) in nodes (UINT64_MAX without a budget).
+Result<uint64_t> budgetSlots(const PixelLayout& layout, const MethodDesc& method,
+                             const MemoryModel& memory, std::optional<uint64_t> budget);
+/// The global k of a counted-k (explicit or F(M) / |P|) or dynamic-k (the largest k whose
+/// sum of min(n(p), k) fits F(M), from the histogram) allocation, with allocate()'s errors.
+Result<uint32_t> boundedK(const PixelLayout& layout, const MethodDesc& method,
+                          const MemoryModel& memory, std::optional<uint64_t> budget,
+                          const CountSummary& counts);
+/// allocate()'s check that a counted/dynamic k's sum of min(n(p), k) = `slots` nodes fits.
+Result<void> checkBoundedSlots(const PixelLayout& layout, const MethodDesc& method,
+                               const MemoryModel& memory, std::optional<uint64_t> budget,
+                               uint32_t k, uint64_t slots);
+/// allocate()'s checks of an importance or optimal allocation: a budget, one node per covered
+/// pixel.
+Result<void> checkCoveredPixels(const PixelLayout& layout, const MethodDesc& method,
+                                const MemoryModel& memory, std::optional<uint64_t> budget,
+                                uint64_t covered);
+
 /// Turns the policy, the budget and (when a count pass ran) n(p) into k(p) and offsets.
 /// `fragmentCounts`: n(p) (empty when the method does not count); `importance`: I(p) of the
 /// importance policies; `oracleK`: the optimal policy's k(p). Errors (one line): a budget too
