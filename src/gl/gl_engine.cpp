@@ -500,11 +500,17 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
     auto atomic64 = raster("capture_kbuffer_atomic64.frag",
                            "#extension GL_ARB_gpu_shader_int64 : require\n"
                            "#extension GL_NV_shader_atomic_int64 : require\n");
-    if (!atomic64) return atomic64.error();
-    s->progKBufferAtomic64 = *atomic64;
     auto swap = linkProgram("swap_node_words.comp", {{GL_COMPUTE_SHADER, "swap_node_words.comp"}});
-    if (!swap) return swap.error();
-    s->progSwapWords = *swap;
+    // never verified on a driver that offers the extension (llvmpipe does not): a driver that
+    // announces it but does not compile the shaders keeps the lock (engine_counters.atomic64
+    // says per frame which capture ran) instead of losing the whole engine
+    if (atomic64 && swap) {
+      s->progKBufferAtomic64 = *atomic64;
+      s->progSwapWords = *swap;
+    } else {
+      if (atomic64) glDeleteProgram(*atomic64);
+      if (swap) glDeleteProgram(*swap);
+    }
   }
   auto depthRange = raster("depth_range.frag");
   if (!depthRange) return depthRange.error();
