@@ -5,9 +5,9 @@
 namespace mfr {
 
 std::vector<std::string> presetNames() {
-  return {"zbuffer",        "abuffer", "fkb",      "kplus-array", "kplus-heap", "kplus-sb",
-          "kplus-dynamic",  "vkb",     "vkb-fill", "dkb",         "dkb-fill",   "optimal",
-          "optimal-greedy", "wboit",   "mboit",    "mlab"};
+  return {"zbuffer", "abuffer",  "fkb", "kplus-array", "kplus-heap", "kplus-sb", "kplus-dynamic",
+          "vkb",     "vkb-fill", "dkb", "dkb-fill",    "dkb-curve",  "optimal",  "optimal-greedy",
+          "wboit",   "mboit",    "mlab"};
 }
 
 Result<MethodDesc> methodPreset(const std::string& fullName) {
@@ -57,6 +57,15 @@ Result<MethodDesc> methodPreset(const std::string& fullName) {
     m.perPixelLock = true;
     m.compositing = Compositing::Hybrid;  // deep hybrid transparency (DHOIT sec. 3.3)
     m.fillUnusedSlots = name == "dkb-fill";
+  } else if (name == "dkb-curve") {
+    // beyond the paper (issue 14 sec. 4): the oracle's hull allocation over curves a network
+    // predicts from the deep k-buffer's features (mfr/method/dkb_curve.hpp)
+    m.allocation = AllocationPolicy::Optimal;
+    m.predictedCurves = true;
+    m.store = StoreChoice::PerPixel;
+    m.culling = CullingTest::KPlus;
+    m.perPixelLock = true;
+    m.compositing = Compositing::Hybrid;
   } else if (name == "optimal" || name == "optimal-greedy") {
     m.allocation = AllocationPolicy::Optimal;
     m.store = StoreChoice::PerPixel;
