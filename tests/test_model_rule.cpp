@@ -44,7 +44,7 @@ void expectOneLineError(const test::CliRun& r, std::initializer_list<std::string
 
 learn::Model modelDeclaring(const nlohmann::json& extra) {
   nlohmann::json meta = {{"features", kDkbFeatureSet}, {"target", learn::kDkbTargetScaling}};
-  meta.update(extra);
+  if (extra.is_object()) meta.update(extra);
   return {learn::makeMlp(learn::kDkbLayers, 3), meta.dump()};
 }
 
@@ -134,8 +134,8 @@ std::string datasetFor(const std::string& rule) {
   const std::string out = path(rule + ".mfrds");
   if (fs::exists(out)) return out;
   const auto r = runCli(
-      "dataset procedural:glassware?count=2&segments=12 procedural:city?rows=2&columns=2 "
-      "procedural:city?rows=3&columns=2 --width 32 --height 32 --orbit 2 --quiet --composite " +
+      "dataset 'procedural:glassware?count=2&segments=12' 'procedural:city?rows=2&columns=2' "
+      "'procedural:city?rows=3&columns=2' --width 32 --height 32 --orbit 2 --quiet --composite " +
       rule + " -o " + out);
   EXPECT_EQ(r.exitCode, 0) << r.err;
   return out;
@@ -189,7 +189,7 @@ TEST(ModelRuleCli, ValidationFamilyHoldsOutEverySceneOfTheFamily) {
 }
 
 TEST(ModelRuleCli, RenderAndCompareRefuseAModelOfTheOtherRule) {
-  const std::string scene = "procedural:city?rows=2&columns=2 --width 32 --height 32 --quiet ";
+  const std::string scene = "'procedural:city?rows=2&columns=2' --width 32 --height 32 --quiet ";
   expectOneLineError(runCli("render " + scene + "-m dkb -M 60KB --composite kbuffer --model " +
                             modelFor("hybrid") + " -o " + path("x.png")),
                      {"hybrid.mfrnn", "kbuffer", "hybrid"});

@@ -6,7 +6,7 @@
 // 6-sided tube of radius 0.015 from the ground to the crown centre at height 1.2-1.6) and `leaves`
 // leaves whose centres are uniform in the crown ball of radius 0.45. A leaf is the cut-out shape of
 // an alpha-tested card modelled as geometry: a flat fan of 8 triangles around its centre with the
-// outline of an ellipse of half-axes 0.09 x 0.04 (area 8 sin(pi/4) a b, about 0.0204), in a random
+// outline of an ellipse of half-axes 0.09 x 0.04 (area 4 sin(pi/4) a b, about 0.0102), in a random
 // plane. A line crosses each leaf at most once, so n(p) <= plants * leaves + 2 * plants; along a
 // line through the crown centre the expected count is rho * 2 R * A / 2 = 3 N A / (4 pi R^2)
 // (N leaves of area A, density rho = N / (4/3 pi R^3), mean projected area A / 2).
