@@ -40,7 +40,8 @@ Result<CurveChoice> predictedCurveK(const RasterFrame& frame, const MethodDesc& 
   // the hull allocation over the rebuilt curves
   out.k = allocateByPredictedCurves(predictions, out.n, slots);
   out.bytesAllocated = pixels.size() * (sizeof(FeatureAccumulator) + 4 * kCurveOutputs) +
-                       (rows.size() + predicted.size()) * 4 + image.fragments * sizeof(double);
+                       (rows.size() + predicted.size()) * 4 + image.fragments * sizeof(double) +
+                       pixels.size() * sizeof(std::vector<double>);
   return out;
 }
 
