@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Retrains the deep k-buffer's model from the same code with the same script as the shipped one,
-# scaled down (scripts/train-model.sh --tiny: the same 5 procedural scenes at 32x32, 2 orbit
-# views, 3 epochs), in a temporary folder, and compares the model's bytes with the committed reference
+# scaled down (scripts/train-model.sh --tiny: the same procedural corpus at 32x32 and 24x24, one
+# orbit view each, 3 epochs, hybrid targets), in a temporary folder, and compares the model's bytes with the committed reference
 # models/test/dkb-tiny.mfrnn. The model holds the weights and the metadata, which records the
 # feature set, the target definition and each dataset's FNV-1a 64 hash: a change of the training,
 # dataset or feature code that changes any of them fails here. After an intended change,

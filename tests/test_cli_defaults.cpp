@@ -151,7 +151,7 @@ TEST(CliDefaults, HelpListsTheTablesPresetsForEachOption) {
         << squeezed;
   EXPECT_EQ(presetsAccepting(MethodOption::K),
             "zbuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, mlab");
-  EXPECT_EQ(presetsAccepting(MethodOption::Model), "dkb, dkb-fill");
+  EXPECT_EQ(presetsAccepting(MethodOption::Model), "dkb, dkb-fill, dkb-curve");
   for (const std::string& preset : presetNames())
     EXPECT_NE(squeezed.find(preset), std::string::npos) << preset;
 }

@@ -343,7 +343,7 @@ TEST(DkbDataset, FileRoundTripsExactly) {
   const learn::Dataset d = smallDataset();
   const std::string path = tempPath("roundtrip.mfrds");
   ASSERT_TRUE(learn::writeDataset(path, d));
-  EXPECT_EQ(readBytes(path).size(), 8 + 12 + 4 + 17 + 4 + 16 + 4 + 20 + 8 + 10 * 68u);
+  EXPECT_EQ(readBytes(path).size(), 8 + 16 + 4 + 17 + 4 + 16 + 4 + 20 + 8 + 10 * 68u);
   auto back = learn::readDataset(path);
   ASSERT_TRUE(back) << back.error().message;
   EXPECT_EQ(back->scenes, d.scenes);

@@ -4,6 +4,8 @@
 // recomputed from the run's k(p) and n(p).
 #include <gtest/gtest.h>
 
+#include "mfr/method/dkb_features.hpp"
+
 #include <map>
 #include <string>
 
@@ -63,7 +65,15 @@ std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const 
     b["nearest_normal"] = 4 * pixels;
   }
   if (importance && m.importanceSource == ImportanceSource::Network) b["importance"] = 4 * pixels;
-  if (m.allocation == AllocationPolicy::Optimal) {
+  if (m.allocation == AllocationPolicy::Optimal && m.predictedCurves) {
+    b["oracle_k"] = 4 * pixels;
+    // dkb-curve: a feature accumulator and 9 predictions per pixel, 12 features and 9 outputs
+    // per covered pixel, the rebuilt curves (a vector per pixel, a double per fragment)
+    uint64_t covered = 0;
+    for (uint32_t n : out.depthComplexity) covered += n > 0;
+    b["oracle_prepass"] = (sizeof(FeatureAccumulator) + 4 * 9) * pixels + (12 + 9) * 4 * covered +
+                          8 * abufferFragments + sizeof(std::vector<double>) * pixels;
+  } else if (m.allocation == AllocationPolicy::Optimal) {
     b["oracle_k"] = 4 * pixels;
     // n(p) and the error curves (the A-buffer is tile-local: one tile's nodes per worker)
     const uint64_t curves = 8 * abufferFragments + sizeof(std::vector<double>) * pixels;

@@ -82,9 +82,11 @@ double ndc(int i, int n) {
 // ------------------------------------------------------------------------------------------------
 // All scenes
 
-TEST(ProceduralScenes, NamesAreTheFiveBuiltInScenes) {
-  EXPECT_EQ(proceduralSceneNames(),
-            (std::vector<std::string>{"layers", "hairball", "smoke", "bottles", "spheres"}));
+TEST(ProceduralScenes, NamesAreTheBuiltInScenes) {
+  EXPECT_EQ(
+      proceduralSceneNames(),
+      (std::vector<std::string>{"layers", "hairball", "smoke", "bottles", "spheres", "glassware",
+                                "foliage", "particles", "hair", "panels", "city"}));
 }
 
 TEST(ProceduralScenes, EveryDefaultSceneIsValidBlendedAndFramedByItsDefaultCamera) {

@@ -14,6 +14,7 @@
 #include "mfr/compare/compare.hpp"
 #include "mfr/compare/compare_output.hpp"
 #include "mfr/core/units.hpp"
+#include "mfr/method/dkb_model.hpp"
 
 namespace mfr::cli {
 namespace {
@@ -152,6 +153,14 @@ int run(const CompareArgs& a, const std::string& version) {
     if (!compositing) return fail("--composite: " + compositing.error().message);
     options.compositing = compositing.value();
   }
+  if (options.model)  // a model trained for the other compositing rule is refused up front
+    for (const std::string& name : options.methods) {
+      MethodDesc m = methodPreset(name).value();
+      if (!checkMethodOption(MethodOption::Model, m)) continue;
+      if (options.compositing) m.compositing = *options.compositing;
+      if (auto ok = checkModelForMethod(*options.model, a.model, m); !ok)
+        return fail("--model: " + ok.error().message);
+    }
   if (a.capture == "parallel")
     options.capture = CaptureMode::FragmentParallel;
   else if (a.capture != "tile")

@@ -18,6 +18,8 @@ struct DatasetArgs {
   std::string out;
   int budgetSteps = 5;
   double sample = 0.2;
+  std::string composite = "hybrid";
+  std::string curveOut;  // also dkb-curve's dataset of the same samples
 };
 
 int runDataset(DatasetArgs& a) {
@@ -30,6 +32,11 @@ int runDataset(DatasetArgs& a) {
   sampling.budgetSteps = a.budgetSteps;
   sampling.sampleFraction = a.sample;
   sampling.seed = a.scene.seed;
+  auto rule = parseCompositing(a.composite);
+  if (!rule || !kBufferFamilyRule(rule.value()))
+    return fail("--composite '" + a.composite + "': expected kbuffer or hybrid");
+  sampling.compositing = rule.value();
+  sampling.curveTargets = !a.curveOut.empty();
   Progress progress(!a.scene.quiet);
   nlohmann::json perScene = nlohmann::json::array();
   for (const std::string& source : a.scenes) {
@@ -65,6 +72,7 @@ int runDataset(DatasetArgs& a) {
       {"generator", "mfr dataset"},
       {"features", kDkbFeatureSet},
       {"target", learn::kDkbTargetScaling},
+      {"composite", toString(sampling.compositing)},
       {"width", a.scene.width},
       {"height", a.scene.height},
       {"orbit", a.scene.orbit},
@@ -75,6 +83,14 @@ int runDataset(DatasetArgs& a) {
        perScene}}.dump();
   auto written = learn::writeDataset(a.out, data);
   if (!written) return fail(written.error().message);
+  if (!a.curveOut.empty()) {  // the same samples with dkb-curve's targets
+    auto meta = nlohmann::json::parse(data.metadata);
+    meta["target"] = kDkbCurveTargetScaling;
+    data.metadata = meta.dump();
+    data.targetCount = kCurveOutputs;
+    written = learn::writeDataset(a.curveOut, data);
+    if (!written) return fail(written.error().message);
+  }
   if (a.scene.json)
     std::printf(
         "%s\n",
@@ -107,6 +123,12 @@ Runner addDatasetCommand(CLI::App& app) {
                   "Budgets per view, from one fragment per covered pixel to all (default 5)");
   cmd->add_option("--sample", args->sample,
                   "Fraction of covered pixels kept per view and budget (default 0.2)");
+  cmd->add_option("--composite", args->composite,
+                  "Compositing rule of the optimal targets: hybrid (default) or kbuffer; train "
+                  "one model per rule");
+  cmd->add_option("--curve-out", args->curveOut,
+                  "Also write dkb-curve's dataset: the same samples with each pixel's error curve "
+                  "(8 drops and a tail) as targets");
   return [args] { return runDataset(*args); };
 }
 

@@ -12,6 +12,7 @@
 #include "mfr/core/colormap.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/render.hpp"
+#include "mfr/method/dkb_model.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/method/stats_json.hpp"
 
@@ -84,6 +85,8 @@ Result<MethodDesc> buildMethod(const RenderArgs& a) {
     auto model = loadDkbModel(a.model);
     if (!model) return model.error();
     m.model = model.value();
+    if (auto ok = checkModelForMethod(*m.model, a.model, m); !ok)
+      return makeError("--model: " + ok.error().message);
   }
   if (m.allocation == AllocationPolicy::Importance) {
     ImportanceParams ip = a.importance;

@@ -30,12 +30,15 @@ struct TrainArgs {
   std::string log;
   std::string lossCurve;
   std::vector<std::string> validationScenes;
+  std::vector<std::string> validationFamilies;
   learn::TrainOptions train;
   bool quiet = false;
 };
 
 struct Split {
   Eigen::MatrixXf trainX, trainY, validX, validY;
+  Compositing rule = Compositing::Hybrid;  // of every dataset's targets
+  uint32_t targetCount = 1;                // 1: importance, kCurveOutputs: dkb-curve
   std::vector<std::string> trainScenes, validScenes;
   // per dataset, in order: its file name (not the folder, so the model's bytes do not depend on
   // where it was trained) and the FNV-1a 64 of its bytes
@@ -51,6 +54,19 @@ Result<Split> loadSplit(const TrainArgs& a) {
     auto data = learn::readDataset(path);
     if (!data) return data.error();
     if (auto ok = learn::checkDatasetDefinitions(data.value(), path); !ok) return ok.error();
+    auto rule = learn::datasetRule(data.value(), path);
+    if (!rule) return rule.error();
+    if (!sets.empty() && rule.value() != split.rule)
+      return makeError("dataset " + path + ": targets for " + toString(rule.value()) +
+                       " compositing, " + a.datasets.front() + " has " + toString(split.rule) +
+                       " (one model per rule: train them separately)");
+    split.rule = rule.value();
+    if (!sets.empty() && data->targetCount != split.targetCount)
+      return makeError("dataset " + path + ": " + std::to_string(data->targetCount) +
+                       " targets per sample, " + a.datasets.front() + " has " +
+                       std::to_string(split.targetCount) + " (importance and curve datasets " +
+                       "train different networks)");
+    split.targetCount = data->targetCount;
     split.datasets.push_back({{"file", std::filesystem::path(path).filename().string()},
                               {"fnv1a64", learn::hashHex(data->fileHash)}});
     for (const std::string& s : data->scenes)
@@ -60,11 +76,24 @@ Result<Split> loadSplit(const TrainArgs& a) {
   std::set<std::string> valid(a.validationScenes.begin(), a.validationScenes.end());
   if (valid.count("none"))
     valid.clear();
-  else if (valid.empty() && order.size() > 1)
+  else if (valid.empty() && a.validationFamilies.empty() && order.size() > 1)
     valid.insert(order.back());
   for (const std::string& v : valid)
     if (std::find(order.begin(), order.end(), v) == order.end())
       return makeError("--validation-scene '" + v + "': not in the datasets");
+  // a validation split by family: every scene of procedural:NAME, whatever its parameters
+  for (const std::string& family : a.validationFamilies) {
+    const std::string prefix = "procedural:" + family;
+    bool found = false;
+    for (const std::string& s : order)
+      if (s == prefix || s.starts_with(prefix + "?")) {
+        valid.insert(s);
+        found = true;
+      }
+    if (!found)
+      return makeError("--validation-family '" + family + "': no " + prefix +
+                       " scene in the datasets");
+  }
   for (const std::string& s : order)
     (valid.count(s) ? split.validScenes : split.trainScenes).push_back(s);
   if (split.trainScenes.empty()) return makeError("--validation-scene: no scene left to train on");
@@ -74,9 +103,10 @@ Result<Split> loadSplit(const TrainArgs& a) {
       (valid.count(d.scenes[s.scene]) ? validCount : trainCount)++;
   if (trainCount == 0) return makeError("the datasets hold no training samples");
   split.trainX.resize(kDkbFeatureCount, static_cast<Eigen::Index>(trainCount));
-  split.trainY.resize(1, static_cast<Eigen::Index>(trainCount));
+  const Eigen::Index outputs = static_cast<Eigen::Index>(split.targetCount);
+  split.trainY.resize(outputs, static_cast<Eigen::Index>(trainCount));
   split.validX.resize(kDkbFeatureCount, static_cast<Eigen::Index>(validCount));
-  split.validY.resize(1, static_cast<Eigen::Index>(validCount));
+  split.validY.resize(outputs, static_cast<Eigen::Index>(validCount));
   Eigen::Index t = 0, v = 0;
   for (const learn::Dataset& d : sets)
     for (const learn::DatasetSample& s : d.samples) {
@@ -85,7 +115,10 @@ Result<Split> loadSplit(const TrainArgs& a) {
       Eigen::MatrixXf& y = isValid ? split.validY : split.trainY;
       const Eigen::Index i = isValid ? v++ : t++;
       for (int c = 0; c < kDkbFeatureCount; ++c) x(c, i) = s.features[c];
-      y(0, i) = s.target;
+      if (outputs == 1)
+        y(0, i) = s.target;
+      else
+        for (Eigen::Index t = 0; t < outputs; ++t) y(t, i) = s.curve[static_cast<size_t>(t)];
     }
   return split;
 }
@@ -126,7 +159,9 @@ int runTrain(TrainArgs& a) {
 
   auto split = loadSplit(a);
   if (!split) return fail(split.error().message);
-  learn::Mlp net = learn::makeMlp(learn::kDkbLayers, o.seed);
+  const bool curve = split->targetCount != 1;
+  const std::vector<int>& layers = curve ? kDkbCurveLayers : learn::kDkbLayers;
+  learn::Mlp net = learn::makeMlp(layers, o.seed);
   // the log is written (atomically, like every output) when training ends; its folder is checked
   // now so that a bad --log fails before the training, not after it
   const std::filesystem::path logFolder = std::filesystem::path(a.log).parent_path();
@@ -152,8 +187,9 @@ int runTrain(TrainArgs& a) {
   const learn::EpochLog& last = logs.back();
   nlohmann::json meta = {{"features", kDkbFeatureSet},
                          {"feature_normalisation", "include/mfr/method/dkb_features.hpp"},
-                         {"target", learn::kDkbTargetScaling},
-                         {"layers", learn::kDkbLayers},
+                         {"target", curve ? kDkbCurveTargetScaling : learn::kDkbTargetScaling},
+                         {"composite", toString(split->rule)},
+                         {"layers", layers},
                          {"activations", "relu, relu, sigmoid"},
                          {"training",
                           {{"datasets", split->datasets},
@@ -194,6 +230,9 @@ Runner addTrainCommand(CLI::App& app) {
   cmd->add_option("--loss-curve", args->lossCurve, "Loss curve PNG (default: OUT.loss.png)");
   cmd->add_option("--validation-scene", args->validationScenes,
                   "Scene held out for validation (repeatable; default: the last scene; 'none')");
+  cmd->add_option("--validation-family", args->validationFamilies,
+                  "Hold out every scene of the procedural family NAME (procedural:NAME[?...]) for "
+                  "validation (repeatable): a validation split by family");
   cmd->add_option("--epochs", args->train.epochs, "Epochs (default 20)");
   cmd->add_option("--batch", args->train.batchSize, "Mini-batch size (default 512, the paper's)");
   cmd->add_option("--learning-rate", args->train.learningRate,

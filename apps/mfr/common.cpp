@@ -231,7 +231,10 @@ int fail(const std::string& message) {
 Result<std::shared_ptr<const learn::Model>> loadDkbModel(const std::string& path) {
   auto model = learn::readModel(path);
   if (!model) return model.error();
-  if (auto fits = checkDkbModel(model.value(), path); !fits) return fits.error();
+  // an importance model (dkb, dkb-fill) or a curve model (dkb-curve): which one a method needs
+  // is checkModelForMethod's question
+  if (auto fits = checkDkbModel(model.value(), path); !fits)
+    if (!checkDkbCurveModel(model.value(), path)) return fits.error();
   return std::make_shared<const learn::Model>(std::move(model.value()));
 }
 

@@ -107,8 +107,8 @@ std::shared_ptr<Model> loadModel(const py::object& pathArg) {
 
 // --- datasets ---------------------------------------------------------------------------------
 
-static_assert(sizeof(learn::DatasetSample) == 68 && alignof(learn::DatasetSample) == 4,
-              "DatasetSample is the file's 68-byte record");
+static_assert(alignof(learn::DatasetSample) == 4 && sizeof(learn::DatasetSample) % 4 == 0,
+              "DatasetSample: floats and u32 only (strided views below)");
 
 /// A read-only strided view into the samples (owned by `owner`).
 template <class Scalar>

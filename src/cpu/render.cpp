@@ -15,6 +15,7 @@
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
+#include "mfr/cpu/dkb_curve_pass.hpp"
 #include "mfr/cpu/optimal_oracle.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/optimal_allocation.hpp"
@@ -242,7 +243,17 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
 
   // optimal k-buffer (offline oracle): exact A-buffer, per-pixel hybrid error curves, allocation
   std::vector<uint32_t> oracleK;
-  if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes) {
+  if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes &&
+      method.predictedCurves) {  // dkb-curve: the hull allocation over predicted curves
+    const uint64_t slots = memory.fragmentSlots(*options.budgetBytes, pixels);
+    auto chosen = timer.run("curves", [&] { return predictedCurveK(frame, method, slots); });
+    if (!chosen) return chosen.error();
+    out.depthComplexity = std::move(chosen->n);
+    oracleK = std::move(chosen->k);
+    ledger.add("depth_complexity", out.depthComplexity);
+    ledger.add("oracle_k", oracleK);
+    ledger.addBytes("oracle_prepass", chosen->bytesAllocated);
+  } else if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes) {
     const uint64_t slots = memory.fragmentSlots(*options.budgetBytes, pixels);
     auto chosen = timer.run("oracle", [&] { return optimalK(frame, method, options, slots); });
     if (!chosen) return chosen.error();

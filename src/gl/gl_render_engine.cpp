@@ -10,6 +10,7 @@
 #include <chrono>
 #include <utility>
 
+#include "mfr/cpu/dkb_curve_pass.hpp"
 #include "mfr/cpu/optimal_oracle.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/gl/gl_context.hpp"
@@ -55,6 +56,17 @@ Result<OracleChoice> cpuOracle(const View& view, const MethodDesc& method,
   auto frame = RasterFrame::build(*view.scene, view.camera, ro);
   if (!frame) return frame.error();
   return optimalK(*frame, method, options, slots);
+}
+
+// dkb-curve's n(p) and k(p) from the CPU engine's passes (predictedCurveK,
+// mfr/cpu/dkb_curve_pass.hpp) on the same view.
+Result<CurveChoice> cpuCurves(const View& view, const MethodDesc& method, uint64_t slots) {
+  RasterOptions ro;
+  ro.width = view.width;
+  ro.height = view.height;
+  auto frame = RasterFrame::build(*view.scene, view.camera, ro);
+  if (!frame) return frame.error();
+  return predictedCurveK(*frame, method, slots);
 }
 
 class GlRenderEngine final : public Engine {
@@ -165,7 +177,15 @@ class GlRenderEngine final : public Engine {
     } else if (variable) {
       std::vector<uint32_t> oracleK;
       auto t0 = std::chrono::steady_clock::now();
-      if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes) {
+      if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes &&
+          method.predictedCurves) {  // dkb-curve: features, network and hull on the host
+        auto chosen =
+            cpuCurves(gv->view(), method, memory.fragmentSlots(*options.budgetBytes, pixels));
+        if (!chosen) return chosen.error();
+        n = std::move(chosen->n);
+        oracleK = std::move(chosen->k);
+        hostPasses.push_back({"curves (cpu)", msSince(t0)});
+      } else if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes) {
         auto chosen = cpuOracle(gv->view(), method, options,
                                 memory.fragmentSlots(*options.budgetBytes, pixels));
         if (!chosen) return chosen.error();
@@ -228,7 +248,7 @@ class GlRenderEngine final : public Engine {
     go.warmUp = gv->firstRender();
     go.allocation = perPixel ? &*perPixel : nullptr;
     go.deviceAllocation = onDevice;
-    // (GL's own n(p) only: the optimal k-buffer's comes from the CPU oracle)
+    // (GL's own n(p) only: the optimal k-buffer's and dkb-curve's come from CPU passes)
     go.counts = n.empty() || method.allocation == AllocationPolicy::Optimal ? nullptr : &n;
     auto gl = gv->engine().render(method, go);
     if (!gl) return gl.error();

@@ -25,7 +25,9 @@ static_assert(std::endian::native == std::endian::little, "the file formats are 
 
 constexpr char kMagic[8] = {'M', 'F', 'R', 'D', 'S', 0, 0, 0};
 constexpr uint32_t kMaxScenes = 65536, kMaxName = 4096, kMaxMetadata = 1u << 20;
-constexpr size_t kSampleBytes = 4 * 4 + 4 * kDkbFeatureCount + 4;
+size_t sampleBytes(uint32_t targets) {
+  return 4 * 4 + 4 * kDkbFeatureCount + 4 * size_t{targets};
+}
 
 uint64_t mix(uint64_t x) {  // SplitMix64 finaliser
   x += 0x9e3779b97f4a7c15ull;
@@ -99,8 +101,9 @@ uint64_t budgetStepSlots(uint64_t coveredPixels, uint64_t fragments, int step, i
 Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t scene,
                                               uint32_t view, const ViewSamplingOptions& options) {
   auto oracle =
-      frameErrorCurves(frame, options.background, Compositing::Hybrid, options.memoryLimitBytes);
+      frameErrorCurves(frame, options.background, options.compositing, options.memoryLimitBytes);
   if (!oracle) return oracle.error();
+  const double scale = options.curveTargets ? curveScale(oracle->curves) : 1.0;
   const std::vector<FeatureAccumulator> pixels = accumulateFeatures(frame);
   const ImageFeatureStats image = imageFeatureStats(pixels);
   std::vector<DatasetSample> samples;
@@ -121,6 +124,7 @@ Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t
       sample.pixel = p;
       sample.features = pixelFeatures(pixels[p], image, slots);
       sample.target = static_cast<float>(k[p]) / static_cast<float>(kMax);
+      if (options.curveTargets) sample.curve = curveTargets(oracle->curves[p], scale);
       samples.push_back(sample);
     }
   }
@@ -129,10 +133,11 @@ Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t
 
 Result<void> writeDataset(const std::string& path, const Dataset& data) {
   std::string out;
-  out.reserve(64 + data.samples.size() * kSampleBytes);
+  out.reserve(64 + data.samples.size() * sampleBytes(data.targetCount));
   out.append(kMagic, sizeof kMagic);
   put<uint32_t>(out, kDatasetVersion);
   put<uint32_t>(out, kDkbFeatureCount);
+  put<uint32_t>(out, data.targetCount);
   put<uint32_t>(out, static_cast<uint32_t>(data.scenes.size()));
   for (const std::string& name : data.scenes) {
     put<uint32_t>(out, static_cast<uint32_t>(name.size()));
@@ -147,7 +152,10 @@ Result<void> writeDataset(const std::string& path, const Dataset& data) {
     put(out, s.budgetStep);
     put(out, s.pixel);
     for (float f : s.features) put(out, f);
-    put(out, s.target);
+    if (data.targetCount == 1)
+      put(out, s.target);
+    else
+      for (uint32_t t = 0; t < data.targetCount; ++t) put(out, s.curve[t]);
   }
   // a temporary file renamed into place: an interrupted write never leaves a truncated dataset
   if (auto written = writeFileAtomically(path, out); !written)
@@ -166,17 +174,23 @@ Result<Dataset> readDataset(const std::string& path) {
   std::string magic;
   if (!in.getString(magic, sizeof kMagic) || std::memcmp(magic.data(), kMagic, sizeof kMagic) != 0)
     return makeError("dataset " + path + ": not an mfr dataset (bad magic)");
-  uint32_t version = 0, features = 0, sceneCount = 0;
+  uint32_t version = 0, features = 0, targets = 0, sceneCount = 0;
   if (!in.get(version)) return in.error("truncated header");
   if (version != kDatasetVersion)
     return in.error("version " + std::to_string(version) + " is not supported (this build reads " +
                     std::to_string(kDatasetVersion) + ")");
-  if (!in.get(features) || !in.get(sceneCount)) return in.error("truncated header");
+  if (!in.get(features) || !in.get(targets) || !in.get(sceneCount))
+    return in.error("truncated header");
   if (features != kDkbFeatureCount)
     return in.error(std::to_string(features) + " features per sample, expected 12");
+  if (targets != 1 && targets != kCurveOutputs)
+    return in.error(std::to_string(targets) + " targets per sample, expected 1 or " +
+                    std::to_string(kCurveOutputs));
   if (sceneCount == 0 || sceneCount > kMaxScenes) return in.error("bad scene count");
   Dataset data;
   data.fileHash = fnv1a64(bytes);
+  data.targetCount = targets;
+  const size_t perSample = sampleBytes(targets);
   for (uint32_t i = 0; i < sceneCount; ++i) {
     uint32_t length = 0;
     std::string name;
@@ -190,18 +204,22 @@ Result<Dataset> readDataset(const std::string& path) {
     return in.error("truncated or bad metadata");
   uint64_t count = 0;
   if (!in.get(count)) return in.error("truncated sample count");
-  if (count > in.remaining() / kSampleBytes)
+  if (count > in.remaining() / perSample)
     return in.error("truncated: " + std::to_string(count) + " samples declared, room for " +
-                    std::to_string(in.remaining() / kSampleBytes));
-  if (in.remaining() != count * kSampleBytes) return in.error("trailing bytes after the samples");
+                    std::to_string(in.remaining() / perSample));
+  if (in.remaining() != count * perSample) return in.error("trailing bytes after the samples");
   data.samples.resize(count);
   for (uint64_t i = 0; i < count; ++i) {
     DatasetSample& s = data.samples[i];
     (void)(in.get(s.scene) && in.get(s.view) && in.get(s.budgetStep) && in.get(s.pixel));
     for (float& f : s.features) (void)in.get(f);
-    (void)in.get(s.target);
+    if (targets == 1)
+      (void)in.get(s.target);
+    else
+      for (uint32_t t = 0; t < targets; ++t) (void)in.get(s.curve[t]);
     if (s.scene >= sceneCount) return in.error("sample " + std::to_string(i) + ": bad scene");
     bool finite = std::isfinite(s.target) && s.target >= 0.0f && s.target <= 1.0f;
+    for (float t : s.curve) finite = finite && std::isfinite(t) && t >= 0.0f && t <= 1.0f;
     for (float f : s.features) finite = finite && std::isfinite(f);
     if (!finite)
       return in.error("sample " + std::to_string(i) + ": non-finite or out-of-range value");
@@ -209,11 +227,24 @@ Result<Dataset> readDataset(const std::string& path) {
   return data;
 }
 
+Result<Compositing> datasetRule(const Dataset& data, const std::string& path) {
+  const auto meta = nlohmann::json::parse(data.metadata, nullptr, false);
+  if (!meta.is_object() || !meta.contains("composite")) return Compositing::Hybrid;
+  const auto& declared = meta["composite"];
+  if (declared.is_string()) {
+    auto rule = parseCompositing(declared.get<std::string>());
+    if (rule && kBufferFamilyRule(rule.value())) return rule.value();
+  }
+  return makeError("dataset " + path + ": its metadata declares the compositing rule " +
+                   oneLine(declared.dump(), 60) + ", expected \"hybrid\" or \"kbuffer\"");
+}
+
 Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& path) {
   const auto meta = nlohmann::json::parse(data.metadata, nullptr, false);
   if (!meta.is_object()) return {};
-  const std::pair<const char*, const char*> expected[] = {{"features", kDkbFeatureSet},
-                                                          {"target", kDkbTargetScaling}};
+  const std::pair<const char*, const char*> expected[] = {
+      {"features", kDkbFeatureSet},
+      {"target", data.targetCount == 1 ? kDkbTargetScaling : kDkbCurveTargetScaling}};
   for (const auto& [key, value] : expected) {
     const auto it = meta.find(key);
     if (it == meta.end()) continue;

@@ -104,6 +104,17 @@ const std::vector<PresetRow>& presetRows() {
          m.compositing = Compositing::Hybrid;
          m.fillUnusedSlots = true;
        }},
+      {{"dkb-curve", "mfr: DHOIT's features + the optimal k-buffer's hull allocation",
+        "a network predicts each pixel's error-vs-k curve; k(p) by the oracle's hull allocator"},
+       [](MethodDesc& m) {
+         // beyond the paper (issue 14 sec. 4): the oracle's hull allocation over curves a network
+         // predicts from the deep k-buffer's features (mfr/method/dkb_curve.hpp)
+         m.allocation = AllocationPolicy::Optimal;
+         m.predictedCurves = true;
+         m.store = StoreChoice::PerPixel;
+         kPlusCore(m);
+         m.compositing = Compositing::Hybrid;
+       }},
       {{"optimal", "optimal k-buffer (DHOIT sec. 3.1.2; mfr's convex-hull allocator)",
         "exact A-buffer pre-pass, k(p) minimising the summed squared error under the budget"},
        [](MethodDesc& m) {

@@ -29,8 +29,9 @@ bool heuristicImportance(const MethodDesc& m) {
 }
 
 bool networkImportance(const MethodDesc& m) {
-  return m.allocation == AllocationPolicy::Importance &&
-         m.importanceSource == ImportanceSource::Network;
+  return (m.allocation == AllocationPolicy::Importance &&
+          m.importanceSource == ImportanceSource::Network) ||
+         m.predictedCurves;
 }
 
 bool occupancy(const MethodDesc& m) {
@@ -48,7 +49,8 @@ const std::vector<MethodOptionRule>& methodOptionRules() {
       {MethodOption::K, "--k", "fixed, counted and dynamic k (the dynamic k's upper bound)",
        takesK},
       {MethodOption::OccupancyD, "--occupancy-d", "methods with +occupancy", occupancy},
-      {MethodOption::Model, "--model", "the deep k-buffer", networkImportance},
+      {MethodOption::Model, "--model", "the deep k-buffer (dkb, dkb-fill, dkb-curve)",
+       networkImportance},
       {MethodOption::ImportanceMap, "--importance-map", "importance allocation (vkb, dkb)",
        importanceMethod},
       {MethodOption::ImportanceParams,

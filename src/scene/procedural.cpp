@@ -43,6 +43,12 @@ const std::vector<SceneDef>& sceneDefs() {
       {"smoke", {"count", "size", "alpha"}, &buildSmoke},
       {"bottles", {"count", "segments", "alpha"}, &buildBottles},
       {"spheres", {"count", "scale", "detail", "alpha"}, &buildSpheres},
+      {"glassware", {"count", "segments", "shells", "alpha", "spread"}, &buildGlassware},
+      {"foliage", {"plants", "leaves", "alpha", "spread"}, &buildFoliage},
+      {"particles", {"clouds", "count", "size", "alpha", "spread"}, &buildParticles},
+      {"hair", {"strands", "segments", "sides", "alpha", "spread"}, &buildHair},
+      {"panels", {"boxes", "panels", "alpha", "spread"}, &buildPanels},
+      {"city", {"rows", "columns", "alpha", "spread"}, &buildCity},
   };
   return defs;
 }
@@ -319,6 +325,32 @@ void appendUvSphere(MeshBuilder& mesh, const glm::vec3& center, float radius, in
     profile[static_cast<size_t>(i)] = {radius * s, radius * c, {s, c}};
   }
   appendLathe(mesh, profile, sectors, center, material);
+}
+
+void appendBox(MeshBuilder& mesh, const glm::vec3& lo, const glm::vec3& hi, uint32_t material) {
+  MFR_CHECK(hi.x > lo.x && hi.y > lo.y && hi.z > lo.z);
+  // per axis a: the face at lo[a] (normal -a) and at hi[a] (normal +a)
+  for (int axis = 0; axis < 3; ++axis) {
+    const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+    for (int side = 0; side < 2; ++side) {
+      glm::vec3 normal(0.0f);
+      normal[axis] = side == 0 ? -1.0f : 1.0f;
+      uint32_t corner[4];
+      for (int c = 0; c < 4; ++c) {
+        glm::vec3 p;
+        p[axis] = side == 0 ? lo[axis] : hi[axis];
+        p[u] = (c == 1 || c == 2) ? hi[u] : lo[u];
+        p[v] = (c >= 2) ? hi[v] : lo[v];
+        corner[c] = mesh.vertex(p, normal);
+      }
+      mesh.quad(corner[0], corner[1], corner[2], corner[3], material);
+    }
+  }
+}
+
+float jitteredAlpha(Rng& rng, float alpha, float spread) {
+  const float factor = rng.uniform(1.0f - spread, 1.0f + spread);
+  return std::clamp(alpha * factor, 0.02f, 1.0f);
 }
 
 }  // namespace procedural

@@ -215,6 +215,17 @@ inline double uvSphereTriangles(double rings, double sectors) {
 void appendUvSphere(MeshBuilder& mesh, const glm::vec3& center, float radius, int rings,
                     int sectors, uint32_t material);
 
+/// Triangles appendBox makes.
+inline constexpr double kBoxTriangles = 12.0;
+
+/// Closed axis-aligned box [lo, hi] (hi > lo on every axis): 6 faces of 4 own vertices with the
+/// face normal, 12 triangles, so a ray through its interior crosses it exactly twice.
+void appendBox(MeshBuilder& mesh, const glm::vec3& lo, const glm::vec3& hi, uint32_t material);
+
+/// A per-material alpha around the scene's `alpha`: alpha * [1 - spread, 1 + spread], clamped to
+/// [0.02, 1] (the corpus families' "per-material alphas"; spread 0 keeps the global alpha).
+float jitteredAlpha(Rng& rng, float alpha, float spread);
+
 // ---------------------------------------------------------------------------------------------
 // The scenes (the dispatcher has already rejected unknown keys and parsed the seed).
 
@@ -223,5 +234,12 @@ Result<Scene> buildHairball(ParamReader& params, uint64_t seed);
 Result<Scene> buildSmoke(ParamReader& params, uint64_t seed);
 Result<Scene> buildBottles(ParamReader& params, uint64_t seed);
 Result<Scene> buildSpheres(ParamReader& params, uint64_t seed);
+// The training corpus families (issue 14 sec. 2): one file each, procedural_<name>.cpp.
+Result<Scene> buildGlassware(ParamReader& params, uint64_t seed);
+Result<Scene> buildFoliage(ParamReader& params, uint64_t seed);
+Result<Scene> buildParticles(ParamReader& params, uint64_t seed);
+Result<Scene> buildHair(ParamReader& params, uint64_t seed);
+Result<Scene> buildPanels(ParamReader& params, uint64_t seed);
+Result<Scene> buildCity(ParamReader& params, uint64_t seed);
 
 }  // namespace mfr::procedural

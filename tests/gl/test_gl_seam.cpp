@@ -135,6 +135,9 @@ INSTANTIATE_TEST_SUITE_P(
         SeamCase{"procedural:hairball?strands=150", "vkb-fill", Compositing::KBuffer, 200u << 10},
         SeamCase{"procedural:bottles?count=4", "vkb", Compositing::Hybrid, 300u << 10},
         SeamCase{"procedural:layers", "optimal", Compositing::Hybrid, 400u << 10},
+        // dkb-curve: k(p) from the CPU passes (features, network, hull) on the view's CPU frame
+        SeamCase{"procedural:bottles?count=4", "dkb-curve", Compositing::Hybrid, 300u << 10},
+        SeamCase{"procedural:layers", "dkb-curve", Compositing::KBuffer, 300u << 10},
         SeamCase{"procedural:hairball?strands=150", "optimal-greedy", Compositing::Hybrid,
                  300u << 10},
         SeamCase{"procedural:layers", "wboit", Compositing::WeightedBlended, 400u << 10},
@@ -383,7 +386,8 @@ TEST(GlSeamErrors, MethodsNotInTheGlEngineAndBudgetsAreOneLine) {
   auto cpuView = cpu.prepare(view);
   ASSERT_TRUE(cpuView.ok());
   // budget errors of the variable-k methods: the shared allocate()'s, the CPU engine's words
-  for (const char* name : {"kplus-sb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "optimal"})
+  for (const char* name :
+       {"kplus-sb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "dkb-curve", "optimal"})
     for (std::optional<uint64_t> budget :
          {std::optional<uint64_t>(1000), std::optional<uint64_t>()}) {
       SCOPED_TRACE(name);

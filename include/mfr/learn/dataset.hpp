@@ -12,12 +12,14 @@
 //   0       8      magic "MFRDS\0\0\0"
 //   8       4      u32 version (kDatasetVersion)
 //   12      4      u32 feature count (12)
-//   16      4      u32 S, number of scenes (1..65536)
+//   16      4      u32 T, targets per sample: 1 (the importance t(p)) or 9 (dkb-curve's curve,
+//                  mfr/method/dkb_curve.hpp)
+//   20      4      u32 S, number of scenes (1..65536)
 //   ...            S x { u32 length (1..4096), UTF-8 name }
 //   ...     4      u32 metadata length m (<= 1 MiB), then m bytes of JSON (how it was generated)
 //   ...     8      u64 N, number of samples (<= 2^32)
-//   ...            N x 68-byte samples: u32 scene, u32 view, u32 budget step, u32 pixel,
-//                  f32 features[12] (dkb_features.hpp), f32 target t(p)
+//   ...            N x (64 + 4 T)-byte samples: u32 scene, u32 view, u32 budget step, u32 pixel,
+//                  f32 features[12] (dkb_features.hpp), f32 targets[T] (t(p), or the curve)
 //   end            (no trailing bytes)
 #pragma once
 
@@ -30,11 +32,13 @@
 
 #include "mfr/core/result.hpp"
 #include "mfr/cpu/raster_frame.hpp"
+#include "mfr/method/dkb_curve.hpp"
 #include "mfr/method/dkb_features.hpp"
+#include "mfr/method/method.hpp"
 
 namespace mfr::learn {
 
-inline constexpr uint32_t kDatasetVersion = 1;
+inline constexpr uint32_t kDatasetVersion = 2;
 
 /// The target definition (scaling) of sampleView: the one constant `mfr dataset` records in
 /// datasets, `mfr train` in models, and checkDkbModel compares ("target"). Change it whenever the
@@ -48,12 +52,14 @@ struct DatasetSample {
   uint32_t budgetStep = 0;  // 0 = one fragment per covered pixel ... steps - 1 = all fragments
   uint32_t pixel = 0;       // y * width + x
   PixelFeatures features{};
-  float target = 0.0f;
+  float target = 0.0f;   // the importance target t(p) (Dataset::targetCount 1)
+  CurveTargets curve{};  // dkb-curve's targets (Dataset::targetCount 9)
 };
 
 struct Dataset {
   std::vector<std::string> scenes;
-  std::string metadata;  // JSON
+  uint32_t targetCount = 1;  // 1: DatasetSample::target, kCurveOutputs: DatasetSample::curve
+  std::string metadata;      // JSON
   std::vector<DatasetSample> samples;
   uint64_t fileHash = 0;  // fnv1a64 of the file's bytes: set by readDataset, ignored when writing
 };
@@ -74,9 +80,14 @@ Result<void> writeDataset(const std::string& path, const Dataset& data);
 Result<Dataset> readDataset(const std::string& path);
 
 /// Checks that a dataset's metadata, where it declares a feature set ("features") or a target
-/// ("target"), declares kDkbFeatureSet and kDkbTargetScaling: a dataset written by an older
-/// `mfr dataset` is refused rather than trained on. `path` names it in the message.
+/// ("target"), declares kDkbFeatureSet and kDkbTargetScaling (kDkbCurveTargetScaling for curve
+/// datasets): a dataset written by an older `mfr dataset` is refused rather than trained on.
+/// `path` names it in the message.
 Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& path);
+
+/// The compositing rule a dataset's targets were computed for: its metadata's "composite"
+/// (absent: hybrid, the only rule before per-rule models). Errors name `path`.
+Result<Compositing> datasetRule(const Dataset& data, const std::string& path);
 
 /// F(M) of budget step s of `steps`: from one slot per covered pixel to every fragment, evenly.
 uint64_t budgetStepSlots(uint64_t coveredPixels, uint64_t fragments, int step, int steps);
@@ -86,6 +97,11 @@ struct ViewSamplingOptions {
   double sampleFraction = 0.2;  // of the covered pixels, per view and budget
   uint64_t seed = 1;
   glm::vec3 background{1.0f};
+  /// The compositing rule whose error curves define the optimal targets (kbuffer or hybrid):
+  /// one model per rule (issue 14 sec. 3); datasets record it as "composite".
+  Compositing compositing = Compositing::Hybrid;
+  /// dkb-curve's targets (the curve, DatasetSample::curve) instead of the importance target.
+  bool curveTargets = false;
   /// Memory pre-flight of the exact A-buffer and error curves (frameErrorCurves); none: default.
   std::optional<uint64_t> memoryLimitBytes;
 };

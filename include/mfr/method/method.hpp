@@ -84,6 +84,10 @@ struct MethodDesc {
   bool fillUnusedSlots = false;
   /// Optimal allocation: DHOIT's Algorithm 1 as published instead of the convex-hull allocator.
   bool publishedGreedy = false;
+  /// Optimal allocation over error curves a network predicts from the deep k-buffer's features
+  /// (dkb-curve, mfr/method/dkb_curve.hpp) instead of the exact A-buffer pre-pass's; `model`
+  /// then holds a curve model (null: the built-in one).
+  bool predictedCurves = false;
 };
 
 /// One row of the preset table (src/method/method.cpp): the name, the paper it follows and a
@@ -100,7 +104,8 @@ const std::vector<PresetInfo>& presetTable();
 std::string presetTableMarkdown();
 
 /// Preset names: zbuffer, abuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, vkb,
-/// vkb-fill, dkb, dkb-fill, optimal, optimal-greedy, each bounded one optionally followed by
+/// vkb-fill, dkb, dkb-fill, dkb-curve, optimal, optimal-greedy, each bounded one optionally
+/// followed by
 /// "+occupancy"; and the peer methods wboit, mboit, mlab (no +occupancy).
 std::vector<std::string> presetNames();
 

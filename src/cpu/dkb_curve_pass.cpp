@@ -1,0 +1,48 @@
+// dkb-curve's feature, inference and allocation passes (issue 14 sec. 4; features and network of
+// DHOIT sec. 3.1.3 / 3.2, allocation of DHOIT sec. 3.1.2's hull variant): see
+// mfr/cpu/dkb_curve_pass.hpp.
+#include "mfr/cpu/dkb_curve_pass.hpp"
+
+#include "mfr/cpu/deep_importance.hpp"
+#include "mfr/learn/model_file.hpp"
+#include "mfr/method/dkb_curve.hpp"
+#include "mfr/method/dkb_model.hpp"
+
+namespace mfr {
+
+Result<CurveChoice> predictedCurveK(const RasterFrame& frame, const MethodDesc& method,
+                                    uint64_t slots) {
+  auto model = dkbModelFor(method);
+  if (!model) return model.error();
+  // features of every pixel
+  const std::vector<FeatureAccumulator> pixels = accumulateFeatures(frame);
+  const ImageFeatureStats image = imageFeatureStats(pixels);
+  CurveChoice out;
+  out.n.resize(pixels.size());
+  std::vector<uint32_t> covered;
+  for (uint32_t p = 0; p < pixels.size(); ++p) {
+    out.n[p] = pixels[p].n;
+    if (pixels[p].n > 0) covered.push_back(p);
+  }
+  if (slots < covered.size()) return out;  // allocate() reports the budget
+  // the network over the covered pixels (rows of 12 features)
+  std::vector<float> rows(covered.size() * kDkbFeatureCount);
+  for (size_t i = 0; i < covered.size(); ++i) {
+    const PixelFeatures f = pixelFeatures(pixels[covered[i]], image, slots);
+    std::copy(f.begin(), f.end(), rows.begin() + static_cast<ptrdiff_t>(i * kDkbFeatureCount));
+  }
+  std::vector<float> predicted(covered.size() * kCurveOutputs);
+  learn::predictRows((*model)->net, rows.data(), covered.size(), predicted.data());
+  std::vector<float> predictions(pixels.size() * kCurveOutputs, 0.0f);
+  for (size_t i = 0; i < covered.size(); ++i)
+    std::copy_n(predicted.begin() + static_cast<ptrdiff_t>(i * kCurveOutputs), kCurveOutputs,
+                predictions.begin() + static_cast<ptrdiff_t>(covered[i]) * kCurveOutputs);
+  // the hull allocation over the rebuilt curves
+  out.k = allocateByPredictedCurves(predictions, out.n, slots);
+  out.bytesAllocated = pixels.size() * (sizeof(FeatureAccumulator) + 4 * kCurveOutputs) +
+                       (rows.size() + predicted.size()) * 4 + image.fragments * sizeof(double) +
+                       pixels.size() * sizeof(std::vector<double>);
+  return out;
+}
+
+}  // namespace mfr
