@@ -8,7 +8,11 @@
 #include <string>
 #include <vector>
 
+#include <random>
+
+#include "cpu/max_heap_replace.hpp"
 #include "mfr/core/isa.hpp"
+#include "mfr/cpu/fragment_stores.hpp"
 #include "mfr/method/stats_json.hpp"
 #include "mfr/scene/procedural.hpp"
 #include "tsan/capture_cases.hpp"
@@ -119,6 +123,31 @@ TEST(CaptureIsa, WidePathCapturesWhatTheScalarPathCaptures) {
       }
     }
   }
+}
+
+// The branchless root replacement leaves every slot as maxHeapInsert does, on heaps of every size
+// up to 12 with many equal keys (small key range).
+TEST(CaptureIsa, BranchlessRootReplacementIsMaxHeapInsert) {
+  std::mt19937_64 rng(12);
+  for (uint32_t n = 1; n <= 12; ++n)
+    for (int trial = 0; trial < 400; ++trial) {
+      std::vector<FragmentNode> heap(n);
+      uint32_t count = 0;
+      FragmentNode evicted = 0;
+      for (uint32_t i = 0; i < n; ++i)
+        maxHeapInsert(heap.data(), count, n, FragmentNode{rng() % 40}, evicted);
+      for (int step = 0; step < 20; ++step) {
+        const FragmentNode node = rng() % 40;
+        if (!(node < heap[0])) continue;  // its precondition (the k+ test passed)
+        std::vector<FragmentNode> expected = heap;
+        uint32_t expectedCount = n;
+        FragmentNode expectedEvicted = 0;
+        ASSERT_EQ(maxHeapInsert(expected.data(), expectedCount, n, node, expectedEvicted),
+                  InsertOutcome::Replaced);
+        EXPECT_EQ(detail::maxHeapReplaceRoot(heap.data(), n, node), expectedEvicted);
+        ASSERT_EQ(heap, expected) << "n " << n << " trial " << trial << " step " << step;
+      }
+    }
 }
 
 }  // namespace

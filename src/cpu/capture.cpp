@@ -22,6 +22,7 @@
 
 #include <algorithm>
 
+#include "max_heap_replace.hpp"
 #include "mfr/core/isa.hpp"
 #include "pipeline.hpp"
 #include "raster_span_avx2.hpp"
@@ -174,6 +175,25 @@ struct LaneCaptureSink {
     return true;
   }
   void emitLane(const Fragment& f, int32_t* cull) {
+    if constexpr (KPlus) {
+      // a full max-heap: the k+ test and the root replacement without branches on the data
+      // (max_heap_replace.hpp); everything else through the scalar sink
+      const uint32_t p = f.pixel;
+      const uint32_t n = inner.stores.counts[p];
+      if (inner.alloc.kind[p] == StoreKind::MaxHeap && n > 0 && n == inner.alloc.capacity[p]) {
+        FragmentNode* s = inner.slots(p);
+        const FragmentNode node = makeNode(f);
+        if (!(node < s[0])) {
+          ++inner.counters.culledKPlus;
+          return;
+        }
+        maxHeapReplaceRoot(s, n, node);
+        ++inner.counters.inserted;
+        ++inner.counters.evicted;
+        *cull = cullDepthOf(p);
+        return;
+      }
+    }
     inner.emit(f);
     if constexpr (KPlus) *cull = cullDepthOf(f.pixel);
   }
