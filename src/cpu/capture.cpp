@@ -22,7 +22,10 @@
 
 #include <algorithm>
 
+#include "max_heap_replace.hpp"
+#include "mfr/core/isa.hpp"
 #include "pipeline.hpp"
+#include "raster_span_avx2.hpp"
 
 namespace mfr::detail {
 namespace {
@@ -123,10 +126,125 @@ struct CaptureSink {
   }
 };
 
+#if MFR_HAS_AVX2_KERNELS
+/// The lane protocol of RasterFrame::rasterizeTileAvx2 over the tile-owned kbuffer sink: the
+/// tile's cull depths (raster_span_avx2.hpp), refreshed after every insertion; the insertion
+/// itself and its counters are the scalar sink's.
+template <bool Occupancy, bool KPlus>
+struct LaneCaptureSink {
+  using Inner = CaptureSink<false, Occupancy, KPlus, PlainAccess, NoLock>;
+  static constexpr bool kCullsInLanes = Occupancy;  // occupancy is tested before k+, per lane
+
+  Inner inner;
+  int width = 0;
+  TileRect tile{};
+  int stride = 0;
+  std::vector<int32_t> cullDepth;  // the tile's pixels, row stride = tile size
+
+  int32_t* cullDepthRow(int localY) { return cullDepth.data() + localY * stride; }
+
+  int32_t cullDepthOf(uint32_t p) {
+    if constexpr (!KPlus) return INT32_MAX;
+    return detail::cullDepthOf(inner.slots(p), inner.stores.counts[p], inner.alloc.capacity[p]);
+  }
+
+  void beginTile(const TileRect& r, int tileSize) {
+    tile = r;
+    stride = tileSize;
+    cullDepth.resize(static_cast<size_t>(tileSize) * tileSize);
+    for (int y = r.y0; y <= r.y1; ++y)
+      for (int x = r.x0; x <= r.x1; ++x)
+        cullDepthRow(y - r.y0)[x - r.x0] = cullDepthOf(static_cast<uint32_t>(y) * width + x);
+  }
+
+  // the lanes of an 8-pixel step: all passed the alpha test; `culled` failed the k+ test
+  void countEarly(uint32_t generated, uint32_t culled) {
+    inner.counters.generated += generated;
+    inner.counters.culledKPlus += culled;
+  }
+  bool acceptLane(uint32_t p, float depth, bool passesKPlus) {
+    ++inner.counters.generated;
+    if (Occupancy && inner.occupancy->culls(p, depth)) {
+      ++inner.counters.culledOccupancy;
+      return false;
+    }
+    if (!passesKPlus) {
+      ++inner.counters.culledKPlus;
+      return false;
+    }
+    return true;
+  }
+  void emitLane(const Fragment& f, int32_t* cull) {
+    if constexpr (KPlus) {
+      // a full max-heap: the k+ test and the root replacement without branches on the data
+      // (max_heap_replace.hpp); everything else through the scalar sink
+      const uint32_t p = f.pixel;
+      const uint32_t n = inner.stores.counts[p];
+      if (inner.alloc.kind[p] == StoreKind::MaxHeap && n > 0 && n == inner.alloc.capacity[p]) {
+        FragmentNode* s = inner.slots(p);
+        const FragmentNode node = makeNode(f);
+        if (!(node < s[0])) {
+          ++inner.counters.culledKPlus;
+          return;
+        }
+        maxHeapReplaceRoot(s, n, node);
+        ++inner.counters.inserted;
+        ++inner.counters.evicted;
+        *cull = cullDepthOf(p);
+        return;
+      }
+    }
+    inner.emit(f);
+    if constexpr (KPlus) *cull = cullDepthOf(f.pixel);
+  }
+
+  // the scalar protocol, for the triangles the lanes do not take (textured, alpha-masked)
+  bool accept(uint32_t p, float depth) { return inner.accept(p, depth); }
+  void emit(const Fragment& f) {
+    const int x = static_cast<int>(f.pixel % static_cast<uint32_t>(width));
+    const int y = static_cast<int>(f.pixel / static_cast<uint32_t>(width));
+    emitLane(f, cullDepthRow(y - tile.y0) + (x - tile.x0));
+  }
+};
+#endif
+
+/// The instruction set the capture of this method runs on: the 8-lane kernel serves tile-owned
+/// kbuffer compositing (hybrid shades every fragment, fragment-parallel has no tiles).
+Isa captureIsa(const MethodDesc& method, CaptureMode mode) {
+#if MFR_HAS_AVX2_KERNELS
+  if (mode == CaptureMode::TileOwned && method.compositing == Compositing::KBuffer &&
+      activeIsa() >= Isa::Avx2)
+    return Isa::Avx2;
+#endif
+  (void)method;
+  (void)mode;
+  return Isa::Scalar;
+}
+
 template <bool Hybrid, bool Occupancy, bool KPlus>
 CaptureCounters runCapture(const RasterFrame& frame, const Allocation& alloc,
-                           const OccupancyMap* occupancy, CaptureMode mode, Stores& stores) {
+                           const OccupancyMap* occupancy, CaptureMode mode, Isa isa,
+                           Stores& stores) {
   CaptureCounters total;
+#if MFR_HAS_AVX2_KERNELS
+  if constexpr (!Hybrid) {
+    if (isa == Isa::Avx2) {
+      ShadeInputs inputs;
+      frame.rasterizeTile<ShadeMode::Full>(0, inputs);
+      std::vector<CaptureCounters> perTile(static_cast<size_t>(frame.tileCount()));
+      frame.forEachTile([&](int tile) {
+        thread_local std::vector<int32_t> cullDepth;  // reused by the worker's tiles
+        LaneCaptureSink<Occupancy, KPlus> sink{
+            {alloc, occupancy, stores, {}}, frame.width(), {}, 0, std::move(cullDepth)};
+        rasterizeTileAvx2(frame, inputs, tile, sink);
+        perTile[tile] = sink.inner.counters;
+        cullDepth = std::move(sink.cullDepth);
+      });
+      for (const CaptureCounters& c : perTile) total.add(c);
+      return total;
+    }
+  }
+#endif
   if (mode == CaptureMode::TileOwned) {
     std::vector<CaptureCounters> perTile(static_cast<size_t>(frame.tileCount()));
     frame.forEachTile([&](int tile) {
@@ -162,6 +280,11 @@ CaptureCounters runCapture(const RasterFrame& frame, const Allocation& alloc,
 
 }  // namespace
 
+Isa captureIsaFor(const MethodDesc& method, CaptureMode mode) {
+  if (isPeerRule(method.compositing)) return Isa::Scalar;
+  return captureIsa(method, mode);
+}
+
 CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,
                         const Allocation& allocation, const OccupancyMap* occupancy,
                         CaptureMode mode, Stores& stores) {
@@ -170,19 +293,20 @@ CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,
   const bool hybrid = method.compositing == Compositing::Hybrid;
   const bool occ = occupancy != nullptr;
   const bool kplus = method.culling == CullingTest::KPlus;
+  const Isa isa = captureIsa(method, mode);
   // one instantiation per combination, so each inner loop carries only the tests it needs
   if (hybrid) {
     if (occ)
-      return kplus ? runCapture<true, true, true>(frame, allocation, occupancy, mode, stores)
-                   : runCapture<true, true, false>(frame, allocation, occupancy, mode, stores);
-    return kplus ? runCapture<true, false, true>(frame, allocation, occupancy, mode, stores)
-                 : runCapture<true, false, false>(frame, allocation, occupancy, mode, stores);
+      return kplus ? runCapture<true, true, true>(frame, allocation, occupancy, mode, isa, stores)
+                   : runCapture<true, true, false>(frame, allocation, occupancy, mode, isa, stores);
+    return kplus ? runCapture<true, false, true>(frame, allocation, occupancy, mode, isa, stores)
+                 : runCapture<true, false, false>(frame, allocation, occupancy, mode, isa, stores);
   }
   if (occ)
-    return kplus ? runCapture<false, true, true>(frame, allocation, occupancy, mode, stores)
-                 : runCapture<false, true, false>(frame, allocation, occupancy, mode, stores);
-  return kplus ? runCapture<false, false, true>(frame, allocation, occupancy, mode, stores)
-               : runCapture<false, false, false>(frame, allocation, occupancy, mode, stores);
+    return kplus ? runCapture<false, true, true>(frame, allocation, occupancy, mode, isa, stores)
+                 : runCapture<false, true, false>(frame, allocation, occupancy, mode, isa, stores);
+  return kplus ? runCapture<false, false, true>(frame, allocation, occupancy, mode, isa, stores)
+               : runCapture<false, false, false>(frame, allocation, occupancy, mode, isa, stores);
 }
 
 }  // namespace mfr::detail

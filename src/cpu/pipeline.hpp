@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "mfr/core/isa.hpp"
 #include "mfr/cpu/fragment_stores.hpp"
 #include "mfr/cpu/occupancy_map.hpp"
 #include "mfr/cpu/render.hpp"
@@ -85,6 +86,9 @@ struct Stores {
   std::vector<MboitPixel> mboit;  // per pixel
   std::vector<MlabNode> mlab;     // k(p) per pixel at offsets[p] (the node pool of mlab)
 };
+
+/// The instruction set capture() runs this method on (what the statistics report as "isa").
+Isa captureIsaFor(const MethodDesc& method, CaptureMode mode);
 
 /// The capture pass: every fragment through occupancy test, k+ test and store insertion.
 CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,

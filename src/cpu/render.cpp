@@ -20,6 +20,7 @@
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/optimal_allocation.hpp"
 #include "pipeline.hpp"
+#include "sort_nodes.hpp"
 
 namespace mfr {
 namespace {
@@ -88,17 +89,17 @@ ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method, const Alloc
   ImageRGB image(frame.width(), frame.height());
   const bool hybrid = method.compositing == Compositing::Hybrid;
   frame.forEachTile([&](int tile) {
-    std::vector<FragmentNode> local;
+    FragmentNode small[detail::kSortNetworkSize];
+    std::vector<FragmentNode> large;  // pixels above the network's size; grows once per tile
     const TileRect r = frame.tileRect(tile);
     for (int y = r.y0; y <= r.y1; ++y)
       for (int x = r.x0; x <= r.x1; ++x) {
         const size_t p = static_cast<size_t>(y) * frame.width() + x;
         const uint32_t n = stores.counts[p];
-        const FragmentNode* slots = stores.nodes.data() + alloc.offsets[p];
-        local.assign(slots, slots + n);
-        std::sort(local.begin(), local.end());
-        image.pixels[p] = hybrid ? compositeHybrid(local.data(), n, stores.tails[p], background)
-                                 : compositeKBuffer(local.data(), n, background);
+        const FragmentNode* sorted =
+            detail::sortNodes(stores.nodes.data() + alloc.offsets[p], n, small, large);
+        image.pixels[p] = hybrid ? compositeHybrid(sorted, n, stores.tails[p], background)
+                                 : compositeKBuffer(sorted, n, background);
       }
   });
   return image;
@@ -327,6 +328,8 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
     timer.run("moments", [&] { detail::accumulateMoments(frame, options.capture, stores); });
 
   // capture
+  // the capture's path, written as "isa" (stats_json.cpp)
+  stats.engineCounters["isa"] = static_cast<double>(detail::captureIsaFor(method, options.capture));
   const detail::CaptureCounters counters = timer.run("capture", [&] {
     return detail::capture(frame, method, alloc, method.occupancyWords > 0 ? &occupancy : nullptr,
                            options.capture, stores);

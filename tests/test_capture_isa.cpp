@@ -1,0 +1,154 @@
+// The capture pass on the wide (AVX2) path against the scalar path (mfr/core/isa.hpp): for several
+// scenes and presets, the same captured nodes in every slot, the same counters and the same image
+// bytes, and the statistics name the path taken. Skipped on a CPU without AVX2 (the scalar path is
+// then the only one; the ctest entry CaptureScalarPath runs the capture tests with MFR_ISA=scalar).
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <random>
+
+#include "cpu/max_heap_replace.hpp"
+#include "mfr/core/isa.hpp"
+#include "mfr/cpu/fragment_stores.hpp"
+#include "mfr/method/stats_json.hpp"
+#include "mfr/scene/procedural.hpp"
+#include "tsan/capture_cases.hpp"
+
+namespace mfr {
+namespace {
+
+/// Restores the process's path when a test ends.
+struct IsaGuard {
+  Isa saved = activeIsa();
+  ~IsaGuard() { setActiveIsa(saved); }
+};
+
+RenderOutput renderOn(Isa isa, const RasterFrame& frame, const MethodDesc& method,
+                      std::optional<uint64_t> budget) {
+  setActiveIsa(isa);
+  auto out = test::runMethod(frame, method, CaptureMode::TileOwned, budget);
+  EXPECT_TRUE(out.has_value()) << method.name;
+  return out ? std::move(*out) : RenderOutput{};
+}
+
+void expectSameCapture(const RasterFrame& frame, const MethodDesc& method,
+                       std::optional<uint64_t> budget, const std::string& what) {
+  const RenderOutput scalar = renderOn(Isa::Scalar, frame, method, budget);
+  const RenderOutput wide = renderOn(detectedIsa(), frame, method, budget);
+  // the path taken, as the statistics JSON names it
+  EXPECT_EQ(statsToJson(scalar.stats)["isa"], "scalar") << what;
+  const bool kbuffer = method.compositing == Compositing::KBuffer;
+  EXPECT_EQ(statsToJson(wide.stats)["isa"], kbuffer ? "avx2" : "scalar") << what;
+  EXPECT_FALSE(statsToJson(wide.stats)["engine_counters"].contains("isa")) << what;
+  ASSERT_GT(scalar.stats.fragmentsGenerated, 0u) << what << ": nothing rasterized";
+  // every slot, in store order (the same insertions in the same order leave the same heaps)
+  EXPECT_TRUE(scalar.nodes == wide.nodes) << what << ": captured nodes differ";
+  EXPECT_TRUE(scalar.counts == wide.counts) << what << ": per-pixel counts differ";
+  EXPECT_EQ(scalar.stats.fragmentsGenerated, wide.stats.fragmentsGenerated) << what;
+  EXPECT_EQ(scalar.stats.culledOccupancy, wide.stats.culledOccupancy) << what;
+  EXPECT_EQ(scalar.stats.culledKPlus, wide.stats.culledKPlus) << what;
+  EXPECT_EQ(scalar.stats.rejectedInStore, wide.stats.rejectedInStore) << what;
+  EXPECT_EQ(scalar.stats.inserted, wide.stats.inserted) << what;
+  EXPECT_EQ(scalar.stats.evicted, wide.stats.evicted) << what;
+  EXPECT_TRUE(scalar.image.pixels == wide.image.pixels) << what << ": images differ";
+}
+
+Scene proceduralScene(const std::string& spec) {
+  auto scene = makeProceduralScene(spec, 1);
+  EXPECT_TRUE(scene.ok()) << spec;
+  return scene.ok() ? std::move(scene.value()) : Scene{};
+}
+
+// An opaque, a blended, an alpha-masked and a textured material in one scene: the wide path takes
+// the first two and hands the others to the scalar loop on the same tile.
+Scene mixedMaterialScene(int size) {
+  std::vector<test::TestTriangle> tris;
+  for (int i = 0; i < 12; ++i) {
+    const double o = 3.0 * i;
+    const auto rect = test::screenRect(2 + o, 1 + 0.5 * o, size - 7 - 0.7 * o, size - 3 - o, size,
+                                       -0.05f * static_cast<float>(i % 5),
+                                       glm::vec4(0.1f * (i % 9), 0.9f - 0.05f * i, 0.5f, 0.35f));
+    tris.insert(tris.end(), rect.begin(), rect.end());
+  }
+  Scene s = test::makeScene(tris);
+  s.materials[2].alphaMode = AlphaMode::Opaque;
+  s.materials[5].alphaMode = AlphaMode::Mask;
+  s.materials[5].alphaCutoff = 0.3f;
+  Texture checker;
+  checker.width = checker.height = 2;
+  checker.rgba = {255, 0, 0, 255, 0, 255, 0, 40, 0, 0, 255, 200, 255, 255, 255, 90};
+  s.textures.push_back(checker);
+  s.materials[8].baseColorTexture = 0;
+  s.uvs.assign(s.positions.size(), glm::vec2(0.0f));
+  for (size_t v = 0; v < s.uvs.size(); ++v)
+    s.uvs[v] = glm::vec2(static_cast<float>(v % 3) * 0.7f, static_cast<float>(v % 2) * 1.3f);
+  return s;
+}
+
+TEST(CaptureIsa, WidePathCapturesWhatTheScalarPathCaptures) {
+  if (detectedIsa() == Isa::Scalar) GTEST_SKIP() << "no AVX2 on this CPU: only the scalar path";
+  const IsaGuard guard;
+  struct Case {
+    std::string name;
+    Scene scene;
+    int width, height;
+  };
+  std::vector<Case> cases;
+  cases.push_back({"layers", proceduralScene("layers?k=4&r=2&pd=0.55"), 97, 83});
+  cases.push_back({"hairball", proceduralScene("hairball?strands=250"), 80, 72});
+  cases.push_back({"mixed materials", mixedMaterialScene(70), 70, 70});
+  cases.push_back({"hot pixels", test::hotPixelScene(24, 400, 7), 24, 24});
+  for (const Case& c : cases) {
+    const Camera camera = c.scene.defaultCamera ? *c.scene.defaultCamera : test::screenCamera();
+    const auto frame = test::buildFrame(c.scene, camera, c.width, c.height, 2);
+    ASSERT_TRUE(frame) << c.name;
+    for (const std::string preset :
+         {"zbuffer", "fkb", "kplus-array", "kplus-heap", "kplus-heap+occupancy", "kplus-sb",
+          "kplus-dynamic", "abuffer"}) {
+      for (Compositing rule : {Compositing::KBuffer, Compositing::Hybrid}) {
+        if (preset == "abuffer" && rule == Compositing::Hybrid) continue;
+        // fixed k for the fixed-k presets, a budget (40 B per pixel) for the counted ones
+        const bool budgeted = preset == "kplus-sb" || preset == "kplus-dynamic";
+        const bool fixedK = !budgeted && preset != "abuffer" && preset != "zbuffer";
+        const MethodDesc method =
+            test::presetWithK(preset, fixedK ? std::optional<uint32_t>(3) : std::nullopt, rule);
+        const std::optional<uint64_t> budget =
+            budgeted ? std::optional<uint64_t>(static_cast<uint64_t>(c.width) * c.height * 40)
+                     : std::nullopt;
+        expectSameCapture(*frame, method, budget,
+                          c.name + " " + method.name + " " + toString(rule));
+      }
+    }
+  }
+}
+
+// The branchless root replacement leaves every slot as maxHeapInsert does, on heaps of every size
+// up to 12 with many equal keys (small key range).
+TEST(CaptureIsa, BranchlessRootReplacementIsMaxHeapInsert) {
+  std::mt19937_64 rng(12);
+  for (uint32_t n = 1; n <= 12; ++n)
+    for (int trial = 0; trial < 400; ++trial) {
+      std::vector<FragmentNode> heap(n);
+      uint32_t count = 0;
+      FragmentNode evicted = 0;
+      for (uint32_t i = 0; i < n; ++i)
+        maxHeapInsert(heap.data(), count, n, FragmentNode{rng() % 40}, evicted);
+      for (int step = 0; step < 20; ++step) {
+        const FragmentNode node = rng() % 40;
+        if (!(node < heap[0])) continue;  // its precondition (the k+ test passed)
+        std::vector<FragmentNode> expected = heap;
+        uint32_t expectedCount = n;
+        FragmentNode expectedEvicted = 0;
+        ASSERT_EQ(maxHeapInsert(expected.data(), expectedCount, n, node, expectedEvicted),
+                  InsertOutcome::Replaced);
+        EXPECT_EQ(detail::maxHeapReplaceRoot(heap.data(), n, node), expectedEvicted);
+        ASSERT_EQ(heap, expected) << "n " << n << " trial " << trial << " step " << step;
+      }
+    }
+}
+
+}  // namespace
+}  // namespace mfr
