@@ -68,7 +68,9 @@ inline glm::vec4 sampleTexture(const Texture& tex, glm::vec2 uv) {
   const float fy = uv.y * static_cast<float>(tex.height) - 0.5f;
   const float flx = std::floor(fx), fly = std::floor(fy);
   const float ax = fx - flx, ay = fy - fly;
-  auto wrap = [](long v, int n) { return static_cast<int>(((v % n) + n) % n); };
+  auto wrap = [](long v, int n) {  // the common case, uv in [0, 1), without a division
+    return v >= 0 && v < n ? static_cast<int>(v) : static_cast<int>(((v % n) + n) % n);
+  };
   // uvs far outside [0, 1] (any finite float a file holds) wrap exactly with fmod before the
   // conversion, which would overflow a long
   auto texelIndex = [](float f, int n) -> long {
@@ -77,8 +79,8 @@ inline glm::vec4 sampleTexture(const Texture& tex, glm::vec2 uv) {
   };
   const long ix = texelIndex(flx, tex.width);
   const long iy = texelIndex(fly, tex.height);
-  const int x0 = wrap(ix, tex.width), x1 = wrap(ix + 1, tex.width);
-  const int y0 = wrap(iy, tex.height), y1 = wrap(iy + 1, tex.height);
+  const int x0 = wrap(ix, tex.width), x1 = x0 + 1 == tex.width ? 0 : x0 + 1;
+  const int y0 = wrap(iy, tex.height), y1 = y0 + 1 == tex.height ? 0 : y0 + 1;
   auto texel = [&](int x, int y) {
     const uint8_t* p = &tex.rgba[(static_cast<size_t>(y) * tex.width + x) * 4];
     return glm::vec4(t.srgb8ToLinear[p[0]], t.srgb8ToLinear[p[1]], t.srgb8ToLinear[p[2]],
