@@ -8,6 +8,7 @@
 #include "common.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/learn/dataset.hpp"
+#include "mfr/method/budget_spec.hpp"
 
 namespace mfr::cli {
 namespace {
@@ -17,7 +18,9 @@ struct DatasetArgs {
   SceneOptions scene;
   std::string out;
   int budgetSteps = 5;
+  std::vector<std::string> budgets;  // relative shares ("25%"), instead of the steps
   double sample = 0.2;
+  const CLI::App* command = nullptr;
 };
 
 int runDataset(DatasetArgs& a) {
@@ -28,6 +31,16 @@ int runDataset(DatasetArgs& a) {
   learn::Dataset data;
   learn::ViewSamplingOptions sampling;
   sampling.budgetSteps = a.budgetSteps;
+  if (!a.budgets.empty() && a.command->count("--budget-steps") > 0)
+    return fail("--budget: give either --budget shares or --budget-steps, not both");
+  for (const std::string& text : a.budgets) {
+    auto spec = parseBudgetSpec(text);
+    if (!spec) return fail("--budget: " + spec.error().message);
+    if (!spec->isRelative())
+      return fail("--budget " + text +
+                  ": mfr dataset takes shares of each view's A-buffer node bytes, e.g. 25%");
+    sampling.budgetPercents.push_back(spec->percent);
+  }
   sampling.sampleFraction = a.sample;
   sampling.seed = a.scene.seed;
   Progress progress(!a.scene.quiet);
@@ -68,7 +81,8 @@ int runDataset(DatasetArgs& a) {
       {"width", a.scene.width},
       {"height", a.scene.height},
       {"orbit", a.scene.orbit},
-      {"budget_steps", a.budgetSteps},
+      {"budget_steps", a.budgets.empty() ? a.budgetSteps : static_cast<int>(a.budgets.size())},
+      {"budget_percents", sampling.budgetPercents},
       {"sample_fraction", a.sample},
       {"seed", a.scene.seed},
       {"scenes",
@@ -105,8 +119,13 @@ Runner addDatasetCommand(CLI::App& app) {
   cmd->add_option("--out,-o", args->out, "Output dataset (.mfrds)")->required();
   cmd->add_option("--budget-steps", args->budgetSteps,
                   "Budgets per view, from one fragment per covered pixel to all (default 5)");
+  cmd->add_option("--budget,-M", args->budgets,
+                  "Budgets as shares of each view's A-buffer node bytes, comma-separated (e.g. "
+                  "25%,50%,75%), instead of --budget-steps")
+      ->delimiter(',');
   cmd->add_option("--sample", args->sample,
                   "Fraction of covered pixels kept per view and budget (default 0.2)");
+  args->command = cmd;
   return [args] { return runDataset(*args); };
 }
 
