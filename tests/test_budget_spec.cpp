@@ -125,7 +125,9 @@ TEST(RelativeBudget, IsTheMethodsWordsPlusTheShareOfTheAbufferNodes) {
         ASSERT_TRUE(out.ok()) << out.error().message;
         EXPECT_LE(out->stats.bytesUsed, expected);
         EXPECT_LE(out->stats.captured, nodeBytes / 8);
-        if (percent == 100.0 && std::string(name) != "fkb") EXPECT_EQ(out->stats.lost, 0u);
+        if (percent == 100.0 && std::string(name) != "fkb") {
+          EXPECT_EQ(out->stats.lost, 0u);
+        }
       }
     }
 }
