@@ -125,7 +125,10 @@ TEST(RelativeBudget, IsTheMethodsWordsPlusTheShareOfTheAbufferNodes) {
         ASSERT_TRUE(out.ok()) << out.error().message;
         EXPECT_LE(out->stats.bytesUsed, expected);
         EXPECT_LE(out->stats.captured, nodeBytes / 8);
-        if (percent == 100.0 && std::string(name) != "fkb") {
+        // every fragment's node: the policies that can place them all keep them all (vkb's
+        // floor(P(p) F(M)) need not)
+        const std::string policy = name;
+        if (percent == 100.0 && (policy == "kplus-dynamic" || policy == "optimal")) {
           EXPECT_EQ(out->stats.lost, 0u);
         }
       }
@@ -176,7 +179,7 @@ TEST(RelativeBudget, CompareTakesMixedLists) {
   const Truth truth = truthOf(*view);
   CompareOptions o;
   o.methods = {"fkb", "kplus-dynamic", "vkb-fill"};
-  o.budgets = {BudgetSpec(400u << 10), BudgetSpec::relative(50.0), BudgetSpec::relative(10.0)};
+  o.budgets = {BudgetSpec(400u << 10), BudgetSpec::relative(50.0), BudgetSpec::relative(20.0)};
   o.scene = kScene;
   o.compositing = Compositing::KBuffer;
   auto r = runComparison(engine(), *view, o);
@@ -190,9 +193,9 @@ TEST(RelativeBudget, CompareTakesMixedLists) {
   EXPECT_EQ(r->budgets[1].runs[0].budgetBytes, documentedOverhead("fkb", false) + half);
   EXPECT_EQ(r->budgets[1].runs[1].budgetBytes, documentedOverhead("kplus-dynamic", false) + half);
   EXPECT_EQ(r->budgets[1].runs[1].imageFile, "kplus-dynamic_50pct.png");
-  // 10%: below one node per pixel for fkb (a recorded error), enough for the counted methods
-  ASSERT_LT(10.0, 100.0 * kPixels / truth.fragments);
-  ASSERT_GT(10.0, 100.0 * truth.covered / truth.fragments);
+  // 20%: below one node per pixel for fkb (a recorded error), enough for the counted methods
+  ASSERT_LT(20.0, 100.0 * kPixels / truth.fragments);
+  ASSERT_GT(20.0, 100.0 * truth.covered / truth.fragments);
   EXPECT_FALSE(r->budgets[2].runs[0].ok());
   EXPECT_NE(r->budgets[2].runs[0].error->find("at least"), std::string::npos);
   EXPECT_TRUE(r->budgets[2].runs[1].ok());

@@ -117,7 +117,7 @@ TEST(TemporalStability, ExactMethodsHaveNoExcessFlickerAlongAnOrbit) {
       scene.defaultCamera ? *scene.defaultCamera : frameBounds(sceneBounds(scene));
   CpuEngine engine(EngineOptions{2, 16});
   CompareOptions o;
-  o.methods = {"abuffer", "kplus-dynamic", "fkb"};
+  o.methods = {"abuffer", "kplus-dynamic", "vkb"};
   o.budgets = {BudgetSpec::relative(100.0)};
   o.compositing = Compositing::KBuffer;
   TemporalStability t;
@@ -129,8 +129,8 @@ TEST(TemporalStability, ExactMethodsHaveNoExcessFlickerAlongAnOrbit) {
     ASSERT_TRUE(view.ok());
     auto r = runComparison(engine, **view, o);
     ASSERT_TRUE(r.ok()) << r.error().message;
-    // room for every fragment: kplus-dynamic renders the ground truth; fkb (k from n_max-free
-    // F(M) / |P|) does not
+    // room for every fragment: kplus-dynamic renders the ground truth; vkb (floor(P(p) F(M)))
+    // does not
     ASSERT_TRUE(r->budgets[0].runs[1].ok());
     ASSERT_EQ(r->budgets[0].runs[1].stats.lost, 0u);
     ASSERT_EQ(r->budgets[0].runs[1].image.rgba, r->groundTruth.image.rgba);
@@ -149,12 +149,12 @@ TEST(TemporalStabilityCli, CompareOrbitWritesFramesMeasureAndPlots) {
   const fs::path dir = test::processTempDir("mfr_temporal") / "out";
   auto r = test::runCli(
       "compare 'procedural:hairball?strands=120' --width 64 --height 64 --quiet --orbit 3 "
-      "--orbit-step 5 --methods abuffer,fkb,vkb-fill --budget 60%,400KB --out " +
+      "--orbit-step 5 --methods abuffer,fkb,vkb-fill --budget 100%,60% --out " +
           dir.string(),
       dir.parent_path());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   for (const char* f : {"frame_000/results.json", "frame_002/report.html", "report.html",
-                        "temporal_60pct.png", "temporal_400KB.png"})
+                        "temporal_100pct.png", "temporal_60pct.png"})
     EXPECT_TRUE(fs::exists(dir / f)) << f;
   std::ifstream in(dir / "results.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -165,16 +165,18 @@ TEST(TemporalStabilityCli, CompareOrbitWritesFramesMeasureAndPlots) {
   ASSERT_EQ(t["series"].size(), 6u);
   EXPECT_EQ(t["series"][0]["method"], "abuffer");
   EXPECT_EQ(t["series"][0]["excess_flicker"], 0.0);
-  EXPECT_EQ(t["series"][4]["budget_label"], "400KB");
-  EXPECT_EQ(t["series"][1]["consecutive_flip"].size(), 2u);
+  EXPECT_EQ(t["series"][4]["budget_label"], "60%");
+  EXPECT_TRUE(t["series"][3]["excess_flicker"].is_null());  // the A-buffer needs 100%
+  EXPECT_EQ(t["series"][2]["consecutive_flip"].size(), 2u);
   // each frame's error is its own report's
   std::ifstream f1(dir / "frame_001" / "results.json");
   const nlohmann::json frame1 = nlohmann::json::parse(f1);
-  EXPECT_EQ(t["series"][1]["error_flip"][1], frame1["budgets"][0]["methods"][1]["flip_mean"]);
+  ASSERT_TRUE(frame1["budgets"][0]["methods"][2].contains("flip_mean"));
+  EXPECT_EQ(t["series"][2]["error_flip"][1], frame1["budgets"][0]["methods"][2]["flip_mean"]);
   std::ifstream html(dir / "report.html");
   const std::string page((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
   EXPECT_NE(page.find("excess flicker"), std::string::npos);
-  EXPECT_NE(page.find("temporal_60pct.png"), std::string::npos);
+  EXPECT_NE(page.find("temporal_100pct.png"), std::string::npos);
 
   auto one = test::runCli(
       "compare procedural:spheres --width 32 --height 32 --quiet --orbit 1 "
