@@ -5,6 +5,7 @@
 // that works (checked by rendering at it and just below it); compare accepts mixed lists.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +15,9 @@
 #include "cli_runner.hpp"
 #include "mfr/compare/compare.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
+#include "mfr/cpu/raster_frame.hpp"
+#include "mfr/cpu/render.hpp"
+#include "mfr/learn/dataset.hpp"
 #include "mfr/method/budget_spec.hpp"
 #include "mfr/scene/load.hpp"
 
@@ -209,6 +213,48 @@ TEST(RelativeBudget, CompareTakesMixedLists) {
   EXPECT_FALSE(runComparison(engine(), *view, o).ok());
 }
 
+// mfr dataset's shares: 100% is every fragment (the oracle's k(p) = n(p), so the target scaled
+// by the largest n(p) is n(p)); a share below one slot per covered pixel names the smallest one
+TEST(RelativeBudget, DatasetSharesReplaceTheSteps) {
+  const Scene scene = loadScene(kScene).value();
+  const Camera camera =
+      scene.defaultCamera ? *scene.defaultCamera : frameBounds(sceneBounds(scene));
+  RasterOptions ro;
+  ro.width = ro.height = kSize;
+  ro.threads = 2;
+  auto frame = RasterFrame::build(scene, camera, ro);
+  ASSERT_TRUE(frame.ok()) << frame.error().message;
+  const std::vector<uint32_t> n = countFragments(frame.value());
+  uint32_t maxN = 0;
+  uint64_t covered = 0, fragments = 0;
+  for (uint32_t c : n) {
+    maxN = std::max(maxN, c);
+    covered += c > 0;
+    fragments += c;
+  }
+  learn::ViewSamplingOptions o;
+  o.budgetPercents = {50.0, 100.0};
+  o.sampleFraction = 1.0;
+  auto samples = learn::sampleView(frame.value(), 0, 0, o);
+  ASSERT_TRUE(samples.ok()) << samples.error().message;
+  uint64_t atFull = 0;
+  for (const learn::DatasetSample& s : samples.value()) {
+    ASSERT_LT(s.budgetStep, 2u);
+    if (s.budgetStep != 1) continue;
+    ++atFull;
+    EXPECT_EQ(std::lround(s.target * static_cast<float>(maxN)), n[s.pixel]) << s.pixel;
+  }
+  EXPECT_EQ(atFull, covered);
+  o.budgetPercents = {5.0};
+  auto tooSmall = learn::sampleView(frame.value(), 0, 0, o);
+  ASSERT_FALSE(tooSmall.ok());
+  const double smallest = std::ceil(10000.0 * covered / fragments) / 100.0;
+  EXPECT_NE(tooSmall.error().message.find("budget 5%"), std::string::npos);
+  EXPECT_NE(tooSmall.error().message.find("at least " + BudgetSpec::relative(smallest).label),
+            std::string::npos)
+      << tooSmall.error().message;
+}
+
 // ---- command line ----------------------------------------------------------------------------
 
 TEST(RelativeBudgetCli, RenderRecordsTheLabelAndTheBytes) {
@@ -259,6 +305,12 @@ TEST(RelativeBudgetCli, CompareWritesMixedBudgets) {
   EXPECT_TRUE(fs::exists(dir / "kplus-dynamic_50pct.png"));
   EXPECT_GT(j["budgets"][2]["methods"][1]["budget_bytes"].get<uint64_t>(),
             j["budgets"][1]["methods"][1]["budget_bytes"].get<uint64_t>());
+  auto dataset = test::runCli(std::string("dataset '") + kScene +
+                                  "' --width 64 --height 64 --quiet --budget 20MB -o " +
+                                  (dir.parent_path() / "d.mfrds").string(),
+                              dir.parent_path());
+  EXPECT_EQ(dataset.exitCode, 1);
+  EXPECT_NE(dataset.err.find("shares"), std::string::npos) << dataset.err;
   auto twice = test::runCli(std::string("compare '") + kScene +
                                 "' --width 96 --height 96 --quiet --methods fkb --budget 25%,25% "
                                 "--out " +
