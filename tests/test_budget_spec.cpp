@@ -115,8 +115,8 @@ TEST(RelativeBudget, IsTheMethodsWordsPlusTheShareOfTheAbufferNodes) {
       for (double percent : {40.0, 75.0, 100.0}) {
         SCOPED_TRACE(std::string(name) + (hybrid ? " hybrid " : " kbuffer ") +
                      std::to_string(percent));
-        const uint64_t nodeBytes =
-            static_cast<uint64_t>(std::floor(percent / 100.0 * 8.0 * truth.fragments));
+        // whole percents: exact in integers
+        const uint64_t nodeBytes = static_cast<uint64_t>(percent) * 8 * truth.fragments / 100;
         const uint64_t expected = documentedOverhead(name, hybrid) + nodeBytes;
         auto bytes =
             resolveBudget(BudgetSpec::relative(percent), m, MemoryModel::of(m), counts, "96x96");
@@ -191,7 +191,7 @@ TEST(RelativeBudget, CompareTakesMixedLists) {
   ASSERT_EQ(r->budgets.size(), 3u);
   EXPECT_FALSE(r->budgets[0].percent);
   EXPECT_EQ(r->budgets[0].runs[0].budgetBytes, 400u << 10);
-  const uint64_t half = static_cast<uint64_t>(std::floor(0.5 * 8.0 * truth.fragments));
+  const uint64_t half = 8 * truth.fragments / 2;
   EXPECT_EQ(r->budgets[1].budgetBytes, half);
   EXPECT_EQ(r->budgets[1].label, "50%");
   EXPECT_EQ(r->budgets[1].runs[0].budgetBytes, documentedOverhead("fkb", false) + half);
@@ -271,8 +271,7 @@ TEST(RelativeBudgetCli, RenderRecordsTheLabelAndTheBytes) {
   const auto view = makeView();
   const Truth truth = truthOf(*view);
   EXPECT_EQ(stats["budget_bytes"].get<uint64_t>(),
-            documentedOverhead("kplus-dynamic", false) +
-                static_cast<uint64_t>(std::floor(0.3 * 8.0 * truth.fragments)));
+            documentedOverhead("kplus-dynamic", false) + 30 * 8 * truth.fragments / 100);
 
   auto bad = test::runCli(std::string("render '") + kScene + "' --method fkb --budget 2%" + size +
                               " -o " + (dir / "b.png").string(),

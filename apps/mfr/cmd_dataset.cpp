@@ -74,7 +74,7 @@ int runDataset(DatasetArgs& a) {
         {{"scene", source}, {"views", views}, {"samples", data.samples.size() - before}});
   }
   progress.clear();
-  data.metadata = nlohmann::json{
+  nlohmann::json metadata = nlohmann::json{
       {"generator", "mfr dataset"},
       {"features", kDkbFeatureSet},
       {"target", learn::kDkbTargetScaling},
@@ -82,11 +82,12 @@ int runDataset(DatasetArgs& a) {
       {"height", a.scene.height},
       {"orbit", a.scene.orbit},
       {"budget_steps", a.budgets.empty() ? a.budgetSteps : static_cast<int>(a.budgets.size())},
-      {"budget_percents", sampling.budgetPercents},
       {"sample_fraction", a.sample},
       {"seed", a.scene.seed},
-      {"scenes",
-       perScene}}.dump();
+      {"scenes", perScene}};
+  // shares only when given: a dataset made with --budget-steps keeps its bytes
+  if (!sampling.budgetPercents.empty()) metadata["budget_percents"] = sampling.budgetPercents;
+  data.metadata = metadata.dump();
   auto written = learn::writeDataset(a.out, data);
   if (!written) return fail(written.error().message);
   if (a.scene.json)

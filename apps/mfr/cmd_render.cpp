@@ -230,7 +230,7 @@ int run(const RenderArgs& a) {
     stats["view"] = v;
     stats["compositing"] = toString(method->compositing);
     stats["capture"] = a.capture;
-    if (budget) stats["budget_label"] = budget->label;
+    if (budget && budget->isRelative()) stats["budget_label"] = budget->label;
     allStats.push_back(stats);
     if (!a.scene.quiet && !a.scene.json) {
       const RenderStats& s = result->stats;

@@ -106,9 +106,10 @@ FrameCounts FrameCounts::of(const std::vector<uint32_t>& n) {
 }
 
 uint64_t relativeNodeBytes(double percent, const FrameCounts& counts) {
-  // exact for the shares people type: 8 N < 2^53 and percent has few digits
-  const long double bytes = static_cast<long double>(percent) / 100.0L *
-                            static_cast<long double>(kNodeBytes * counts.fragments);
+  // multiply first: a whole or half percent times 8 N is exact in long double, and so is its
+  // quotient by 100 when that is a whole number (no 59255.999 for 60% of 8 * 12345)
+  const long double bytes = static_cast<long double>(percent) *
+                            static_cast<long double>(kNodeBytes * counts.fragments) / 100.0L;
   return static_cast<uint64_t>(std::floor(bytes));
 }
 
