@@ -175,7 +175,7 @@ TEST(ProceduralParameters, UnknownParameterIsAnErrorListingTheKnownOnes) {
               {"procedural:layers: unknown parameter 'foo' (known: k, r, pd, alpha, seed)"});
   expectError("hairball?k=1", {"'k'", "strands, segments, sides, radius, alpha, seed"});
   expectError("smoke?strands=1", {"'strands'", "count, size, alpha, seed"});
-  expectError("bottles?detail=1", {"'detail'", "count, segments, alpha, seed"});
+  expectError("bottles?detail=1", {"'detail'", "count, segments, alpha, spacing, seed"});
   expectError("spheres?sides=1", {"'sides'", "count, scale, detail, alpha, seed"});
 }
 
@@ -397,6 +397,28 @@ TEST(ProceduralBottles, CountAndSegmentsDetermineTheTriangleCount) {
   EXPECT_EQ(build("bottles?count=2&segments=8").triangleCount(),
             2u * 8u * (6u + 4u * 7u + 2u * 3u));
   EXPECT_EQ(build("bottles?count=5").materials.size(), 10u);  // glass and liquid per vessel
+}
+
+TEST(ProceduralBottles, SpacingMovesEachVesselWithItsGridCell) {
+  // 2 x 2 grid: vessel i sits at column i % 2, row i / 2; spacing s scales the cell offsets
+  // (+-0.5 in x and z) and leaves the shapes, jitter and vertex order as they were
+  const Scene one = build("bottles?count=4&segments=8");
+  EXPECT_EQ(build("bottles?count=4&segments=8&spacing=1").positions, one.positions);
+  const float s = 0.6f;
+  const Scene close = build("bottles?count=4&segments=8&spacing=0.6");
+  ASSERT_EQ(close.indices, one.indices);
+  ASSERT_EQ(close.positions.size(), one.positions.size());
+  for (size_t t = 0; t < one.indices.size(); ++t) {
+    const uint32_t v = one.indices[t];
+    const uint32_t vessel = one.triangleMaterial[t / 3] / 2;  // glass, liquid per vessel
+    const glm::vec3 cell(static_cast<float>(vessel % 2) - 0.5f, 0.0f,
+                         0.5f - static_cast<float>(vessel / 2));
+    const glm::vec3 moved = close.positions[v] - one.positions[v];
+    ASSERT_NEAR(moved.x, (s - 1.0f) * cell.x, 1e-5f) << t;
+    ASSERT_NEAR(moved.y, 0.0f, 1e-6f) << t;
+    ASSERT_NEAR(moved.z, (s - 1.0f) * cell.z, 1e-5f) << t;
+  }
+  expectError("bottles?spacing=0", {"procedural:bottles", "'spacing'"});
 }
 
 // ------------------------------------------------------------------------------------------------

@@ -319,7 +319,7 @@ TEST_P(ReportPlots, EveryPlottedPointIsTheJsonValue) {
   const std::unique_ptr<PreparedView> view = makeView(engine);
   CompareOptions o;
   o.methods = sc.methods;
-  o.budgets = sc.budgets;
+  o.budgets.assign(sc.budgets.begin(), sc.budgets.end());
   o.scene = kScene;
   o.compositing = Compositing::KBuffer;  // explicit: independent of the presets' defaults
   auto r = runComparison(engine, *view, o);

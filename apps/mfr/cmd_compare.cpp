@@ -13,6 +13,9 @@
 #include "common.hpp"
 #include "mfr/compare/compare.hpp"
 #include "mfr/compare/compare_output.hpp"
+#include "mfr/compare/temporal.hpp"
+#include "mfr/core/atomic_file.hpp"
+#include "mfr/core/image.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/dkb_model.hpp"
 
@@ -30,6 +33,7 @@ struct CompareArgs {
   std::string composite;  // empty: each preset's own rule
   std::string capture = "tile";
   double pixelsPerDegree = kFlipDefaultPixelsPerDegree;
+  double orbitStep = 0.0;  // --orbit N without --orbit-view: degrees between frames (0: 360 / N)
 };
 
 std::vector<std::string> splitList(const std::string& text) {
@@ -105,9 +109,102 @@ void printSummary(const CompareResult& r) {
     }
 }
 
+// --orbit N (no --orbit-view): every frame's comparison in DIR/frame_NNN, and the temporal
+// stability of each method along the path (mfr/compare/temporal.hpp) in DIR/results.json,
+// DIR/report.html and one plot per budget.
+int runTemporal(const CompareArgs& a, CompareOptions options, const std::string& version,
+                Engine& engine, const PreparedScene& prepared, Progress& progress) {
+  const int frames = a.scene.orbit;
+  const float step =
+      a.orbitStep > 0.0 ? static_cast<float>(a.orbitStep) : 360.0f / static_cast<float>(frames);
+  const std::vector<Camera> path = orbitPath(prepared.cameras.front(), frames, step);
+  const fs::path dir(a.out);
+  std::string versionNumber = version;
+  if (versionNumber.rfind("mfr ", 0) == 0) versionNumber.erase(0, 4);
+  ReportInfo info;
+  info.mfrVersion = version.empty() ? "mfr" : version;
+  info.commandLine = commandLine();
+  info.generated = utcTimestamp();
+  TemporalStability temporal(a.pixelsPerDegree);
+  std::vector<std::string> folders;
+  std::vector<float> previousCosine;  // vkb's Fresnel term: the previous frame's nearest |n.v|
+  std::string engineName;
+  for (int f = 0; f < frames; ++f) {
+    auto view = engine.prepare(sceneView(prepared, a.scene, path[f]));
+    if (!view) return fail(a.scene.source + ": " + view.error().message);
+    options.previousNearestCosine = previousCosine;
+    options.progress = [&progress, f, frames](const std::string& stage, int done, int total) {
+      progress.set("frame " + std::to_string(f + 1) + "/" + std::to_string(frames) + ": " + stage,
+                   done, total);
+    };
+    auto result = runComparison(engine, **view, options);
+    if (!result) return fail(a.scene.source + ": " + result.error().message);
+    engineName = result->engine;
+    char folder[32];
+    std::snprintf(folder, sizeof folder, "frame_%03d", f);
+    folders.push_back(folder);
+    if (auto ready = prepareOutputFolder((dir / folder).string()); !ready)
+      return fail(ready.error().message);
+    auto written = writeComparison(result.value(), (dir / folder).string(), versionNumber, info);
+    if (!written) return fail(written.error().message);
+    if (auto added = temporal.add(result.value()); !added) return fail(added.error().message);
+    auto cosine = engine.nearestCosine(**view);
+    if (!cosine) return fail(a.scene.source + ": " + cosine.error().message);
+    previousCosine = std::move(cosine.value());
+  }
+  progress.set("writing " + a.out);
+  const TemporalResult t = temporal.result();
+  std::vector<std::string> plots;
+  for (const BudgetSpec& b : options.budgets) {
+    auto plot = temporalPlot(t, b.label);
+    if (!plot) continue;  // e.g. every method failed at this budget: nothing to draw
+    const std::string file = "temporal_" + b.fileLabel() + ".png";
+    if (auto w = writePng((dir / file).string(), plot.value()); !w) return fail(w.error().message);
+    plots.push_back(file);
+  }
+  nlohmann::json j;
+  j["mfr_version"] = versionNumber;
+  j["scene"] = a.scene.source;
+  j["engine"] = engineName;
+  j["width"] = a.scene.width;
+  j["height"] = a.scene.height;
+  j["orbit"] = frames;
+  j["orbit_step_degrees"] = step;
+  j["frames"] = folders;
+  j["plots"] = plots;
+  j["temporal"] = temporalToJson(t);
+  const std::string jsonText = j.dump(2) + "\n";
+  if (auto w = writeFileAtomically((dir / "results.json").string(), jsonText); !w)
+    return fail(w.error().message);
+  if (auto w =
+          writeFileAtomically((dir / "report.html").string(),
+                              temporalReportHtml(t, a.scene.source, a.scene.width, a.scene.height,
+                                                 plots, folders, info.commandLine));
+      !w)
+    return fail(w.error().message);
+  progress.clear();
+  if (!a.scene.quiet) {
+    std::fprintf(stderr, "%s, %d frames %.3g degrees apart; ground truth flicker %.4f\n",
+                 a.scene.source.c_str(), frames, step, t.groundTruthFlicker);
+    std::fprintf(stderr, "  %-20s %8s %9s %9s\n", "method", "budget", "flicker", "excess");
+    for (const TemporalSeries& s : t.series)
+      std::fprintf(stderr, "  %-20s %8s %9.4f %9.4f\n", s.method.c_str(), s.budgetLabel.c_str(),
+                   s.flicker, s.excessFlicker);
+    std::fprintf(stderr, "report: %s\n", (dir / "report.html").string().c_str());
+  }
+  if (a.scene.json) std::fputs(jsonText.c_str(), stdout);
+  return 0;
+}
+
 int run(const CompareArgs& a, const std::string& version) {
-  if (a.scene.orbit != 0 && a.scene.orbitView < 0)
-    return fail("--orbit: compare renders one view (add --orbit-view I, or use --camera / --view)");
+  const bool temporal = a.scene.orbit != 0 && a.scene.orbitView < 0;
+  if (temporal && a.scene.orbit < 2)
+    return fail("--orbit " + std::to_string(a.scene.orbit) +
+                ": a temporal comparison needs at least 2 frames (or add --orbit-view I)");
+  if (!(a.orbitStep >= 0.0 && a.orbitStep <= 360.0))
+    return fail("--orbit-step: must be in (0, 360] degrees");
+  if (a.orbitStep > 0.0 && !temporal)
+    return fail("--orbit-step: needs --orbit N (and no --orbit-view)");
   if (a.out.empty()) return fail("--out: an output folder is required");
   CompareOptions options;
   options.scene = a.scene.source;
@@ -141,13 +238,14 @@ int run(const CompareArgs& a, const std::string& version) {
   // budgets
   for (const std::string& text : splitList(a.budgets)) {
     if (text.empty()) return fail("--budget '" + a.budgets + "': empty budget in the list");
-    auto bytes = parseByteSize(text);
-    if (!bytes) return fail("--budget: " + bytes.error().message);
-    for (uint64_t seen : options.budgets)
-      if (seen == bytes.value()) return fail("--budget '" + text + "': listed twice");
-    options.budgets.push_back(bytes.value());
+    auto spec = parseBudgetSpec(text);
+    if (!spec) return fail("--budget: " + spec.error().message);
+    for (const BudgetSpec& seen : options.budgets)
+      if (seen == spec.value()) return fail("--budget '" + text + "': listed twice");
+    options.budgets.push_back(spec.value());
   }
-  if (options.budgets.empty()) return fail("--budget: no budget given (e.g. --budget 20MB,40MB)");
+  if (options.budgets.empty())
+    return fail("--budget: no budget given (e.g. --budget 20MB,40MB or 25%,50%)");
   if (!a.composite.empty()) {
     auto compositing = parseCompositing(a.composite);
     if (!compositing) return fail("--composite: " + compositing.error().message);
@@ -178,6 +276,7 @@ int run(const CompareArgs& a, const std::string& version) {
   options.background = prepared->scene.background;
   auto engine = makeSceneEngine(a.scene);
   if (!engine) return fail(engine.error().message);
+  if (temporal) return runTemporal(a, options, version, **engine, *prepared, progress);
   progress.set("setting up " + a.scene.source);
   auto view = (*engine)->prepare(sceneView(*prepared, a.scene, prepared->cameras.front()));
   if (!view) return fail(a.scene.source + ": " + view.error().message);
@@ -226,7 +325,9 @@ Runner addCompareCommand(CLI::App& app) {
       "(results.json, results.csv) and an HTML report");
   args->scene.add(*cmd, true, true);
   cmd->add_option("--budget,--budgets,-M", args->budgets,
-                  "Memory budgets, comma-separated, e.g. 20MB,40MB (MB = 2^20 bytes)")
+                  "Memory budgets, comma-separated, e.g. 20MB,40MB (MB = 2^20 bytes) or 25%,50% "
+                  "(each method's per-pixel words + that share of the exact A-buffer's node "
+                  "bytes); lists may mix both")
       ->required();
   cmd->add_option("--methods,-m", args->methods,
                   "Methods, comma-separated (default " + args->methods + "). " + presetHelp());
@@ -238,6 +339,9 @@ Runner addCompareCommand(CLI::App& app) {
   cmd->add_option("--model", args->model,
                   "Deep k-buffer model (.mfrnn, from mfr train; default: the built-in model)");
   cmd->add_option("--ppd", args->pixelsPerDegree, "FLIP pixels per degree (default 67.02)");
+  cmd->add_option("--orbit-step", args->orbitStep,
+                  "With --orbit N (temporal comparison): degrees between consecutive frames "
+                  "(default 360 / N)");
   const CLI::App* root = &app;
   return [args, root] { return run(*args, root->version()); };
 }

@@ -8,6 +8,7 @@
 #include "common.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/learn/dataset.hpp"
+#include "mfr/method/budget_spec.hpp"
 
 namespace mfr::cli {
 namespace {
@@ -17,9 +18,11 @@ struct DatasetArgs {
   SceneOptions scene;
   std::string out;
   int budgetSteps = 5;
+  std::vector<std::string> budgets;  // relative shares ("25%"), instead of the steps
   double sample = 0.2;
   std::string composite = "hybrid";
   std::string curveOut;  // also dkb-curve's dataset of the same samples
+  const CLI::App* command = nullptr;
 };
 
 int runDataset(DatasetArgs& a) {
@@ -30,6 +33,16 @@ int runDataset(DatasetArgs& a) {
   learn::Dataset data;
   learn::ViewSamplingOptions sampling;
   sampling.budgetSteps = a.budgetSteps;
+  if (!a.budgets.empty() && a.command->count("--budget-steps") > 0)
+    return fail("--budget: give either --budget shares or --budget-steps, not both");
+  for (const std::string& text : a.budgets) {
+    auto spec = parseBudgetSpec(text);
+    if (!spec) return fail("--budget: " + spec.error().message);
+    if (!spec->isRelative())
+      return fail("--budget " + text +
+                  ": mfr dataset takes shares of each view's A-buffer node bytes, e.g. 25%");
+    sampling.budgetPercents.push_back(spec->percent);
+  }
   sampling.sampleFraction = a.sample;
   sampling.seed = a.scene.seed;
   auto rule = parseCompositing(a.composite);
@@ -68,7 +81,7 @@ int runDataset(DatasetArgs& a) {
         {{"scene", source}, {"views", views}, {"samples", data.samples.size() - before}});
   }
   progress.clear();
-  data.metadata = nlohmann::json{
+  nlohmann::json metadata = nlohmann::json{
       {"generator", "mfr dataset"},
       {"features", kDkbFeatureSet},
       {"target", learn::kDkbTargetScaling},
@@ -76,11 +89,13 @@ int runDataset(DatasetArgs& a) {
       {"width", a.scene.width},
       {"height", a.scene.height},
       {"orbit", a.scene.orbit},
-      {"budget_steps", a.budgetSteps},
+      {"budget_steps", a.budgets.empty() ? a.budgetSteps : static_cast<int>(a.budgets.size())},
       {"sample_fraction", a.sample},
       {"seed", a.scene.seed},
-      {"scenes",
-       perScene}}.dump();
+      {"scenes", perScene}};
+  // shares only when given: a dataset made with --budget-steps keeps its bytes
+  if (!sampling.budgetPercents.empty()) metadata["budget_percents"] = sampling.budgetPercents;
+  data.metadata = metadata.dump();
   auto written = learn::writeDataset(a.out, data);
   if (!written) return fail(written.error().message);
   if (!a.curveOut.empty()) {  // the same samples with dkb-curve's targets
@@ -121,6 +136,10 @@ Runner addDatasetCommand(CLI::App& app) {
   cmd->add_option("--out,-o", args->out, "Output dataset (.mfrds)")->required();
   cmd->add_option("--budget-steps", args->budgetSteps,
                   "Budgets per view, from one fragment per covered pixel to all (default 5)");
+  cmd->add_option("--budget,-M", args->budgets,
+                  "Budgets as shares of each view's A-buffer node bytes, comma-separated (e.g. "
+                  "25%,50%,75%), instead of --budget-steps")
+      ->delimiter(',');
   cmd->add_option("--sample", args->sample,
                   "Fraction of covered pixels kept per view and budget (default 0.2)");
   cmd->add_option("--composite", args->composite,
@@ -129,6 +148,7 @@ Runner addDatasetCommand(CLI::App& app) {
   cmd->add_option("--curve-out", args->curveOut,
                   "Also write dkb-curve's dataset: the same samples with each pixel's error curve "
                   "(8 drops and a tail) as targets");
+  args->command = cmd;
   return [args] { return runDataset(*args); };
 }
 

@@ -13,6 +13,8 @@
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/dkb_model.hpp"
+#include "mfr/method/budget_spec.hpp"
+#include "mfr/method/memory_model.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/method/stats_json.hpp"
 
@@ -131,10 +133,12 @@ int run(const RenderArgs& a) {
   auto method = buildMethod(a);
   if (!method) return fail(method.error().message);
   RenderOptions options;
+  std::optional<BudgetSpec> budget;  // a relative one is resolved per view (its count pass)
   if (!a.budget.empty()) {
-    auto budget = parseByteSize(a.budget);
-    if (!budget) return fail(budget.error().message);
-    options.budgetBytes = budget.value();
+    auto parsed = parseBudgetSpec(a.budget);
+    if (!parsed) return fail("--budget: " + parsed.error().message);
+    budget = parsed.value();
+    options.budgetBytes = budget->bytes;
   }
   if (a.capture == "parallel")
     options.capture = CaptureMode::FragmentParallel;
@@ -169,6 +173,16 @@ int run(const RenderArgs& a) {
     auto view = (*engine)->prepare(sceneView(*prepared, a.scene, prepared->cameras[v]));
     if (!view) return fail(a.scene.source + ": " + view.error().message);
     options.previousNearestCosine = previousCosine.empty() ? nullptr : &previousCosine;
+    if (budget && budget->isRelative()) {
+      auto counted = (*engine)->countFragments(**view);
+      if (!counted) return fail(a.scene.source + ": " + counted.error().message);
+      auto bytes = resolveBudget(
+          *budget, method.value(),
+          MemoryModel::of(method.value(), options.capture == CaptureMode::FragmentParallel),
+          FrameCounts::of(counted.value()), std::to_string(width) + "x" + std::to_string(height));
+      if (!bytes) return fail(a.scene.source + ": " + bytes.error().message);
+      options.budgetBytes = bytes.value();
+    }
     auto result = (*engine)->render(**view, method.value(), options);
     if (!result) return fail(a.scene.source + ": " + result.error().message);
     previousCosine = result->nearestCosine;
@@ -219,6 +233,7 @@ int run(const RenderArgs& a) {
     stats["view"] = v;
     stats["compositing"] = toString(method->compositing);
     stats["capture"] = a.capture;
+    if (budget && budget->isRelative()) stats["budget_label"] = budget->label;
     allStats.push_back(stats);
     if (!a.scene.quiet && !a.scene.json) {
       const RenderStats& s = result->stats;
@@ -253,7 +268,10 @@ Runner addRenderCommand(CLI::App& app) {
   cmd->add_option("--k-map", args->kMap, "Write the per-pixel k as a colour-mapped PNG");
   cmd->add_option("--stats-json", args->statsJson, "Write the run's statistics as JSON");
   cmd->add_option("--method,-m", args->method, presetHelp());
-  cmd->add_option("--budget,-M", args->budget, "Memory budget, e.g. 20MB (MB = 2^20 bytes)");
+  cmd->add_option(
+      "--budget,-M", args->budget,
+      "Memory budget, e.g. 20MB (MB = 2^20 bytes), or 30% (the method's per-pixel words + "
+      "30% of the exact A-buffer's node bytes for the frame)");
   cmd->add_option("--k", args->k,
                   "Explicit k (otherwise derived from the budget)" + appliesTo(MethodOption::K));
   cmd->add_option("--composite", args->composite,

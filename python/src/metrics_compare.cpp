@@ -100,10 +100,13 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     options.model = modelArgument(model);
   }
   for (const py::object& budget : budgets) {
-    const uint64_t bytes = budgetArgument(budget);
-    for (uint64_t seen : options.budgets)
-      if (seen == bytes) throw LibraryError("budgets: " + budgetLabel(bytes) + " listed twice");
-    options.budgets.push_back(bytes);
+    // a size ("20MB", bytes) or a share of the A-buffer's node bytes ("25%")
+    const BudgetSpec spec = py::isinstance<py::str>(budget)
+                                ? unwrap(parseBudgetSpec(budget.cast<std::string>()))
+                                : BudgetSpec(budgetArgument(budget));
+    for (const BudgetSpec& seen : options.budgets)
+      if (seen == spec) throw LibraryError("budgets: " + spec.label + " listed twice");
+    options.budgets.push_back(spec);
   }
   if (options.budgets.empty())
     throw LibraryError("budgets: no budget given (e.g. budgets=[\"20MB\", \"40MB\"])");

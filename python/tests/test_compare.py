@@ -95,3 +95,27 @@ def test_default_methods_are_the_clis(run_cli):
                         help_text)
     assert default, help_text
     assert tuple(default.group(1).split(",")) == mfr.DEFAULT_COMPARE_METHODS
+
+
+def test_relative_budgets_match_the_cli(tmp_path, cli):
+    # a mixed list: the share's bytes are each method's own words + the share of the A-buffer's
+    # node bytes, resolved the same way by the module and the command line
+    import subprocess
+    budgets = ["40KB", "60%"]
+    subprocess.run([cli, "compare", SCENE, "--width", str(SIZE), "--height", str(SIZE),
+                    "--budget", ",".join(budgets), "--methods", "vkb,kplus-dynamic",
+                    "--threads", "2", "--out", str(tmp_path / "cli"), "--quiet"], check=True)
+    py = mfr.compare(SCENE, tmp_path / "py", budgets, methods=["vkb", "kplus-dynamic"],
+                     width=SIZE, height=SIZE, threads=2)
+    cli_json = read_json(tmp_path / "cli" / "results.json")
+    assert without_times(cli_json) == without_times(py)
+    share = py["budgets"][1]
+    assert share["budget_label"] == "60%" and share["budget_percent"] == 60.0
+    fragments = py["ground_truth"]["fragments_generated"]
+    assert share["budget_bytes"] == 60 * 8 * fragments // 100
+    # vkb pays one byte per pixel more than kplus-dynamic (the previous frame's |n.v|), which
+    # pays its 4 KiB histogram
+    vkb, dynamic = share["methods"]
+    assert vkb["budget_bytes"] - dynamic["budget_bytes"] == SIZE * SIZE * 1 - 4096
+    with pytest.raises(Exception, match="0%"):
+        mfr.compare(SCENE, tmp_path / "bad", ["0%"], methods=["vkb"], width=SIZE, height=SIZE)

@@ -103,21 +103,6 @@ double CompareRun::memoryUtilisation() const {
   return slots ? static_cast<double>(stats.captured) / static_cast<double>(slots) : 0.0;
 }
 
-std::string budgetLabel(uint64_t bytes) {
-  std::string s;
-  if (bytes > 0 && bytes % (1ull << 20) == 0) {
-    s = std::to_string(bytes >> 20);
-    s += "MB";
-  } else if (bytes > 0 && bytes % (1ull << 10) == 0) {
-    s = std::to_string(bytes >> 10);
-    s += "KB";
-  } else {
-    s = std::to_string(bytes);
-    s += "B";
-  }
-  return s;
-}
-
 Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
                                     const CompareOptions& options) {
   if (options.methods.empty()) return makeError("--methods: the method list is empty");
@@ -137,11 +122,15 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
     m.model = options.model;
     methods.push_back(m);
   }
-  std::set<uint64_t> seenBudgets;
-  for (uint64_t b : options.budgets) {
-    if (b == 0) return makeError("budget 0 B: must be at least 1 byte");
-    if (!seenBudgets.insert(b).second)
-      return makeError("budget " + budgetLabel(b) + ": listed twice");
+  bool anyRelative = false;
+  for (size_t i = 0; i < options.budgets.size(); ++i) {
+    const BudgetSpec& b = options.budgets[i];
+    if (b.bytes && *b.bytes == 0) return makeError("budget 0 B: must be at least 1 byte");
+    if (!b.bytes && !(b.percent > 0.0 && std::isfinite(b.percent)))
+      return makeError("budget " + b.label + ": a share must be above 0%");
+    for (size_t j = 0; j < i; ++j)
+      if (options.budgets[j] == b) return makeError("budget " + b.label + ": listed twice");
+    anyRelative = anyRelative || b.isRelative();
   }
   if (!(options.flipPixelsPerDegree > 0.0 && std::isfinite(options.flipPixelsPerDegree)))
     return makeError("FLIP pixels per degree: must be finite and positive");
@@ -188,23 +177,41 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
                 h, std::max(1.0f, maxOf(truth->depthComplexity)), "n(p)");
   result.depthComplexityFile = "ground_truth_depth_complexity.png";
   truth = Error{};  // release the frame-sized buffers
+  // relative budgets: the A-buffer's node bytes of this frame (a count pass)
+  FrameCounts counts;
+  counts.pixels = pixels;
+  if (anyRelative) {
+    auto n = engine.countFragments(view);
+    if (!n) return makeError("count pass: " + n.error().message);
+    counts = FrameCounts::of(n.value());
+  }
+  const std::string sizeName = std::to_string(w) + "x" + std::to_string(h);
 
   std::vector<std::vector<uint32_t>> kMaps;  // per run, colour-mapped at the end (shared scale)
   float kScale = 1.0f;
-  for (uint64_t budget : options.budgets) {
+  for (const BudgetSpec& spec : options.budgets) {
     CompareBudget& cb = result.budgets.emplace_back();
-    cb.budgetBytes = budget;
-    cb.label = budgetLabel(budget);
+    cb.budgetBytes = spec.bytes ? *spec.bytes : relativeNodeBytes(spec.percent, counts);
+    if (spec.isRelative()) cb.percent = spec.percent;
+    cb.label = spec.label;
     for (const MethodDesc& method : methods) {
       CompareRun& run = cb.runs.emplace_back();
       run.method = method.name;
       run.compositing = method.compositing;
-      run.budgetBytes = budget;
-      run.budgetSlots = MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel)
-                            .fragmentSlots(budget, pixels);
+      const MemoryModel memory =
+          MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
+      auto budget = resolveBudget(spec, method, memory, counts, sizeName);
+      if (!budget) {
+        run.error = budget.error().message;
+        kMaps.emplace_back();
+        ++step;
+        continue;
+      }
+      run.budgetBytes = budget.value();
+      run.budgetSlots = memory.fragmentSlots(budget.value(), pixels);
       progress("rendering " + method.name + " at " + cb.label);
       RenderOptions ro = renderOptions;
-      ro.budgetBytes = budget;
+      ro.budgetBytes = budget.value();
       auto out = engine.render(view, method, ro);
       if (!out) {
         run.error = out.error().message;
@@ -225,7 +232,7 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
       run.metrics.psnrSrgb = errors->psnrSrgb;
       run.metrics.flipMean = flip->mean;
       run.flipMap = flipErrorImage(*flip);
-      const std::string stem = fileStem(method.name) + "_" + cb.label;
+      const std::string stem = fileStem(method.name) + "_" + spec.fileLabel();
       run.imageFile = stem + ".png";
       run.flipFile = stem + "_flip.png";
       run.kMapFile = stem + "_kmap.png";
@@ -271,8 +278,11 @@ nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersi
   for (const CompareBudget& cb : r.budgets) {
     nlohmann::json runs = nlohmann::json::array();
     for (const CompareRun& run : cb.runs) runs.push_back(runToJson(run));
-    budgets.push_back(
-        {{"budget_bytes", cb.budgetBytes}, {"budget_label", cb.label}, {"methods", runs}});
+    nlohmann::json entry = {
+        {"budget_bytes", cb.budgetBytes}, {"budget_label", cb.label}, {"methods", runs}};
+    // relative: budget_bytes is the share's node bytes; each run's budget_bytes is its own M
+    entry["budget_percent"] = cb.percent ? nlohmann::json(*cb.percent) : nlohmann::json(nullptr);
+    budgets.push_back(entry);
   }
   j["methods"] = budgets.empty() ? nlohmann::json::array() : budgets[0]["methods"];
   j["budgets"] = budgets;

@@ -98,6 +98,13 @@ std::string budgetTitle(uint64_t bytes) {
   return s;
 }
 
+// a relative budget: its share, the node bytes it buys, and that each method adds its own words
+std::string budgetTitle(const CompareBudget& cb) {
+  if (!cb.percent) return budgetTitle(cb.budgetBytes);
+  return escape(cb.label) + " of the A-buffer&rsquo;s node bytes = " + budgetTitle(cb.budgetBytes) +
+         " of nodes + each method&rsquo;s per-pixel words";
+}
+
 // ---- SVG line plots --------------------------------------------------------------------------
 
 struct Series {
@@ -551,7 +558,7 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
   std::string budgetsText;
   for (const CompareBudget& cb : r.budgets) {
     if (!budgetsText.empty()) budgetsText += ", ";
-    budgetsText += escape(formatBytes(cb.budgetBytes));
+    budgetsText += cb.percent ? escape(cb.label) : escape(formatBytes(cb.budgetBytes));
   }
   std::string methodsText;
   for (const std::string& m : methodNames) {
@@ -585,7 +592,7 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
   h += "<tr><th>Memory budgets M</th><td>";
   for (size_t i = 0; i < r.budgets.size(); ++i) {
     if (i) h += "; ";
-    h += budgetTitle(r.budgets[i].budgetBytes);
+    h += budgetTitle(r.budgets[i]);
   }
   h += " &mdash; binary units, 1&#8201;MiB = 2<sup>20</sup>&#8201;B</td></tr>\n";
   h += "<tr><th>Methods</th><td>" + methodsText + "</td></tr>\n";
@@ -636,7 +643,7 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
        "and per-image (S<sub>i</sub>) overhead; utilisation is captured fragments / F(M). Times "
        "are wall-clock milliseconds of the CPU engine.</p>\n";
   for (const CompareBudget& cb : r.budgets) {
-    h += "<h3>M = " + budgetTitle(cb.budgetBytes) + "</h3>\n";
+    h += "<h3>M = " + budgetTitle(cb) + "</h3>\n";
     h += resultsTable(r, cb) + "\n";
   }
 
@@ -743,7 +750,7 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
   h += ", and for the variable k-buffer its importance map I(p). Click an image for full "
        "size.</p>\n";
   for (const CompareBudget& cb : r.budgets) {
-    h += "<h3>M = " + budgetTitle(cb.budgetBytes) + "</h3>\n";
+    h += "<h3>M = " + budgetTitle(cb) + "</h3>\n";
     h += imageGrid(r, cb) + "\n";
   }
 

@@ -16,6 +16,7 @@
 #include "mfr/core/quote.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/optimal_oracle.hpp"
+#include "mfr/method/budget_spec.hpp"
 #include "mfr/method/optimal_allocation.hpp"
 
 namespace mfr::learn {
@@ -108,9 +109,29 @@ Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t
   const ImageFeatureStats image = imageFeatureStats(pixels);
   std::vector<DatasetSample> samples;
   if (image.coveredPixels == 0) return samples;
-  for (int step = 0; step < options.budgetSteps; ++step) {
-    const uint64_t slots =
-        budgetStepSlots(image.coveredPixels, image.fragments, step, options.budgetSteps);
+  const bool relative = !options.budgetPercents.empty();
+  MethodDesc oracleMethod;  // what a share must serve: one node per covered pixel
+  oracleMethod.allocation = AllocationPolicy::Optimal;
+  const int steps =
+      relative ? static_cast<int>(options.budgetPercents.size()) : options.budgetSteps;
+  FrameCounts counts;
+  counts.pixels = pixels.size();
+  counts.coveredPixels = image.coveredPixels;
+  counts.fragments = image.fragments;
+  for (int step = 0; step < steps; ++step) {
+    uint64_t slots = budgetStepSlots(image.coveredPixels, image.fragments, step, steps);
+    if (relative) {
+      const BudgetSpec share = BudgetSpec::relative(options.budgetPercents[step]);
+      slots = relativeNodeBytes(share.percent, counts) / kNodeBytes;
+      if (slots < image.coveredPixels)
+        return makeError(
+            "budget " + share.label +
+            ": too small for one node per covered pixel (needs at least " +
+            BudgetSpec::relative(smallestWorkingPercent(oracleMethod, MemoryModel{}, counts))
+                .label +
+            " of the A-buffer's " + std::to_string(image.fragments) + " nodes)");
+      slots = std::min(slots, image.fragments);
+    }
     const std::vector<uint32_t> k = allocateOptimalHull(oracle->curves, slots);
     const uint32_t kMax = *std::max_element(k.begin(), k.end());
     for (uint32_t p = 0; p < pixels.size(); ++p) {

@@ -41,7 +41,7 @@ const std::vector<SceneDef>& sceneDefs() {
       {"layers", {"k", "r", "pd", "alpha"}, &buildLayers},
       {"hairball", {"strands", "segments", "sides", "radius", "alpha"}, &buildHairball},
       {"smoke", {"count", "size", "alpha"}, &buildSmoke},
-      {"bottles", {"count", "segments", "alpha"}, &buildBottles},
+      {"bottles", {"count", "segments", "alpha", "spacing"}, &buildBottles},
       {"spheres", {"count", "scale", "detail", "alpha"}, &buildSpheres},
       {"glassware", {"count", "segments", "shells", "alpha", "spread"}, &buildGlassware},
       {"foliage", {"plants", "leaves", "alpha", "spread"}, &buildFoliage},

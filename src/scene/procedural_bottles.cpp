@@ -4,7 +4,8 @@
 // volume, so a ray through a filled vessel crosses 6 surfaces, and vessels standing behind one
 // another in a grid add up.
 //
-// `count` vessels on a grid of ceil(sqrt(count)) columns (spacing 1, small random jitter), each of
+// `count` vessels on a grid of ceil(sqrt(count)) columns (`spacing`, default 1, apart; small random
+// jitter; below about 0.76 neighbours interpenetrate), each of
 // a random kind (wine bottle, vase, flask), height 0.9-1.5 and body radius 0.25-0.38. Surfaces of
 // revolution have `segments` steps around the axis and max(8, segments / 2) profile samples;
 // normals come from the profile curve (creases at the rims, bottoms and liquid surface are kept
@@ -66,6 +67,7 @@ Result<Scene> buildBottles(ParamReader& params, uint64_t seed) {
   const int64_t count = params.integer("count", 6, 1, 10'000);
   const int64_t segments = params.integer("segments", 64, 3, 4096);
   const float alpha = params.real("alpha", 0.3, 0.0, 1.0);
+  const float spacing = params.real("spacing", 1.0, 0.0, 100.0, /*lowOpen=*/true);
   if (params.error()) return *params.error();
   const int samples = std::max(8, static_cast<int>(segments) / 2);  // wall profile samples
   const int liquidSamples = std::max(4, samples / 2);
@@ -95,8 +97,8 @@ Result<Scene> buildBottles(ParamReader& params, uint64_t seed) {
     const float jitterX = rng.uniform(-0.05f, 0.05f);
     const float jitterZ = rng.uniform(-0.05f, 0.05f);
     const glm::vec3 base(
-        static_cast<float>(column) - 0.5f * static_cast<float>(columns - 1) + jitterX, 0.0f,
-        0.5f * static_cast<float>(rows - 1) - static_cast<float>(row) + jitterZ);
+        spacing * (static_cast<float>(column) - 0.5f * static_cast<float>(columns - 1)) + jitterX,
+        0.0f, spacing * (0.5f * static_cast<float>(rows - 1) - static_cast<float>(row)) + jitterZ);
     const uint32_t glass =
         mesh.material("glass_" + std::to_string(i),
                       hsv(goldenHue(2 * static_cast<uint32_t>(i), hueOffset), 0.35f, 1.0f), alpha);

@@ -19,6 +19,7 @@
 #include "mfr/core/image.hpp"
 #include "mfr/core/result.hpp"
 #include "mfr/engine/engine.hpp"
+#include "mfr/method/budget_spec.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/method/render_output.hpp"
 #include "mfr/metrics/flip.hpp"
@@ -27,7 +28,9 @@ namespace mfr {
 
 struct CompareOptions {
   std::vector<std::string> methods;  // preset names (methodPreset), at least one, no duplicates
-  std::vector<uint64_t> budgets;  // bytes, at least one, no duplicates; budgets[0] is "the" budget
+  /// At least one, no duplicates; budgets[0] is "the" budget. Bytes, or shares of the exact
+  /// A-buffer's node bytes ("30%", budget_spec.hpp: each method's own words on top).
+  std::vector<BudgetSpec> budgets;
   /// Compositing of every method (ground truth: exact); none: each preset's own rule (hybrid for
   /// dkb*, optimal*; kbuffer for the others).
   std::optional<Compositing> compositing;
@@ -76,9 +79,12 @@ struct CompareRun {
 };
 
 struct CompareBudget {
+  /// Absolute: the budget. Relative: the node bytes of the share (relativeNodeBytes), the same for
+  /// every method; each run's budgetBytes adds that method's own per-pixel and per-image words.
   uint64_t budgetBytes = 0;
-  std::string label;             // "20MB", "400KB", "1000B"
-  std::vector<CompareRun> runs;  // in CompareOptions::methods order
+  std::optional<double> percent;  // relative budgets: the share, in percent
+  std::string label;              // "20MB", "400KB", "1000B", "25%"
+  std::vector<CompareRun> runs;   // in CompareOptions::methods order
 };
 
 struct CompareResult {
@@ -102,9 +108,6 @@ struct CompareResult {
 /// compare_output.hpp writes the result as `mfr compare` does (writeComparison).
 Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
                                     const CompareOptions& options);
-
-/// "20MB" for whole MiB, "400KB" for whole KiB, else "12345B" (file-name safe).
-std::string budgetLabel(uint64_t bytes);
 
 /// results.json: scene, width, height, compositing, capture, flip_pixels_per_degree,
 /// budget_bytes (the first budget), ground_truth {name, image, depth_complexity_image, ...stats},

@@ -94,6 +94,10 @@ uint64_t budgetStepSlots(uint64_t coveredPixels, uint64_t fragments, int step, i
 
 struct ViewSamplingOptions {
   int budgetSteps = 5;
+  /// Relative budgets instead of the steps (budget_spec.hpp): step s has F(M) =
+  /// floor(budgetPercents[s] / 100 * 8 N) / 8 slots; a share below one slot per covered pixel is
+  /// an error naming the smallest share that works.
+  std::vector<double> budgetPercents;
   double sampleFraction = 0.2;  // of the covered pixels, per view and budget
   uint64_t seed = 1;
   glm::vec3 background{1.0f};

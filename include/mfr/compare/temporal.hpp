@@ -1,0 +1,86 @@
+// Temporal stability along a camera path (issue 14, sec. 5): `mfr compare --orbit N` compares
+// the methods on each of N views (runComparison per frame) and measures how much each method
+// flickers from one frame to the next beyond what the scene itself changes:
+//
+//   f_X(t)   = mean LDR-FLIP between frames t-1 and t of X          (t = 1 .. N-1)
+//   flicker  = mean over t of f_X(t)
+//   excess   = mean over t of (f_method(t) - f_ground truth(t))     ("excess flicker")
+//
+// The ground truth's own f(t) is the change the camera motion causes; a method whose images are
+// the ground truth's (the A-buffer, or any method with room for every fragment) has excess 0
+// exactly, and a method whose error pattern jumps between frames has a positive excess. The
+// images compared are the sRGB8 images as written, like every metric of mfr compare. Frames are
+// added one at a time and only the previous frame's images are kept, so a long path costs the
+// memory of two frames.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "mfr/compare/compare.hpp"
+#include "mfr/core/image.hpp"
+#include "mfr/core/result.hpp"
+#include "mfr/scene/camera.hpp"
+
+namespace mfr {
+
+/// The camera path of `mfr compare --orbit N [--orbit-step DEG]`: N cameras rotated about the
+/// camera's up axis through its target, view i by i * stepDegrees (scene/camera.hpp's orbit spaces
+/// N views over the full circle; a path for flicker wants small steps).
+std::vector<Camera> orbitPath(const Camera& camera, int views, float stepDegrees);
+
+/// One method at one budget along the path.
+struct TemporalSeries {
+  std::string method;
+  std::string budgetLabel;
+  std::vector<double> consecutiveFlip;  // f(t) for t = 1 .. N-1; NaN where a frame failed
+  std::vector<double> errorFlip;        // mean FLIP against the ground truth per frame; NaN: failed
+  double flicker = 0.0;        // mean of consecutiveFlip (NaN if any transition is missing)
+  double excessFlicker = 0.0;  // mean of consecutiveFlip - the ground truth's (NaN likewise)
+};
+
+struct TemporalResult {
+  int frames = 0;
+  std::vector<double> groundTruthConsecutiveFlip;  // f_ground truth(t), t = 1 .. N-1
+  double groundTruthFlicker = 0.0;
+  std::vector<TemporalSeries> series;  // budgets in order, methods in order within a budget
+};
+
+/// Accumulates frames of one path. Every frame must have the methods and budgets of the first.
+class TemporalStability {
+ public:
+  explicit TemporalStability(double flipPixelsPerDegree = kFlipDefaultPixelsPerDegree);
+  /// Adds the next frame. Errors: a frame whose methods, budgets or size differ from the first.
+  Result<void> add(const CompareResult& frame);
+  /// The measures so far (flicker 0 with fewer than two frames).
+  TemporalResult result() const;
+
+ private:
+  double ppd_;
+  int frames_ = 0;
+  int width_ = 0, height_ = 0;
+  Image8 previousTruth_;
+  std::vector<Image8> previous_;  // per series; empty: the run failed
+  TemporalResult result_;
+};
+
+/// results.json's "temporal" object: frames, definition, ground_truth {consecutive_flip, flicker},
+/// series [{method, budget_label, consecutive_flip, error_flip, flicker, excess_flicker}] (NaN as
+/// null).
+nlohmann::json temporalToJson(const TemporalResult& result);
+
+/// f_method(t) - f_ground truth(t) over t for every method at `budgetLabel` (one line each).
+Result<Image8> temporalPlot(const TemporalResult& result, const std::string& budgetLabel);
+
+/// A self-contained page: the set-up, the flicker table (method, budget, flicker, excess, mean
+/// FLIP against the ground truth over the frames), one plot per budget (`plotFiles`, relative
+/// file names in budget order) and links to the frames' own reports (`frameFolders`).
+std::string temporalReportHtml(const TemporalResult& result, const std::string& scene, int width,
+                               int height, const std::vector<std::string>& plotFiles,
+                               const std::vector<std::string>& frameFolders,
+                               const std::string& commandLine);
+
+}  // namespace mfr
