@@ -543,7 +543,9 @@ TEST_F(CompareCli, SummaryAndReportPathOnStderrAndACsvRowPerRun) {
     const bool inRun = results().dump().find("\"" + p.name + "\"") != std::string::npos;
     const std::string entry = "<dt><code>" + p.name + "</code></dt><dd>";
     EXPECT_EQ(s.str().find(entry) != std::string::npos, inRun) << p.name;
-    if (inRun) EXPECT_NE(s.str().find(entry + p.summary.substr(0, 20)), std::string::npos);
+    if (inRun) {
+      EXPECT_NE(s.str().find(entry + p.summary.substr(0, 20)), std::string::npos);
+    }
   }
 }
 
