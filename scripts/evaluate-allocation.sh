@@ -9,7 +9,7 @@
 #   scripts/evaluate-allocation.sh [--mfr BIN] [--out DIR] [--size N] [--views V] [--zoom Z]
 #                                  [--budgets LIST] [--methods LIST] [--quick]
 #   defaults: build/mfr, eval-allocation, 512, 3, 1.0, 25%,50%,75%,
-#             fkb,kplus-sb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,mlab,optimal
+#             fkb,kplus-sb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,dkb-curve,mlab,optimal
 #   --quick: 128x128, one view (a smoke test of the whole pipeline, about a minute)
 #
 # Scenes are rendered fully transparent (--alpha 0.5), as the papers do. The relative budgets make
@@ -23,7 +23,7 @@ SIZE=512
 VIEWS=3
 ZOOM=1.0
 BUDGETS=25%,50%,75%
-METHODS=fkb,kplus-sb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,mlab,optimal
+METHODS=fkb,kplus-sb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,dkb-curve,mlab,optimal
 SCENES=../shared/scenes
 while [ $# -gt 0 ]; do
   case "$1" in
