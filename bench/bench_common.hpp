@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "mfr/core/image.hpp"
+#include "mfr/core/plot.hpp"
 #include "mfr/core/result.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/cpu/render.hpp"
@@ -45,6 +46,22 @@ struct Program {
 
 inline void printError(const Program& program, const std::string& message) {
   std::fprintf(stderr, "%s: %s\n", program.name, message.c_str());
+}
+
+/// Draws `series` into OUT/fileName and prints its path; false (with the message) if it failed.
+/// Nothing is written for no series.
+inline bool writePlotPng(const Program& program, const std::string& outDir,
+                         const std::string& fileName, const std::vector<PlotSeries>& series,
+                         const PlotOptions& options) {
+  if (series.empty()) return true;
+  auto png = plotLines(series, options);
+  const std::filesystem::path path = std::filesystem::path(outDir) / fileName;
+  if (!png || !writePng(path.string(), *png).ok()) {
+    printError(program, "cannot write " + path.string());
+    return false;
+  }
+  std::printf("PNG: %s\n", path.string().c_str());
+  return true;
 }
 
 // ---- command line (the same options in every bench program) ----------------------------------

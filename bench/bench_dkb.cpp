@@ -197,19 +197,10 @@ int main(int argc, char** argv) {
   }
   table.print();
   std::printf("CSV: %s\n", csv.path().string().c_str());
-  if (!series.empty()) {
-    PlotOptions po;
-    po.title = "deep k-buffer: features + inference vs a kplus-dynamic frame";
-    po.xLabel = "instruction set (0 scalar, 1 avx2, 2 avx512)";
-    po.yLabel = "ms";
-    auto png = plotLines(series, po);
-    const std::filesystem::path pngPath = std::filesystem::path(args.out) / "dkb.png";
-    if (!png || !writePng(pngPath.string(), *png).ok()) {
-      printError(kProgram, "cannot write " + pngPath.string());
-      failed = true;
-    } else {
-      std::printf("PNG: %s\n", pngPath.string().c_str());
-    }
-  }
+  PlotOptions po;
+  po.title = "deep k-buffer: features + inference vs a kplus-dynamic frame";
+  po.xLabel = "instruction set (0 scalar, 1 avx2, 2 avx512)";
+  po.yLabel = "ms";
+  if (!writePlotPng(kProgram, args.out, "dkb.png", series, po)) failed = true;
   return failed ? 1 : 0;
 }

@@ -117,19 +117,10 @@ int main(int argc, char** argv) {
   }
   table.print();
   std::printf("CSV: %s\n", csv.path().string().c_str());
-  if (!series.empty()) {
-    PlotOptions po;
-    po.title = "optimal k-buffer oracle on procedural:hairball";
-    po.xLabel = "run";
-    po.yLabel = "ms";
-    auto png = plotLines(series, po);
-    const std::filesystem::path pngPath = std::filesystem::path(args.out) / "oracle.png";
-    if (!png || !writePng(pngPath.string(), *png).ok()) {
-      printError(kProgram, "cannot write " + pngPath.string());
-      failed = true;
-    } else {
-      std::printf("PNG: %s\n", pngPath.string().c_str());
-    }
-  }
+  PlotOptions po;
+  po.title = "optimal k-buffer oracle on procedural:hairball";
+  po.xLabel = "run";
+  po.yLabel = "ms";
+  if (!writePlotPng(kProgram, args.out, "oracle.png", series, po)) failed = true;
   return failed ? 1 : 0;
 }

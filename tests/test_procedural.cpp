@@ -14,6 +14,7 @@
 #include "mfr/scene/procedural.hpp"
 #include "mfr/scene/procedural_geometry.hpp"
 #include "mfr/scene/scene.hpp"
+#include "ray_hits.hpp"
 #include "scene/procedural_internal.hpp"
 
 namespace mfr {
@@ -39,27 +40,9 @@ void expectError(const std::string& spec, std::initializer_list<std::string> fra
         << spec << ": message \"" << message << "\" lacks \"" << fragment << "\"";
 }
 
-/// Number of triangles the ray crosses in front of its origin (Moller-Trumbore, double precision).
+/// Number of triangles the ray crosses in front of its origin.
 int countHits(const Scene& scene, const Ray& ray) {
-  const glm::dvec3 o(ray.origin), d(ray.direction);
-  int hits = 0;
-  for (size_t t = 0; t + 2 < scene.indices.size(); t += 3) {
-    const glm::dvec3 v0(scene.positions[scene.indices[t]]);
-    const glm::dvec3 e1 = glm::dvec3(scene.positions[scene.indices[t + 1]]) - v0;
-    const glm::dvec3 e2 = glm::dvec3(scene.positions[scene.indices[t + 2]]) - v0;
-    const glm::dvec3 p = glm::cross(d, e2);
-    const double det = glm::dot(e1, p);
-    if (std::abs(det) < 1e-18) continue;
-    const double inv = 1.0 / det;
-    const glm::dvec3 s = o - v0;
-    const double u = glm::dot(s, p) * inv;
-    if (u < 0.0 || u > 1.0) continue;
-    const glm::dvec3 q = glm::cross(s, e1);
-    const double v = glm::dot(d, q) * inv;
-    if (v < 0.0 || u + v > 1.0) continue;
-    if (glm::dot(e2, q) * inv > 1e-9) ++hits;
-  }
-  return hits;
+  return test::countHits(scene, glm::dvec3(ray.origin), glm::dvec3(ray.direction));
 }
 
 bool sameGeometry(const Scene& a, const Scene& b) {
