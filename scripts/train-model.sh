@@ -24,13 +24,12 @@
 #   pass A: 128x128, 4 orbit views, zoom 1, the families' own per-material alphas
 #   pass B: 192x192, 3 orbit views, zoom 1.6, every material at alpha 0.5 (global alpha)
 # 5 budgets per view (one fragment per covered pixel ... all fragments), 10% of the covered pixels.
-# Time: the datasets take about 1 minute per rule; each of the four trainings (60 epochs over
-# about 600k samples) took 7-18 minutes of wall time (5-22 s per epoch, in the logs) on the shared
-# 2-core machine at a load average of about 13 (nice, four other engineers' builds running), and
-# the kbuffer rule's half of the script (datasets + 2 trainings) 25 minutes; on an otherwise idle
-# 2-core machine an epoch takes about 1.5-2.5 s, so the whole script needs about 10 minutes, well
-# under 30 (the two rules' halves are independent: --rule hybrid and --rule kbuffer can run side by
-# side and give the same bytes).
+# Time, measured on 2026-12-02 on the 2-core development machine (`time scripts/train-model.sh
+# build/mfr /tmp/train0`, a -j1 build using the other core for most of it): 7 min 04 s in all.
+# The datasets take about 20 s per rule (both cores); each training is single-threaded and took
+# 96-110 s (60 epochs of about 1.6 s over about 600k samples). The four models came out
+# byte-identical to the shipped ones. The two rules' halves are independent: --rule hybrid and
+# --rule kbuffer can run side by side and give the same bytes.
 #
 # Options (relative paths are relative to the repository root, where the script runs):
 #   --tiny          the scaled-down preset of the reproducibility test (tests/model_repro_test.sh):

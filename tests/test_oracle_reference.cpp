@@ -7,6 +7,9 @@
 #include <limits>
 #include <random>
 
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
+
 #include "mfr/cpu/optimal_oracle.hpp"
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/memory_model.hpp"
@@ -163,6 +166,50 @@ TEST(OracleReference, HullAllocationEqualsSortingEverySegmentOnSceneCurves) {
                              std::string(toString(rule)) + " slots " + std::to_string(slots) +
                                  " chunk " + std::to_string(chunk));
       }
+  }
+}
+
+// The allocators' per-pixel passes run on the caller's task arena (workers fold ranges of pixels
+// and their states combine in any order): one worker and four give the same bits.
+TEST(OracleReference, AllocationIsTheSameOnOneWorkerAndOnFour) {
+  auto scene = loadScene("procedural:hairball?strands=600");
+  ASSERT_TRUE(scene.ok());
+  auto frame = RasterFrame::build(*scene, *scene->defaultCamera, RasterOptions{256, 256, 16, 2});
+  ASSERT_TRUE(frame.ok());
+  const tbb::global_control four(tbb::global_control::max_allowed_parallelism, 4);
+  for (Compositing rule : {Compositing::Hybrid, Compositing::KBuffer}) {
+    const auto curves = frameErrorCurves(*frame, glm::vec3(1.0f), rule).value().curves;
+    uint64_t covered = 0, fragments = 0;
+    for (const auto& e : curves) {
+      covered += !e.empty();
+      fragments += e.size();
+    }
+    // 16 tasks of 4096 pixels (the allocator's grain), most of them covered
+    ASSERT_EQ(curves.size(), 16u * 4096u);
+    ASSERT_GT(covered, curves.size() / 3);
+    for (double share : {0.1, 0.5}) {
+      const uint64_t slots = covered + static_cast<uint64_t>(share * (fragments - covered));
+      OracleAllocation one, many;
+      std::vector<uint32_t> hullOne, hullMany;
+      tbb::task_arena(1).execute([&] {
+        one = allocateOptimal(curves, slots);
+        hullOne = allocateOptimalHull(curves, slots);
+      });
+      tbb::task_arena(4).execute([&] {
+        many = allocateOptimal(curves, slots);
+        hullMany = allocateOptimalHull(curves, slots);
+      });
+      const std::string what = std::string(toString(rule)) + " share " + std::to_string(share);
+      EXPECT_EQ(one.k, many.k) << what;
+      EXPECT_EQ(hullOne, hullMany) << what;
+      EXPECT_EQ(one.error, many.error) << what;  // bit for bit
+      EXPECT_EQ(one.lowerBound, many.lowerBound) << what;
+      EXPECT_EQ(one.lagrangianBound, many.lagrangianBound) << what;
+      EXPECT_EQ(one.nonconvexPixels, many.nonconvexPixels) << what;
+      EXPECT_EQ(one.corePixels, many.corePixels) << what;
+      EXPECT_STREQ(one.solver, many.solver) << what;
+      expectSameAllocation(curves, slots, 64, what);  // and the reference's
+    }
   }
 }
 

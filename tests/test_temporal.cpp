@@ -38,6 +38,18 @@ Image8 pattern(int w, int h, uint8_t a, uint8_t b, int period) {
   return im;
 }
 
+// independent of temporal.cpp: the mean over pixels and RGB of |(m1 - g1) - (m0 - g0)| / 255
+double expectedErrorChange(const Image8& m0, const Image8& g0, const Image8& m1, const Image8& g1) {
+  double sum = 0.0;
+  int n = 0;
+  for (size_t i = 0; i < m0.rgba.size(); ++i) {
+    if (i % 4 == 3) continue;
+    sum += std::fabs((double(m1.rgba[i]) - g1.rgba[i]) - (double(m0.rgba[i]) - g0.rgba[i]));
+    ++n;
+  }
+  return sum / 255.0 / n;
+}
+
 CompareRun run(const std::string& method, const Image8& image, double flip) {
   CompareRun r;
   r.method = method;
@@ -90,15 +102,29 @@ TEST(TemporalStability, ConstructedSequenceHasTheFlipOfItsAlternation) {
   EXPECT_EQ(steady.flicker, 0.0);
   EXPECT_NEAR(steady.excessFlicker, -gFlip, 1e-12);
   EXPECT_EQ(alternating.errorFlip, (std::vector<double>{0.0, 0.25, 0.5, 0.75}));
+  // the error change: none for the exact method; the steady one's error moves with the truth
+  EXPECT_EQ(exact.meanErrorChange, 0.0);
+  const double steadyChange = expectedErrorChange(a, g0, a, g1);
+  ASSERT_GT(steadyChange, 0.0);
+  EXPECT_NEAR(steady.meanErrorChange, steadyChange, 1e-12);
+  ASSERT_EQ(alternating.errorChange.size(), 3u);
+  EXPECT_NEAR(alternating.errorChange[0], expectedErrorChange(a, g0, b, g1), 1e-12);
+  EXPECT_NEAR(alternating.errorChange[1], expectedErrorChange(b, g1, a, g0), 1e-12);
+  EXPECT_GT(alternating.meanErrorChange, steady.meanErrorChange);
+  EXPECT_TRUE(std::isnan(failing.meanErrorChange));
   EXPECT_TRUE(std::isnan(failing.consecutiveFlip[1]) && std::isnan(failing.consecutiveFlip[2]));
   EXPECT_EQ(failing.consecutiveFlip[0], 0.0);
   EXPECT_TRUE(std::isnan(failing.excessFlicker));
   const nlohmann::json j = temporalToJson(r);
   EXPECT_TRUE(j["series"][3]["excess_flicker"].is_null());
   EXPECT_DOUBLE_EQ(j["series"][1]["flicker"].get<double>(), abFlip);
-  auto plot = temporalPlot(r, "50%");
-  ASSERT_TRUE(plot.ok()) << plot.error().message;
-  EXPECT_GT(plot->width, 0);
+  EXPECT_NEAR(j["series"][2]["mean_error_change"].get<double>(), steadyChange, 1e-12);
+  EXPECT_TRUE(j["series"][3]["mean_error_change"].is_null());
+  for (TemporalMeasure m : {TemporalMeasure::ExcessFlicker, TemporalMeasure::ErrorChange}) {
+    auto plot = temporalPlot(r, "50%", m);
+    ASSERT_TRUE(plot.ok()) << plot.error().message;
+    EXPECT_GT(plot->width, 0);
+  }
 }
 
 TEST(TemporalStability, RefusesFramesThatDoNotMatch) {
@@ -141,7 +167,10 @@ TEST(TemporalStability, ExactMethodsHaveNoExcessFlickerAlongAnOrbit) {
   EXPECT_GT(r.groundTruthFlicker, 0.0);  // the camera moves
   EXPECT_EQ(r.series[0].excessFlicker, 0.0);
   EXPECT_EQ(r.series[1].excessFlicker, 0.0);
+  EXPECT_EQ(r.series[0].meanErrorChange, 0.0);
+  EXPECT_EQ(r.series[1].meanErrorChange, 0.0);
   EXPECT_TRUE(std::isfinite(r.series[2].excessFlicker));
+  EXPECT_GT(r.series[2].meanErrorChange, 0.0);  // vkb loses fragments, and its error moves
   EXPECT_NE(r.series[2].flicker, r.groundTruthFlicker);
 }
 
@@ -153,8 +182,9 @@ TEST(TemporalStabilityCli, CompareOrbitWritesFramesMeasureAndPlots) {
           dir.string(),
       dir.parent_path());
   ASSERT_EQ(r.exitCode, 0) << r.err;
-  for (const char* f : {"frame_000/results.json", "frame_002/report.html", "report.html",
-                        "temporal_100pct.png", "temporal_60pct.png"})
+  for (const char* f :
+       {"frame_000/results.json", "frame_002/report.html", "report.html", "temporal_100pct.png",
+        "temporal_60pct.png", "temporal_60pct_error_change.png"})
     EXPECT_TRUE(fs::exists(dir / f)) << f;
   std::ifstream in(dir / "results.json");
   const nlohmann::json j = nlohmann::json::parse(in);
@@ -165,6 +195,8 @@ TEST(TemporalStabilityCli, CompareOrbitWritesFramesMeasureAndPlots) {
   ASSERT_EQ(t["series"].size(), 6u);
   EXPECT_EQ(t["series"][0]["method"], "abuffer");
   EXPECT_EQ(t["series"][0]["excess_flicker"], 0.0);
+  EXPECT_EQ(t["series"][0]["mean_error_change"], 0.0);
+  EXPECT_EQ(t["series"][2]["error_change"].size(), 2u);
   EXPECT_EQ(t["series"][4]["budget_label"], "60%");
   EXPECT_TRUE(t["series"][3]["excess_flicker"].is_null());  // the A-buffer needs 100%
   EXPECT_EQ(t["series"][2]["consecutive_flip"].size(), 2u);
@@ -176,6 +208,7 @@ TEST(TemporalStabilityCli, CompareOrbitWritesFramesMeasureAndPlots) {
   std::ifstream html(dir / "report.html");
   const std::string page((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
   EXPECT_NE(page.find("excess flicker"), std::string::npos);
+  EXPECT_NE(page.find("error change"), std::string::npos);
   EXPECT_NE(page.find("temporal_100pct.png"), std::string::npos);
 
   auto one = test::runCli(

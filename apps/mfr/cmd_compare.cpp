@@ -155,13 +155,16 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
   progress.set("writing " + a.out);
   const TemporalResult t = temporal.result();
   std::vector<std::string> plots;
-  for (const BudgetSpec& b : options.budgets) {
-    auto plot = temporalPlot(t, b.label);
-    if (!plot) continue;  // e.g. every method failed at this budget: nothing to draw
-    const std::string file = "temporal_" + b.fileLabel() + ".png";
-    if (auto w = writePng((dir / file).string(), plot.value()); !w) return fail(w.error().message);
-    plots.push_back(file);
-  }
+  for (const BudgetSpec& b : options.budgets)
+    for (const TemporalMeasure m : {TemporalMeasure::ExcessFlicker, TemporalMeasure::ErrorChange}) {
+      auto plot = temporalPlot(t, b.label, m);
+      if (!plot) continue;  // e.g. every method failed at this budget: nothing to draw
+      const std::string file = "temporal_" + b.fileLabel() +
+                               (m == TemporalMeasure::ErrorChange ? "_error_change" : "") + ".png";
+      if (auto w = writePng((dir / file).string(), plot.value()); !w)
+        return fail(w.error().message);
+      plots.push_back(file);
+    }
   nlohmann::json j;
   j["mfr_version"] = versionNumber;
   j["scene"] = a.scene.source;
@@ -186,10 +189,11 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
   if (!a.scene.quiet) {
     std::fprintf(stderr, "%s, %d frames %.3g degrees apart; ground truth flicker %.4f\n",
                  a.scene.source.c_str(), frames, step, t.groundTruthFlicker);
-    std::fprintf(stderr, "  %-20s %8s %9s %9s\n", "method", "budget", "flicker", "excess");
+    std::fprintf(stderr, "  %-20s %8s %9s %9s %12s\n", "method", "budget", "flicker", "excess",
+                 "error change");
     for (const TemporalSeries& s : t.series)
-      std::fprintf(stderr, "  %-20s %8s %9.4f %9.4f\n", s.method.c_str(), s.budgetLabel.c_str(),
-                   s.flicker, s.excessFlicker);
+      std::fprintf(stderr, "  %-20s %8s %9.4f %9.4f %12.4f\n", s.method.c_str(),
+                   s.budgetLabel.c_str(), s.flicker, s.excessFlicker, s.meanErrorChange);
     std::fprintf(stderr, "report: %s\n", (dir / "report.html").string().c_str());
   }
   if (a.scene.json) std::fputs(jsonText.c_str(), stdout);

@@ -1,5 +1,6 @@
 // Temporal stability along a camera path (issue 14, sec. 5; see mfr/compare/temporal.hpp):
-// consecutive-frame FLIP of each method against that of the ground truth.
+// consecutive-frame FLIP of each method against that of the ground truth, and the change of each
+// method's per-pixel error from frame to frame.
 #include "mfr/compare/temporal.hpp"
 
 #include <cmath>
@@ -63,6 +64,22 @@ const glm::vec3 kColours[] = {{0.12f, 0.47f, 0.71f}, {1.0f, 0.5f, 0.05f},  {0.17
                               {0.89f, 0.47f, 0.76f}, {0.5f, 0.5f, 0.5f},   {0.74f, 0.74f, 0.13f},
                               {0.09f, 0.75f, 0.81f}};
 
+// e(t): mean over pixels and RGB of |(method_t - truth_t) - (method_t-1 - truth_t-1)| / 255
+double errorChange(const Image8& method, const Image8& truth, const Image8& previousMethod,
+                   const Image8& previousTruth) {
+  const size_t pixels = method.rgba.size() / 4;
+  if (pixels == 0) return 0.0;
+  int64_t sum = 0;
+  for (size_t p = 0; p < pixels; ++p)
+    for (size_t c = 0; c < 3; ++c) {
+      const size_t i = p * 4 + c;
+      const int now = int{method.rgba[i]} - int{truth.rgba[i]};
+      const int before = int{previousMethod.rgba[i]} - int{previousTruth.rgba[i]};
+      sum += std::abs(now - before);
+    }
+  return static_cast<double>(sum) / (255.0 * 3.0 * static_cast<double>(pixels));
+}
+
 }  // namespace
 
 std::vector<Camera> orbitPath(const Camera& camera, int views, float stepDegrees) {
@@ -113,13 +130,15 @@ Result<void> TemporalStability::add(const CompareResult& frame) {
       Image8& previous = previous_[index++];
       s.errorFlip.push_back(run.ok() ? run.metrics.flipMean : kNaN);
       if (frames_ > 0) {
-        double f = kNaN;
+        double f = kNaN, e = kNaN;
         if (run.ok() && !previous.rgba.empty()) {
           auto flip = computeFlip(previous, run.image, ppd_);
           if (!flip) return flip.error();
           f = flip->mean;
+          e = errorChange(run.image, frame.groundTruth.image, previous, previousTruth_);
         }
         s.consecutiveFlip.push_back(f);
+        s.errorChange.push_back(e);
       }
       previous = run.ok() ? run.image : Image8{};
     }
@@ -138,6 +157,7 @@ TemporalResult TemporalStability::result() const {
     for (size_t t = 0; t < s.consecutiveFlip.size(); ++t)
       excess.push_back(s.consecutiveFlip[t] - r.groundTruthConsecutiveFlip[t]);
     s.excessFlicker = meanOf(excess);
+    s.meanErrorChange = meanOf(s.errorChange);
   }
   return r;
 }
@@ -147,7 +167,9 @@ nlohmann::json temporalToJson(const TemporalResult& r) {
   j["frames"] = r.frames;
   j["definition"] =
       "flicker = mean over t of mean FLIP(frame t-1, frame t); excess_flicker = mean over t of "
-      "(the method's consecutive-frame FLIP - the ground truth's)";
+      "(the method's consecutive-frame FLIP - the ground truth's); error_change[t] = mean over "
+      "pixels and RGB of |(method_t - truth_t) - (method_t-1 - truth_t-1)| / 255 on the sRGB8 "
+      "images; mean_error_change = its mean over t";
   j["ground_truth"] = {{"consecutive_flip", numbers(r.groundTruthConsecutiveFlip)},
                        {"flicker", number(r.groundTruthFlicker)}};
   nlohmann::json series = nlohmann::json::array();
@@ -156,13 +178,17 @@ nlohmann::json temporalToJson(const TemporalResult& r) {
                       {"budget_label", s.budgetLabel},
                       {"consecutive_flip", numbers(s.consecutiveFlip)},
                       {"error_flip", numbers(s.errorFlip)},
+                      {"error_change", numbers(s.errorChange)},
                       {"flicker", number(s.flicker)},
-                      {"excess_flicker", number(s.excessFlicker)}});
+                      {"excess_flicker", number(s.excessFlicker)},
+                      {"mean_error_change", number(s.meanErrorChange)}});
   j["series"] = series;
   return j;
 }
 
-Result<Image8> temporalPlot(const TemporalResult& r, const std::string& budgetLabel) {
+Result<Image8> temporalPlot(const TemporalResult& r, const std::string& budgetLabel,
+                            TemporalMeasure measure) {
+  const bool excess = measure == TemporalMeasure::ExcessFlicker;
   std::vector<PlotSeries> lines;
   for (const TemporalSeries& s : r.series) {
     if (s.budgetLabel != budgetLabel) continue;
@@ -171,15 +197,16 @@ Result<Image8> temporalPlot(const TemporalResult& r, const std::string& budgetLa
     line.color = kColours[(lines.size() - 1) % (sizeof kColours / sizeof kColours[0])];
     for (size_t t = 0; t < s.consecutiveFlip.size(); ++t) {
       line.x.push_back(static_cast<double>(t + 1));
-      line.y.push_back(s.consecutiveFlip[t] - r.groundTruthConsecutiveFlip[t]);
+      line.y.push_back(excess ? s.consecutiveFlip[t] - r.groundTruthConsecutiveFlip[t]
+                              : s.errorChange[t]);
     }
   }
   PlotOptions options;
   options.width = 640;
   options.height = 360;
-  options.title = "excess flicker at " + budgetLabel;
+  options.title = (excess ? "excess flicker at " : "error change at ") + budgetLabel;
   options.xLabel = "frame t (vs t-1)";
-  options.yLabel = "FLIP(t-1,t) - ground truth's";
+  options.yLabel = excess ? "FLIP(t-1,t) - ground truth's" : "mean |error(t) - error(t-1)|";
   return plotLines(lines, options);
 }
 
@@ -202,16 +229,21 @@ std::string temporalReportHtml(const TemporalResult& r, const std::string& scene
        "&minus; f<sub>ground truth</sub>(t): how much more the method changes between frames "
        "than the exact image does (0 for a method that renders the ground truth). The ground "
        "truth's flicker is " +
-       cell(r.groundTruthFlicker) + ".</p>\n";
+       cell(r.groundTruthFlicker) +
+       ". A lossy method's smoother image often changes less than the exact one, so its excess "
+       "can be negative whatever its error does; the <b>error change</b> e(t), the mean over "
+       "pixels and RGB of |(method<sub>t</sub> &minus; truth<sub>t</sub>) &minus; "
+       "(method<sub>t&minus;1</sub> &minus; truth<sub>t&minus;1</sub>)| / 255, measures how much "
+       "the error itself moves or pops (0 for an exact method).</p>\n";
   h += "<table>\n<tr><th>method</th><th>budget</th><th>flicker</th><th>excess flicker</th>"
-       "<th>mean FLIP vs ground truth</th></tr>\n";
+       "<th>error change</th><th>mean FLIP vs ground truth</th></tr>\n";
   for (const TemporalSeries& s : r.series)
     h += "<tr><td><code>" + escape(s.method) + "</code></td><td>" + escape(s.budgetLabel) +
          "</td><td>" + cell(s.flicker) + "</td><td>" + cell(s.excessFlicker) + "</td><td>" +
-         cell(meanOf(s.errorFlip)) + "</td></tr>\n";
+         cell(s.meanErrorChange) + "</td><td>" + cell(meanOf(s.errorFlip)) + "</td></tr>\n";
   h += "</table>\n";
   for (const std::string& plot : plotFiles)
-    h += "<figure><img src=\"" + escape(plot) + "\" alt=\"excess flicker over the frames\">" +
+    h += "<figure><img src=\"" + escape(plot) + "\" alt=\"temporal measure over the frames\">" +
          "</figure>\n";
   h += "<h2>Frames</h2>\n<ul>\n";
   for (const std::string& f : frameFolders)

@@ -229,8 +229,7 @@ CaptureCounters runCapture(const RasterFrame& frame, const Allocation& alloc,
 #if MFR_HAS_AVX2_KERNELS
   if constexpr (!Hybrid) {
     if (isa == Isa::Avx2) {
-      ShadeInputs inputs;
-      frame.rasterizeTile<ShadeMode::Full>(0, inputs);
+      const ShadingInputs inputs = frame.shadingInputs();
       std::vector<CaptureCounters> perTile(static_cast<size_t>(frame.tileCount()));
       frame.forEachTile([&](int tile) {
         thread_local std::vector<int32_t> cullDepth;  // reused by the worker's tiles

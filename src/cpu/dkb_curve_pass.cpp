@@ -3,6 +3,8 @@
 // mfr/cpu/dkb_curve_pass.hpp.
 #include "mfr/cpu/dkb_curve_pass.hpp"
 
+#include <tbb/task_arena.h>
+
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/dkb_curve.hpp"
@@ -38,7 +40,10 @@ Result<CurveChoice> predictedCurveK(const RasterFrame& frame, const MethodDesc& 
     std::copy_n(predicted.begin() + static_cast<ptrdiff_t>(i * kCurveOutputs), kCurveOutputs,
                 predictions.begin() + static_cast<ptrdiff_t>(covered[i]) * kCurveOutputs);
   // the hull allocation over the rebuilt curves
-  out.k = allocateByPredictedCurves(predictions, out.n, slots);
+  // (on the frame's workers, like its tile passes; the same k on any number)
+  tbb::task_arena(frame.arenaThreads()).execute([&] {
+    out.k = allocateByPredictedCurves(predictions, out.n, slots);
+  });
   out.bytesAllocated = pixels.size() * (sizeof(FeatureAccumulator) + 4 * kCurveOutputs) +
                        (rows.size() + predicted.size()) * 4 + image.fragments * sizeof(double) +
                        pixels.size() * sizeof(std::vector<double>);

@@ -13,6 +13,8 @@
 #include <algorithm>
 #include <string>
 
+#include <tbb/task_arena.h>
+
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/cpu/fragment.hpp"
 #include "mfr/cpu/render.hpp"
@@ -88,7 +90,11 @@ Result<OracleChoice> optimalK(const RasterFrame& frame, const MethodDesc& method
   }
   OracleOptions oo;
   oo.publishedGreedy = method.publishedGreedy;
-  OracleAllocation a = allocateOptimal(oracle->curves, slots, oo);
+  // on the frame's workers, like its tile passes (the allocation is the same on any number)
+  OracleAllocation a;
+  tbb::task_arena(frame.arenaThreads()).execute([&] {
+    a = allocateOptimal(oracle->curves, slots, oo);
+  });
   OracleReport& r = out.report.emplace();
   r.error = a.error;
   r.lowerBound = a.lowerBound;

@@ -39,25 +39,6 @@
 namespace mfr {
 namespace detail {
 
-/// What the lane kernel reads of a frame besides its public set-up: the shading inputs.
-struct ShadeInputs {
-  const std::vector<ShadeMaterial>* materials = nullptr;
-  float rayScaleX = 0, rayBiasX = 0, rayScaleY = 0, rayBiasY = 0;
-  const ColorTables* tables = nullptr;
-};
-
-}  // namespace detail
-
-// RasterFrame hands its shading inputs to the lane kernel through this specialization of its
-// sink protocol (a member, so it reads them without widening the public header).
-template <>
-inline void RasterFrame::rasterizeTile<ShadeMode::Full, detail::ShadeInputs&>(
-    int, detail::ShadeInputs& inputs) const {
-  inputs = {&materials_, rayScaleX_, rayBiasX_, rayScaleY_, rayBiasY_, colorTables_};
-}
-
-namespace detail {
-
 #define MFR_TARGET_AVX2 __attribute__((target("avx2")))
 
 /// The cull depth of one store (see the file comment).
@@ -89,7 +70,7 @@ inline int32_t cullDepthOf(const FragmentNode* slots, uint32_t count, uint32_t c
 
 /// One triangle over one tile, 8 pixels at a time (see the file comment).
 template <class Sink>
-MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadeInputs& in,
+MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingInputs& in,
                                        const TriangleSetup& t, const TileRect& tile, Sink& sink) {
   const int x0 = std::max(tile.x0, t.minX), y0 = std::max(tile.y0, t.minY);
   const int x1 = std::min(tile.x1, t.maxX), y1 = std::min(tile.y1, t.maxY);
@@ -262,7 +243,7 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadeInpu
 /// protocol of `sink` (beginTile, cullDepthRow, countEarly / acceptLane, emitLane) and its scalar
 /// protocol (accept, emit) for the tiles the lanes do not take.
 template <class Sink>
-MFR_TARGET_AVX2 void rasterizeTileAvx2(const RasterFrame& frame, const ShadeInputs& in, int tile,
+MFR_TARGET_AVX2 void rasterizeTileAvx2(const RasterFrame& frame, const ShadingInputs& in, int tile,
                                        Sink& sink) {
   const TileRect r = frame.tileRect(tile);
   sink.beginTile(r, frame.tileSize());

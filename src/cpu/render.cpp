@@ -12,6 +12,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "mfr/core/isa.hpp"
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
@@ -328,8 +329,7 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
     timer.run("moments", [&] { detail::accumulateMoments(frame, options.capture, stores); });
 
   // capture
-  // the capture's path, written as "isa" (stats_json.cpp)
-  stats.engineCounters["isa"] = static_cast<double>(detail::captureIsaFor(method, options.capture));
+  stats.isa = std::string(isaName(detail::captureIsaFor(method, options.capture)));
   const detail::CaptureCounters counters = timer.run("capture", [&] {
     return detail::capture(frame, method, alloc, method.occupancyWords > 0 ? &occupancy : nullptr,
                            options.capture, stores);

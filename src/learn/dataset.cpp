@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 
+#include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
 #include "mfr/core/atomic_file.hpp"
@@ -132,7 +133,10 @@ Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t
             " of the A-buffer's " + std::to_string(image.fragments) + " nodes)");
       slots = std::min(slots, image.fragments);
     }
-    const std::vector<uint32_t> k = allocateOptimalHull(oracle->curves, slots);
+    std::vector<uint32_t> k;  // on the frame's workers (the same k on any number)
+    tbb::task_arena(frame.arenaThreads()).execute([&] {
+      k = allocateOptimalHull(oracle->curves, slots);
+    });
     const uint32_t kMax = *std::max_element(k.begin(), k.end());
     for (uint32_t p = 0; p < pixels.size(); ++p) {
       if (pixels[p].n == 0) continue;

@@ -7,6 +7,10 @@
 #include <limits>
 #include <queue>
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include "mfr/core/color.hpp"
 #include "mfr/core/result.hpp"
 
@@ -16,11 +20,14 @@ std::vector<double> errorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3
                                Compositing compositing) {
   std::vector<double> err(n, 0.0);
   if (n == 0) return err;
-  // prefix: core colour and transmittance; suffix: tail sums
-  std::vector<glm::dvec3> core(n + 1, glm::dvec3(0.0));
-  std::vector<double> T(n + 1, 1.0);
-  std::vector<glm::dvec3> tailColor(n + 2, glm::dvec3(0.0));
-  std::vector<double> tailAlpha(n + 2, 0.0);
+  // prefix: core colour and transmittance; suffix: tail sums (the calling thread's scratch, reused
+  // from pixel to pixel: the oracle calls this once per covered pixel)
+  thread_local std::vector<glm::dvec3> core, tailColor;
+  thread_local std::vector<double> T, tailAlpha;
+  core.assign(n + 1, glm::dvec3(0.0));
+  T.assign(n + 1, 1.0);
+  tailColor.assign(n + 2, glm::dvec3(0.0));
+  tailAlpha.assign(n + 2, 0.0);
   for (uint32_t i = 0; i < n; ++i) {
     const glm::dvec4 c(unpackFragmentColor(nodeColor(sorted[i])));
     core[i + 1] = core[i] + glm::dvec3(c) * (c.a * T[i]);
@@ -84,6 +91,17 @@ std::vector<uint32_t> allocateOptimalGreedy(const std::vector<std::vector<double
 
 namespace {
 
+constexpr size_t kPixelGrain = 4096;  // pixels per task of the parallel passes
+
+// fn(p) for p < pixels on the calling task arena's workers
+template <class F>
+void forEachPixel(size_t pixels, F&& fn) {
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, pixels, kPixelGrain),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                      for (size_t p = r.begin(); p != r.end(); ++p) fn(p);
+                    });
+}
+
 struct HullSolution {
   std::vector<uint32_t> k;
   double lambda = 0.0;  // drop per slot of the first segment not bought whole (0: all bought)
@@ -105,6 +123,13 @@ struct HullSolution {
 //              one by one as the straightforward loop does, then the lower keys in chunks of at
 //              least OracleOptions::hullChunkSegments until the budget is spent.
 // The result (k and lambda) is the straightforward sorted loop's, bit for bit.
+//
+// The hulls and every pass over the segments run on the calling task arena's workers, over ranges
+// of pixels: each worker folds its segments into its own state (cost histograms, slots bought,
+// the chunk's segments), and the states are combined in no particular order. Nothing computed
+// depends on that order: the histograms and slot counts are integer sums, a bought segment raises
+// its own pixel's k, and a chunk is sorted into one total order (drop, then position) before it
+// is processed, so the result is the same for any number of workers.
 class HullAllocator {
  public:
   HullAllocator(const std::vector<std::vector<double>>& curves, uint64_t slots,
@@ -118,42 +143,76 @@ class HullAllocator {
     buildHulls();
     // level 1
     std::vector<uint64_t> cost1(kBuckets, 0), count1(kBuckets, 0);
-    forEachSegment([&](const Segment& s) {
-      cost1[s.key >> 48] += s.to - s.from;
-      ++count1[s.key >> 48];
-    });
+    struct Level1 {
+      std::vector<uint64_t> cost = std::vector<uint64_t>(kBuckets, 0);
+      std::vector<uint64_t> count = std::vector<uint64_t>(kBuckets, 0);
+    };
+    segmentPass<Level1>(
+        [](Level1& l, const Segment& s) {
+          l.cost[s.key >> 48] += s.to - s.from;
+          ++l.count[s.key >> 48];
+        },
+        [&](const Level1& l) {
+          for (int b = 0; b < kBuckets; ++b) {
+            cost1[b] += l.cost[b];
+            count1[b] += l.count[b];
+          }
+        });
     const int64_t budget = static_cast<int64_t>(slots_) - static_cast<int64_t>(used_);
     int64_t cum = 0;
     const int b1 = criticalBucket(cost1, budget, cum);
+    struct Bought {
+      uint64_t used = 0;
+    };
     if (b1 < 0) {  // every segment fits
-      forEachSegment([&](const Segment& s) { buy(s); });
+      segmentPass<Bought>([&](Bought& b, const Segment& s) { buy(s, b.used); },
+                          [&](const Bought& b) { used_ += b.used; });
       return out;
     }
     // level 2 inside b1, buying whole what lies above b1
     std::vector<uint64_t> cost2(kBuckets, 0);
-    forEachSegment([&](const Segment& s) {
-      const uint64_t top = s.key >> 48;
-      if (top > static_cast<uint64_t>(b1)) {
-        buy(s);
-      } else if (top == static_cast<uint64_t>(b1)) {
-        cost2[(s.key >> 32) & 0xffff] += s.to - s.from;
-      }
-    });
+    struct Level2 {
+      uint64_t used = 0;
+      std::vector<uint64_t> cost = std::vector<uint64_t>(kBuckets, 0);
+    };
+    segmentPass<Level2>(
+        [&](Level2& l, const Segment& s) {
+          const uint64_t top = s.key >> 48;
+          if (top > static_cast<uint64_t>(b1)) {
+            buy(s, l.used);
+          } else if (top == static_cast<uint64_t>(b1)) {
+            l.cost[(s.key >> 32) & 0xffff] += s.to - s.from;
+          }
+        },
+        [&](const Level2& l) {
+          used_ += l.used;
+          for (int b = 0; b < kBuckets; ++b) cost2[b] += l.cost[b];
+        });
     int64_t cum2 = 0;
     const int b2 = criticalBucket(cost2, budget - cum, cum2);
     MFR_CHECK(b2 >= 0);
     const uint64_t prefix = (static_cast<uint64_t>(b1) << 16) | static_cast<uint64_t>(b2);
     // chunk 0: the critical 32-bit prefix, buying whole what lies above it in b1
+    struct Chunk {
+      uint64_t used = 0;
+      std::vector<Segment> segments;
+    };
     std::vector<Segment> chunk;
-    forEachSegment([&](const Segment& s) {
-      const uint64_t top32 = s.key >> 32;
-      if ((top32 >> 16) != static_cast<uint64_t>(b1)) return;
-      if (top32 > prefix) {
-        buy(s);
-      } else if (top32 == prefix) {
-        chunk.push_back(s);
-      }
-    });
+    const auto gather = [&](const Chunk& c) {
+      used_ += c.used;
+      chunk.insert(chunk.end(), c.segments.begin(), c.segments.end());
+    };
+    segmentPass<Chunk>(
+        [&](Chunk& c, const Segment& s) {
+          const uint64_t top32 = s.key >> 32;
+          if ((top32 >> 16) != static_cast<uint64_t>(b1)) return;
+          if (top32 > prefix) {
+            buy(s, c.used);
+          } else if (top32 == prefix) {
+            c.segments.push_back(s);
+          }
+        },
+        gather);
     process(chunk, out.lambda);
     // lower keys, in chunks: [lower, upper)
     uint64_t upper = prefix << 32;
@@ -171,9 +230,11 @@ class HullAllocator {
         count += count1[bucket];
       }
       chunk.clear();
-      forEachSegment([&](const Segment& s) {
-        if (s.key >= lower && s.key < upper) chunk.push_back(s);
-      });
+      segmentPass<Chunk>(
+          [&](Chunk& c, const Segment& s) {
+            if (s.key >= lower && s.key < upper) c.segments.push_back(s);
+          },
+          gather);
       process(chunk, out.lambda);
       upper = lower;
     }
@@ -210,47 +271,60 @@ class HullAllocator {
     return -1;
   }
 
+  // fold(state, segment) over every segment, one State per worker; then combine(state) for each
+  template <class State, class Fold, class Combine>
+  void segmentPass(Fold&& fold, Combine&& combine) const {
+    tbb::enumerable_thread_specific<State> states;
+    forEachPixel(curves_.size(), [&](size_t p) {
+      State& state = states.local();
+      forEachSegmentOf(p, [&](const Segment& s) { fold(state, s); });
+    });
+    for (const State& state : states) combine(state);
+  }
+
   void buildHulls() {
     start_.assign(curves_.size() + 1, 0);
     uint64_t total = 0;
     for (size_t p = 0; p < curves_.size(); ++p) {
       start_[p] = total;
       total += curves_[p].size();
+      used_ += !curves_[p].empty();  // every covered pixel starts at k = 1
     }
     start_.back() = total;
     hull_.resize(total);
     length_.assign(curves_.size(), 0);
-    for (size_t p = 0; p < curves_.size(); ++p) {
-      const std::vector<double>& e = curves_[p];
-      if (e.empty()) continue;
-      (*k_)[p] = 1;
-      ++used_;
-      // lower convex hull of (k, e(k)), k = 1..n (monotone chain)
-      uint32_t* hull = hull_.data() + start_[p];
-      uint32_t size = 0;
-      for (uint32_t x = 1; x <= e.size(); ++x) {
-        while (size >= 2) {
-          const uint32_t a = hull[size - 2], b = hull[size - 1];
-          // drop b if it lies on or above the line from a to x
-          const double cross = (e[b - 1] - e[a - 1]) * (x - a) - (e[x - 1] - e[a - 1]) * (b - a);
-          if (cross >= 0.0) {
-            --size;
-          } else {
-            break;
-          }
+    forEachPixel(curves_.size(), [&](size_t p) { buildHull(p); });
+  }
+
+  void buildHull(size_t p) {
+    const std::vector<double>& e = curves_[p];
+    if (e.empty()) return;
+    (*k_)[p] = 1;
+    // lower convex hull of (k, e(k)), k = 1..n (monotone chain)
+    uint32_t* hull = hull_.data() + start_[p];
+    uint32_t size = 0;
+    for (uint32_t x = 1; x <= e.size(); ++x) {
+      while (size >= 2) {
+        const uint32_t a = hull[size - 2], b = hull[size - 1];
+        // drop b if it lies on or above the line from a to x
+        const double cross = (e[b - 1] - e[a - 1]) * (x - a) - (e[x - 1] - e[a - 1]) * (b - a);
+        if (cross >= 0.0) {
+          --size;
+        } else {
+          break;
         }
-        hull[size++] = x;
       }
-      // cut the chain before its first rising drop
-      uint32_t live = 1;
-      double previous = std::numeric_limits<double>::infinity();
-      for (; live < size; ++live) {
-        const double d = dropPerSlot(e, hull[live - 1], hull[live]);
-        if (d > previous) break;
-        previous = d;
-      }
-      length_[p] = live;
+      hull[size++] = x;
     }
+    // cut the chain before its first rising drop
+    uint32_t live = 1;
+    double previous = std::numeric_limits<double>::infinity();
+    for (; live < size; ++live) {
+      const double d = dropPerSlot(e, hull[live - 1], hull[live]);
+      if (d > previous) break;
+      previous = d;
+    }
+    length_[p] = live;
   }
 
   static double dropPerSlot(const std::vector<double>& e, uint32_t from, uint32_t to) {
@@ -258,26 +332,25 @@ class HullAllocator {
   }
 
   template <class F>
-  void forEachSegment(F&& f) const {
-    for (size_t p = 0; p < curves_.size(); ++p) {
-      const uint32_t* hull = hull_.data() + start_[p];
-      for (uint32_t i = 1; i < length_[p]; ++i) {
-        Segment s;
-        s.dropPerSlot = dropPerSlot(curves_[p], hull[i - 1], hull[i]);
-        s.key = orderKey(s.dropPerSlot);
-        s.index = start_[p] + i;
-        s.pixel = static_cast<uint32_t>(p);
-        s.from = hull[i - 1];
-        s.to = hull[i];
-        f(s);
-      }
+  void forEachSegmentOf(size_t p, F&& f) const {
+    const uint32_t* hull = hull_.data() + start_[p];
+    for (uint32_t i = 1; i < length_[p]; ++i) {
+      Segment s;
+      s.dropPerSlot = dropPerSlot(curves_[p], hull[i - 1], hull[i]);
+      s.key = orderKey(s.dropPerSlot);
+      s.index = start_[p] + i;
+      s.pixel = static_cast<uint32_t>(p);
+      s.from = hull[i - 1];
+      s.to = hull[i];
+      f(s);
     }
   }
 
-  // a segment above the critical one: bought whole (its chain's earlier segments are too)
-  void buy(const Segment& s) {
+  // a segment above the critical one: bought whole (its chain's earlier segments are too); only
+  // its own pixel's k changes, and `used` (the caller's share of the slots) grows by its cost
+  void buy(const Segment& s, uint64_t& used) const {
     (*k_)[s.pixel] = std::max((*k_)[s.pixel], s.to);
-    used_ += s.to - s.from;
+    used += s.to - s.from;
   }
 
   bool done() const { return critical_ && used_ >= slots_; }
@@ -397,9 +470,13 @@ OracleAllocation allocateOptimal(const std::vector<std::vector<double>>& curves,
                                  const OracleOptions& options) {
   OracleAllocation out;
   uint64_t fragments = 0;
-  for (const std::vector<double>& e : curves) {
-    fragments += e.size();
-    out.nonconvexPixels += !errorCurveIsConvex(e);
+  {
+    std::vector<uint8_t> nonconvex(curves.size(), 0);
+    forEachPixel(curves.size(), [&](size_t p) { nonconvex[p] = !errorCurveIsConvex(curves[p]); });
+    for (size_t p = 0; p < curves.size(); ++p) {
+      fragments += curves[p].size();
+      out.nonconvexPixels += nonconvex[p];
+    }
   }
   if (fragments <= slots) {  // every fragment fits: the exact image
     out.k.resize(curves.size());
@@ -414,15 +491,16 @@ OracleAllocation allocateOptimal(const std::vector<std::vector<double>>& curves,
   const double lambda = hull.lambda;
   // Lagrangian bound: sum_p min_k (err_p(k) + lambda k) - lambda F <= any feasible error
   std::vector<double> floorCost(curves.size(), 0.0);
-  double bound = -lambda * static_cast<double>(slots);
-  for (size_t p = 0; p < curves.size(); ++p) {
+  forEachPixel(curves.size(), [&](size_t p) {
     const std::vector<double>& e = curves[p];
-    if (e.empty()) continue;
+    if (e.empty()) return;
     double m = std::numeric_limits<double>::infinity();
     for (uint32_t x = 1; x <= e.size(); ++x) m = std::min(m, e[x - 1] + lambda * x);
     floorCost[p] = m;
-    bound += m;
-  }
+  });
+  double bound = -lambda * static_cast<double>(slots);
+  for (size_t p = 0; p < curves.size(); ++p)  // in pixel order: the same sum on any workers
+    if (!curves[p].empty()) bound += floorCost[p];
   const double hullError = allocationError(curves, hull.k);
   out.lagrangianBound = std::max(0.0, std::min(bound, hullError));
   out.k = std::move(hull.k);
@@ -450,22 +528,29 @@ OracleAllocation allocateOptimal(const std::vector<std::vector<double>>& curves,
 
   // reduced-cost fixing: an improving allocation keeps every r_p(k_p) below the gap
   const double gap = out.error - out.lowerBound + tolerance;
+  const auto isCandidate = [&](size_t p, uint32_t x) {
+    return x == out.k[p] || curves[p][x - 1] + lambda * x - floorCost[p] <= gap;
+  };
+  // the pixels with more than one candidate k (few), found in parallel, then listed in order
+  std::vector<uint8_t> several(curves.size(), 0);
+  forEachPixel(curves.size(), [&](size_t p) {
+    uint32_t count = 0;
+    for (uint32_t x = 1; x <= curves[p].size() && count < 2; ++x) count += isCandidate(p, x);
+    several[p] = count > 1;
+  });
   std::vector<uint32_t> core;
   std::vector<std::vector<uint32_t>> coreOptions;
   uint64_t fixedSlots = 0;
-  std::vector<uint32_t> candidates;
   for (size_t p = 0; p < curves.size(); ++p) {
-    const std::vector<double>& e = curves[p];
-    if (e.empty()) continue;
-    candidates.clear();
-    for (uint32_t x = 1; x <= e.size(); ++x)
-      if (x == out.k[p] || e[x - 1] + lambda * x - floorCost[p] <= gap) candidates.push_back(x);
-    if (candidates.size() == 1) {
+    if (curves[p].empty()) continue;
+    if (!several[p]) {
       fixedSlots += out.k[p];
       continue;
     }
+    std::vector<uint32_t>& candidates = coreOptions.emplace_back();
+    for (uint32_t x = 1; x <= curves[p].size(); ++x)
+      if (isCandidate(p, x)) candidates.push_back(x);
     core.push_back(static_cast<uint32_t>(p));
-    coreOptions.push_back(candidates);
   }
   out.corePixels = core.size();
   uint64_t coreBase = 0;

@@ -1,7 +1,5 @@
 #include "mfr/method/stats_json.hpp"
 
-#include "mfr/core/isa.hpp"
-
 namespace mfr {
 
 nlohmann::json statsToJson(const RenderStats& s) {
@@ -33,14 +31,8 @@ nlohmann::json statsToJson(const RenderStats& s) {
   for (const PassTime& p : s.passes) times[p.name] = p.ms;
   j["time_ms"] = times;
   if (!s.engine.empty()) j["engine"] = s.engine;
-  // the engine's instruction-set path travels as the counter "isa" (an Isa value) and is written
-  // by name beside the engine: "isa": "avx2"
-  for (const auto& [name, value] : s.engineCounters) {
-    if (name == "isa")
-      j["isa"] = isaName(static_cast<Isa>(static_cast<int>(value)));
-    else
-      j["engine_counters"][name] = value;
-  }
+  if (!s.isa.empty()) j["isa"] = s.isa;
+  for (const auto& [name, value] : s.engineCounters) j["engine_counters"][name] = value;
   j["total_ms"] = s.totalMs();
   if (s.oracle) {
     const OracleReport& o = *s.oracle;

@@ -5,10 +5,16 @@
 //   f_X(t)   = mean LDR-FLIP between frames t-1 and t of X          (t = 1 .. N-1)
 //   flicker  = mean over t of f_X(t)
 //   excess   = mean over t of (f_method(t) - f_ground truth(t))     ("excess flicker")
+//   e_X(t)   = mean over pixels and RGB of |(X_t - G_t) - (X_t-1 - G_t-1)| / 255
+//   error change = mean over t of e_X(t)
 //
 // The ground truth's own f(t) is the change the camera motion causes; a method whose images are
 // the ground truth's (the A-buffer, or any method with room for every fragment) has excess 0
-// exactly, and a method whose error pattern jumps between frames has a positive excess. The
+// exactly, and a method whose error pattern jumps between frames has a positive excess. Excess
+// flicker alone can mislead: a lossy method renders a smoother image, which changes less between
+// frames than the exact one, so its excess is often negative however its error behaves. The error
+// change measures the error itself: 0 for a method with no error or a fixed one, and large when
+// the error pattern moves or pops (a changing k(p), screen-space noise over moving content). The
 // images compared are the sRGB8 images as written, like every metric of mfr compare. Frames are
 // added one at a time and only the previous frame's images are kept, so a long path costs the
 // memory of two frames.
@@ -38,8 +44,10 @@ struct TemporalSeries {
   std::string budgetLabel;
   std::vector<double> consecutiveFlip;  // f(t) for t = 1 .. N-1; NaN where a frame failed
   std::vector<double> errorFlip;        // mean FLIP against the ground truth per frame; NaN: failed
-  double flicker = 0.0;        // mean of consecutiveFlip (NaN if any transition is missing)
-  double excessFlicker = 0.0;  // mean of consecutiveFlip - the ground truth's (NaN likewise)
+  std::vector<double> errorChange;      // e(t) for t = 1 .. N-1; NaN where a frame failed
+  double flicker = 0.0;          // mean of consecutiveFlip (NaN if any transition is missing)
+  double excessFlicker = 0.0;    // mean of consecutiveFlip - the ground truth's (NaN likewise)
+  double meanErrorChange = 0.0;  // mean of errorChange (NaN likewise)
 };
 
 struct TemporalResult {
@@ -68,16 +76,21 @@ class TemporalStability {
 };
 
 /// results.json's "temporal" object: frames, definition, ground_truth {consecutive_flip, flicker},
-/// series [{method, budget_label, consecutive_flip, error_flip, flicker, excess_flicker}] (NaN as
-/// null).
+/// series [{method, budget_label, consecutive_flip, error_flip, error_change, flicker,
+/// excess_flicker, mean_error_change}] (NaN as null).
 nlohmann::json temporalToJson(const TemporalResult& result);
 
-/// f_method(t) - f_ground truth(t) over t for every method at `budgetLabel` (one line each).
-Result<Image8> temporalPlot(const TemporalResult& result, const std::string& budgetLabel);
+/// What a temporal plot draws over t.
+enum class TemporalMeasure { ExcessFlicker, ErrorChange };
 
-/// A self-contained page: the set-up, the flicker table (method, budget, flicker, excess, mean
-/// FLIP against the ground truth over the frames), one plot per budget (`plotFiles`, relative
-/// file names in budget order) and links to the frames' own reports (`frameFolders`).
+/// f_method(t) - f_ground truth(t) (ExcessFlicker) or e_method(t) (ErrorChange) over t for every
+/// method at `budgetLabel` (one line each).
+Result<Image8> temporalPlot(const TemporalResult& result, const std::string& budgetLabel,
+                            TemporalMeasure measure = TemporalMeasure::ExcessFlicker);
+
+/// A self-contained page: the set-up, the flicker table (method, budget, flicker, excess, error
+/// change, mean FLIP against the ground truth over the frames), the plots (`plotFiles`, relative
+/// file names) and links to the frames' own reports (`frameFolders`).
 std::string temporalReportHtml(const TemporalResult& result, const std::string& scene, int width,
                                int height, const std::vector<std::string>& plotFiles,
                                const std::vector<std::string>& frameFolders,

@@ -69,6 +69,16 @@ struct TileRect {
   int x0, y0, x1, y1;  // inclusive
 };
 
+/// What a wide (SIMD) rasterizer reads of a frame, besides its set-ups and bins, to shade exactly
+/// as RasterFrame does: the materials, the view-ray reconstruction (the view-space direction of
+/// pixel centre (x, y) is (x * rayScaleX + rayBiasX, y * rayScaleY + rayBiasY, -1)) and the colour
+/// tables. Valid while the frame lives.
+struct ShadingInputs {
+  const std::vector<ShadeMaterial>* materials = nullptr;
+  float rayScaleX = 0, rayBiasX = 0, rayScaleY = 0, rayBiasY = 0;
+  const ColorTables* tables = nullptr;
+};
+
 /// One view of a scene, set up for the tile passes: what render() (method/render.hpp) and
 /// runComparison (compare/compare.hpp) take.
 ///
@@ -113,6 +123,11 @@ class RasterFrame {
   /// Rasterizes one set-up triangle over the whole viewport (fragment-parallel capture).
   template <ShadeMode Mode, class Sink>
   void rasterizeTriangle(size_t setupIndex, Sink&& sink) const;
+
+  /// The shading inputs of a wide rasterizer (cpu/raster_span_avx2.hpp).
+  ShadingInputs shadingInputs() const {
+    return {&materials_, rayScaleX_, rayBiasX_, rayScaleY_, rayBiasY_, colorTables_};
+  }
 
   /// Runs fn(tile) for every tile on the frame's worker threads, each tile on one worker.
   template <class Fn>

@@ -23,6 +23,9 @@
 //     minimum. When the core is too large for the programme's cell limit, the better of the hull
 //     and the published greedy is returned and the bound with its gap is reported.
 // Presets optimal / optimal-greedy run them on an exact A-buffer pre-pass (optimal_oracle.hpp).
+// allocateOptimalHull and allocateOptimal run their per-pixel passes on the calling oneTBB task
+// arena's workers (the CPU engine calls them in an arena of its thread count); the result is the
+// same bits for any number of workers.
 #pragma once
 
 #include <cstdint>

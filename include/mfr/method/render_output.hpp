@@ -91,6 +91,9 @@ struct RenderStats {
   /// tile_workers), beside the shared fields above.
   std::string engine;
   std::map<std::string, double> engineCounters;
+  /// The instruction-set path the CPU engine's capture ran on ("scalar", "avx2": isaName of
+  /// core/isa.hpp); empty for an engine that has none (OpenGL).
+  std::string isa;
   double lostPercent() const {
     return fragmentsGenerated ? 100.0 * static_cast<double>(lost) / fragmentsGenerated : 0.0;
   }
