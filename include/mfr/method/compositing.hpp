@@ -42,15 +42,21 @@ static_assert(sizeof(HybridTail) == 20);
 
 /// Front-to-back over of `n` sorted nodes; returns the colour and leaves the transmittance in T.
 inline glm::vec3 compositeCore(const FragmentNode* sorted, uint32_t n, float& transmittance) {
-  glm::vec3 color(0.0f);
-  float T = 1.0f;
+  // scalar channels in registers (glm's vec3 kept the sums on the stack: a store-to-load in
+  // every step of this dependency chain); the same operations, in the same order
+  const ColorTables& t = ColorTables::get();
+  float r = 0.0f, g = 0.0f, b = 0.0f, T = 1.0f;
   for (uint32_t i = 0; i < n; ++i) {
-    const glm::vec4 c = unpackFragmentColor(nodeColor(sorted[i]));
-    color += glm::vec3(c) * (c.a * T);
-    T *= 1.0f - c.a;
+    const uint32_t rgba = nodeColor(sorted[i]);
+    const float a = static_cast<float>(rgba >> 24) * (1.0f / 255.0f);
+    const float w = a * T;
+    r += t.srgb8ToLinear[rgba & 0xffu] * w;
+    g += t.srgb8ToLinear[(rgba >> 8) & 0xffu] * w;
+    b += t.srgb8ToLinear[(rgba >> 16) & 0xffu] * w;
+    T *= 1.0f - a;
   }
   transmittance = T;
-  return color;
+  return {r, g, b};
 }
 
 inline glm::vec3 compositeKBuffer(const FragmentNode* sorted, uint32_t n, glm::vec3 background) {
