@@ -147,18 +147,28 @@ TEST(OracleReference, TileLocalCurvesEqualTheWholeFrameABuffersForBothRules) {
   }
 }
 
+/// A procedural:hairball view's error curves under `rule`, with their covered pixels and
+/// fragments.
+struct SceneCurves {
+  std::vector<std::vector<double>> curves;
+  uint64_t covered = 0, fragments = 0;
+};
+SceneCurves hairballCurves(int strands, int size, Compositing rule) {
+  const Scene scene = loadScene("procedural:hairball?strands=" + std::to_string(strands)).value();
+  const RasterFrame frame =
+      RasterFrame::build(scene, *scene.defaultCamera, RasterOptions{size, size, 16, 2}).value();
+  SceneCurves out;
+  out.curves = frameErrorCurves(frame, glm::vec3(1.0f), rule).value().curves;
+  for (const auto& e : out.curves) {
+    out.covered += !e.empty();
+    out.fragments += e.size();
+  }
+  return out;
+}
+
 TEST(OracleReference, HullAllocationEqualsSortingEverySegmentOnSceneCurves) {
-  auto scene = loadScene("procedural:hairball?strands=300");
-  ASSERT_TRUE(scene.ok());
-  auto frame = RasterFrame::build(*scene, *scene->defaultCamera, RasterOptions{96, 96, 16, 2});
-  ASSERT_TRUE(frame.ok());
   for (Compositing rule : {Compositing::Hybrid, Compositing::KBuffer}) {
-    const auto curves = frameErrorCurves(*frame, glm::vec3(1.0f), rule).value().curves;
-    uint64_t covered = 0, fragments = 0;
-    for (const auto& e : curves) {
-      covered += !e.empty();
-      fragments += e.size();
-    }
+    const auto [curves, covered, fragments] = hairballCurves(300, 96, rule);
     for (double share : {0.0, 0.05, 0.3, 0.7, 0.99, 1.0})
       for (uint64_t chunk : {uint64_t{1}, uint64_t{64}, uint64_t{1} << 20}) {
         const uint64_t slots = covered + static_cast<uint64_t>(share * (fragments - covered));
@@ -172,18 +182,9 @@ TEST(OracleReference, HullAllocationEqualsSortingEverySegmentOnSceneCurves) {
 // The allocators' per-pixel passes run on the caller's task arena (workers fold ranges of pixels
 // and their states combine in any order): one worker and four give the same bits.
 TEST(OracleReference, AllocationIsTheSameOnOneWorkerAndOnFour) {
-  auto scene = loadScene("procedural:hairball?strands=600");
-  ASSERT_TRUE(scene.ok());
-  auto frame = RasterFrame::build(*scene, *scene->defaultCamera, RasterOptions{256, 256, 16, 2});
-  ASSERT_TRUE(frame.ok());
   const tbb::global_control four(tbb::global_control::max_allowed_parallelism, 4);
   for (Compositing rule : {Compositing::Hybrid, Compositing::KBuffer}) {
-    const auto curves = frameErrorCurves(*frame, glm::vec3(1.0f), rule).value().curves;
-    uint64_t covered = 0, fragments = 0;
-    for (const auto& e : curves) {
-      covered += !e.empty();
-      fragments += e.size();
-    }
+    const auto [curves, covered, fragments] = hairballCurves(600, 256, rule);
     // 16 tasks of 4096 pixels (the allocator's grain), most of them covered
     ASSERT_EQ(curves.size(), 16u * 4096u);
     ASSERT_GT(covered, curves.size() / 3);
