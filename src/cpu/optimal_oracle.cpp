@@ -1,16 +1,23 @@
 // The optimal k-buffer's pre-pass (DHOIT sec. 3.1.2): every pixel's fragments, sorted, and their
 // error curves.
 //
-// The curves are built tile by tile: a count pass gives n(p); then each worker rasterizes one tile
-// with full shading into a tile-local A-buffer (the tile's n(p) summed, nodes grouped by pixel),
-// sorts each pixel's nodes and writes its curve. The nodes are exactly the A-buffer's (every
-// fragment, the same shading, makeNode) and their sorted order does not depend on the arrival
-// order, so the curves are those of a whole-frame A-buffer without its 8 bytes per fragment
-// (twice, with the kept copy) ever existing at once: the pre-pass holds n(p), the curves and one
-// tile's nodes per worker.
+// The curves are built tile by tile, without a count pass: each worker rasterizes one tile with
+// full shading into its scratch (local pixel, node) in arrival order, counts per pixel, groups the
+// nodes by pixel (a counting sort, which keeps each pixel's arrival order), sorts each pixel's
+// nodes and writes its curve and n(p). The nodes are exactly the A-buffer's (every fragment, the
+// same shading, makeNode) and their sorted order does not depend on the arrival order, so the
+// curves are those of a whole-frame A-buffer without its 8 bytes per fragment (twice, with the
+// kept copy) ever existing at once: the pre-pass holds n(p), the curves and one tile's nodes per
+// worker.
+//
+// Memory: n(p) and the curves (8 bytes per fragment, a vector per pixel) are checked against the
+// limit as the tiles add their fragments, before each tile's curves are allocated. Once the sum
+// exceeds it, the remaining tiles only count their fragments (coverage), so the error names the
+// frame's whole fragment count, as a count pass up front would (and costs no more than one).
 #include "mfr/cpu/optimal_oracle.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <string>
 
 #include <tbb/task_arena.h>
@@ -25,51 +32,94 @@ namespace mfr {
 Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 background,
                                           Compositing compositing,
                                           std::optional<uint64_t> memoryLimitBytes) {
+  const uint64_t limit = memoryLimitBytes.value_or(defaultMemoryLimit());
+  const uint64_t pixels = frame.pixelCount();
+  // n(p) and the curves of `fragments` fragments (8 bytes each, a vector per pixel)
+  const auto needed = [&](uint64_t fragments) {
+    return saturatingAdd(saturatingAdd(saturatingMul(fragments, sizeof(double)),
+                                       saturatingMul(pixels, sizeof(std::vector<double>))),
+                         saturatingMul(pixels, sizeof(uint32_t)));
+  };
+  const auto check = [&](uint64_t fragments) {
+    return checkMemory(needed(fragments), limit,
+                       "the error curves of " + std::to_string(fragments) + " fragments at " +
+                           std::to_string(frame.width()) + " x " + std::to_string(frame.height()) +
+                           " pixels");
+  };
+  // fragments per tile; kUncounted until a tile is rasterized or counted
+  constexpr uint64_t kUncounted = UINT64_MAX;
+  std::vector<uint64_t> tileFragments(static_cast<size_t>(frame.tileCount()), kUncounted);
+  // the error, with the frame's whole fragment count (coverage-only for the uncounted tiles)
+  const auto overLimit = [&] {
+    frame.forEachTile([&](int tile) {
+      if (tileFragments[tile] != kUncounted) return;
+      uint64_t count = 0;
+      frame.rasterizeTile<ShadeMode::Coverage>(tile,
+                                               CoverageAll{[&](uint32_t, float) { ++count; }});
+      tileFragments[tile] = count;
+    });
+    uint64_t total = 0;
+    for (uint64_t c : tileFragments) total += c;
+    return check(total).error();
+  };
+  if (needed(0) > limit) return overLimit();
+
   FrameErrorCurves out;
-  out.n = countFragments(frame);
-  for (uint32_t c : out.n) {
-    out.coveredPixels += c > 0;
-    out.fragments += c;
-  }
-  // memory pre-flight: n(p) and the curves (8 bytes per fragment, a vector per pixel)
-  const uint64_t curveBytes =
-      saturatingAdd(saturatingMul(out.fragments, sizeof(double)),
-                    saturatingMul(frame.pixelCount(), sizeof(std::vector<double>)));
-  MFR_TRY(checkMemory(saturatingAdd(curveBytes, out.n.capacity() * sizeof(uint32_t)),
-                      memoryLimitBytes.value_or(defaultMemoryLimit()),
-                      "the error curves of " + std::to_string(out.fragments) + " fragments at " +
-                          std::to_string(frame.width()) + " x " + std::to_string(frame.height()) +
-                          " pixels"));
-  out.curves.resize(frame.pixelCount());
+  out.n.assign(pixels, 0);
+  out.curves.resize(pixels);
+  std::atomic<uint64_t> fragments{0};
+  std::atomic<bool> over{false};
   const double inverseWidth = 1.0 / frame.width();
   frame.forEachTile([&](int tile) {
+    if (over.load(std::memory_order_relaxed)) return;
     const TileRect r = frame.tileRect(tile);
     const int w = r.x1 - r.x0 + 1, h = r.y1 - r.y0 + 1;
-    // tile-local A-buffer: pixel i's nodes at first[i] .. first[i] + n
-    std::vector<uint32_t> first(static_cast<size_t>(w) * h + 1, 0), filled(first.size() - 1, 0);
-    for (int y = r.y0, i = 0; y <= r.y1; ++y)
-      for (int x = r.x0; x <= r.x1; ++x, ++i)
-        first[i + 1] = first[i] + out.n[static_cast<size_t>(y) * frame.width() + x];
-    std::vector<FragmentNode> nodes(first.back());
     const uint32_t origin = static_cast<uint32_t>(r.y0) * frame.width() + r.x0;
+    // the tile's fragments in arrival order (local pixel, node), then grouped by pixel in
+    // `nodes` (the worker's scratch, reused from tile to tile)
+    thread_local std::vector<uint32_t> local, first;
+    thread_local std::vector<FragmentNode> arrived, nodes;
+    local.clear();
+    arrived.clear();
     frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
                                            // row and column in the tile without an integer
                                            // division: (d + 0.5) / width is exact enough
                                            const uint32_t d = f.pixel - origin;
                                            const uint32_t y =
                                                static_cast<uint32_t>((d + 0.5) * inverseWidth);
-                                           const uint32_t i = y * w + (d - y * frame.width());
-                                           nodes[first[i] + filled[i]++] = makeNode(f);
+                                           local.push_back(y * w + (d - y * frame.width()));
+                                           arrived.push_back(makeNode(f));
                                          }});
+    tileFragments[tile] = arrived.size();
+    const uint64_t sum = fragments.fetch_add(arrived.size()) + arrived.size();
+    if (needed(sum) > limit) {
+      over.store(true);
+      return;
+    }
+    // counting sort: first[i] = the start of pixel i's nodes, then, after the scatter, their end
+    first.assign(static_cast<size_t>(w) * h + 1, 0);
+    for (uint32_t i : local) ++first[i + 1];
+    for (size_t i = 1; i < first.size(); ++i) first[i] += first[i - 1];
+    nodes.resize(arrived.size());
+    for (size_t j = 0; j < arrived.size(); ++j) nodes[first[local[j]]++] = arrived[j];
     for (int y = r.y0, i = 0; y <= r.y1; ++y)
       for (int x = r.x0; x <= r.x1; ++x, ++i) {
         const size_t p = static_cast<size_t>(y) * frame.width() + x;
-        MFR_CHECK(filled[i] == out.n[p]);  // the count pass and the shaded pass agree
-        FragmentNode* begin = nodes.data() + first[i];
-        std::sort(begin, begin + filled[i]);
-        out.curves[p] = errorCurve(begin, filled[i], background, compositing);
+        const uint32_t begin = i == 0 ? 0 : first[i - 1], n = first[i] - begin;
+        FragmentNode* px = nodes.data() + begin;
+        std::sort(px, px + n);
+        out.n[p] = n;
+        out.curves[p] = errorCurve(px, n, background, compositing);
       }
   });
+  if (over) {
+    out = FrameErrorCurves{};  // free the curves before counting the rest
+    return overLimit();
+  }
+  for (uint32_t c : out.n) {
+    out.coveredPixels += c > 0;
+    out.fragments += c;
+  }
   out.bytesAllocated =
       out.n.capacity() * sizeof(uint32_t) + out.curves.capacity() * sizeof(std::vector<double>);
   for (const std::vector<double>& c : out.curves)
