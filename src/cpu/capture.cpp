@@ -206,15 +206,33 @@ struct LaneCaptureSink {
     emitLane(f, cullDepthRow(y - tile.y0) + (x - tile.x0));
   }
 };
+
+/// The lane protocol over the tile-owned hybrid sink: hybrid compositing shades every fragment
+/// (the rejected ones feed the tail), so no lane is culled before shading (every cull depth is
+/// INT32_MAX) and each shaded lane goes through the scalar sink's tests, insertion and tail.
+template <bool Occupancy, bool KPlus>
+struct LaneHybridSink {
+  using Inner = CaptureSink<true, Occupancy, KPlus, PlainAccess, NoLock>;
+  static constexpr bool kCullsInLanes = false;
+
+  Inner inner;
+  std::vector<int32_t> noCull;  // one row of INT32_MAX, shared by every row
+
+  void beginTile(const TileRect&, int tileSize) { noCull.assign(tileSize, INT32_MAX); }
+  int32_t* cullDepthRow(int) { return noCull.data(); }
+  void countEarly(uint32_t generated, uint32_t) { inner.counters.generated += generated; }
+  void emitLane(const Fragment& f, int32_t*) { inner.emit(f); }
+  // the scalar protocol, for the tiles the lanes do not take (textured, alpha-masked)
+  bool accept(uint32_t p, float depth) { return inner.accept(p, depth); }
+  void emit(const Fragment& f) { inner.emit(f); }
+};
 #endif
 
-/// The instruction set the capture of this method runs on: the 8-lane kernel serves tile-owned
-/// kbuffer compositing (hybrid shades every fragment, fragment-parallel has no tiles).
+/// The instruction set the capture of this method runs on: the 8-lane kernel serves the
+/// tile-owned captures (fragment-parallel capture has no tiles).
 Isa captureIsa(const MethodDesc& method, CaptureMode mode) {
 #if MFR_HAS_AVX2_KERNELS
-  if (mode == CaptureMode::TileOwned && method.compositing == Compositing::KBuffer &&
-      activeIsa() >= Isa::Avx2)
-    return Isa::Avx2;
+  if (mode == CaptureMode::TileOwned && activeIsa() >= Isa::Avx2) return Isa::Avx2;
 #endif
   (void)method;
   (void)mode;
@@ -227,21 +245,26 @@ CaptureCounters runCapture(const RasterFrame& frame, const Allocation& alloc,
                            Stores& stores) {
   CaptureCounters total;
 #if MFR_HAS_AVX2_KERNELS
-  if constexpr (!Hybrid) {
-    if (isa == Isa::Avx2) {
-      const ShadingInputs inputs = frame.shadingInputs();
-      std::vector<CaptureCounters> perTile(static_cast<size_t>(frame.tileCount()));
-      frame.forEachTile([&](int tile) {
-        thread_local std::vector<int32_t> cullDepth;  // reused by the worker's tiles
+  if (isa == Isa::Avx2) {
+    const ShadingInputs inputs = frame.shadingInputs();
+    std::vector<CaptureCounters> perTile(static_cast<size_t>(frame.tileCount()));
+    frame.forEachTile([&](int tile) {
+      thread_local std::vector<int32_t> cullDepth;  // reused by the worker's tiles
+      if constexpr (Hybrid) {
+        LaneHybridSink<Occupancy, KPlus> sink{{alloc, occupancy, stores, {}}, std::move(cullDepth)};
+        rasterizeTileAvx2(frame, inputs, tile, sink);
+        perTile[tile] = sink.inner.counters;
+        cullDepth = std::move(sink.noCull);
+      } else {
         LaneCaptureSink<Occupancy, KPlus> sink{
             {alloc, occupancy, stores, {}}, frame.width(), {}, 0, std::move(cullDepth)};
         rasterizeTileAvx2(frame, inputs, tile, sink);
         perTile[tile] = sink.inner.counters;
         cullDepth = std::move(sink.cullDepth);
-      });
-      for (const CaptureCounters& c : perTile) total.add(c);
-      return total;
-    }
+      }
+    });
+    for (const CaptureCounters& c : perTile) total.add(c);
+    return total;
   }
 #endif
   if (mode == CaptureMode::TileOwned) {

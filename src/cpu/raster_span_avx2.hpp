@@ -5,7 +5,8 @@
 // Per row span of a triangle, 8 pixels at a time:
 //   1. barycentrics and depth of the 8 pixel centres: the edge values are exact integers, carried
 //      in doubles (exact below 2^53) and rounded once to float, like the scalar int64 -> float;
-//   2. the k+ test on all 8: each pixel of the tile has a 32-bit "cull depth" (below),
+//   2. the k+ test on all 8 (kbuffer compositing; a hybrid sink's cull depths are all INT32_MAX,
+//      since it shades every fragment): each pixel of the tile has a 32-bit "cull depth" (below),
 //      compared with the 8 depths' bits at once;
 //   3. shading (n.v, headlight, sRGB encode with the colour tables as gathers) on the 8 lanes;
 //   4. the surviving lanes, in x order, go to the sink's scalar insertion.
