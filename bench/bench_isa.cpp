@@ -3,8 +3,8 @@
 // with the k+ test before shading), side by side in one run, the paths interleaved round by round
 // so that a shared machine's slow periods hit both alike. Issue 12's frame first:
 // procedural:layers?k=8&r=2&pd=0.55 (16 layers), kplus-heap, k = 8, kbuffer compositing; then the
-// hairball and the same layers with hybrid compositing (which runs the scalar capture on every
-// path) and the A-buffer (count pass).
+// hairball and the same layers with hybrid compositing (on the lanes too since 2026-12-02: every
+// fragment shaded, no early k+ test) and the A-buffer (count pass).
 //
 // For each (scene, method, path): per-pass median ms (count, capture, resolve) and the whole frame,
 // fragments/s per pass and per frame, and the speed-up of the path over the scalar one; the image
