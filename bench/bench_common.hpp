@@ -25,6 +25,7 @@
 #include "mfr/core/image.hpp"
 #include "mfr/core/plot.hpp"
 #include "mfr/core/result.hpp"
+#include "mfr/core/units.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/method.hpp"
@@ -46,6 +47,29 @@ struct Program {
 
 inline void printError(const Program& program, const std::string& message) {
   std::fprintf(stderr, "%s: %s\n", program.name, message.c_str());
+}
+
+/// Pulls "--budget BYTES" (e.g. 20MB) out of argv, before parseArgs, which knows only the common
+/// options; false (with a one-line error) when its value is missing or not a size.
+inline bool takeBudget(const Program& program, int& argc, char** argv,
+                       std::optional<uint64_t>& budget) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) != "--budget") continue;
+    if (i + 1 >= argc) {
+      printError(program, "--budget needs a value such as 20MB");
+      return false;
+    }
+    auto parsed = parseByteSize(argv[i + 1]);
+    if (!parsed) {
+      printError(program, parsed.error().message);
+      return false;
+    }
+    budget = *parsed;
+    for (int j = i; j + 2 <= argc; ++j) argv[j] = argv[j + 2];
+    argc -= 2;
+    --i;
+  }
+  return true;
 }
 
 /// Draws `series` into OUT/fileName and prints its path; false (with the message) if it failed.

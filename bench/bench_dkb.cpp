@@ -17,7 +17,6 @@
 // and (features + infer) / kplus, the goal (<= 25%). CSV: dkb.csv; chart: dkb.png
 // (features + inference per path and scene, with the kplus-dynamic frame).
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -49,21 +48,10 @@ struct PathRuns {
 }  // namespace
 
 int main(int argc, char** argv) {
-  uint64_t budget = 40ull << 20;
-  std::vector<char*> rest = {argv[0]};
-  for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
-      auto parsed = parseByteSize(argv[++i]);
-      if (!parsed) {
-        printError(kProgram, parsed.error().message);
-        return 2;
-      }
-      budget = *parsed;
-    } else {
-      rest.push_back(argv[i]);
-    }
-  }
-  const Args args = parseArgs(static_cast<int>(rest.size()), rest.data(), kProgram);
+  std::optional<uint64_t> budgetOption;
+  if (!takeBudget(kProgram, argc, argv, budgetOption)) return 2;
+  const uint64_t budget = budgetOption.value_or(40ull << 20);
+  const Args args = parseArgs(argc, argv, kProgram);
   auto model = builtinDkbModel();
   if (!model) {
     printError(kProgram, model.error().message);

@@ -38,18 +38,13 @@ double peakRssMiB() {
 }  // namespace
 
 int main(int argc, char** argv) {
-  uint64_t budget = 120ull << 20;
+  std::optional<uint64_t> budgetOption;
+  if (!takeBudget(kProgram, argc, argv, budgetOption)) return 2;
+  const uint64_t budget = budgetOption.value_or(120ull << 20);
   std::vector<Compositing> rules = {Compositing::Hybrid, Compositing::KBuffer};
   std::vector<char*> rest = {argv[0]};
   for (int i = 1; i < argc; ++i) {
-    if (std::strcmp(argv[i], "--budget") == 0 && i + 1 < argc) {
-      auto parsed = parseByteSize(argv[++i]);
-      if (!parsed) {
-        printError(kProgram, parsed.error().message);
-        return 2;
-      }
-      budget = *parsed;
-    } else if (std::strcmp(argv[i], "--rule") == 0 && i + 1 < argc) {
+    if (std::strcmp(argv[i], "--rule") == 0 && i + 1 < argc) {
       const std::string r = argv[++i];
       if (r == "hybrid") {
         rules = {Compositing::Hybrid};

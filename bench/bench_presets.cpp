@@ -41,27 +41,6 @@ constexpr Program kProgram{
 constexpr uint64_t kBudgetAt1024 = 20ull << 20;  // M = 20 MiB at 1024x1024
 constexpr float kAlphaOverride = 0.5f;           // real scenes rendered fully transparent
 
-// Pulls "--budget M" out of argv (the shared parser knows only the common options).
-bool takeBudget(int& argc, char** argv, std::optional<uint64_t>& budget) {
-  for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) != "--budget") continue;
-    if (i + 1 >= argc) {
-      std::fprintf(stderr, "%s: --budget needs a value such as 20MB\n", argv[0]);
-      return false;
-    }
-    auto parsed = parseByteSize(argv[i + 1]);
-    if (!parsed) {
-      std::fprintf(stderr, "%s: %s\n", argv[0], parsed.error().message.c_str());
-      return false;
-    }
-    budget = *parsed;
-    for (int j = i; j + 2 <= argc; ++j) argv[j] = argv[j + 2];
-    argc -= 2;
-    --i;
-  }
-  return true;
-}
-
 // Passes outside the table's fixed columns (e.g. the variable k-buffer's nearest-normal and
 // importance passes): summed into "other", their names joined by '+'.
 double otherMs(const Case& m, std::string& names) {
@@ -82,7 +61,7 @@ double otherMs(const Case& m, std::string& names) {
 
 int main(int argc, char** argv) {
   std::optional<uint64_t> budgetOption;
-  if (!takeBudget(argc, argv, budgetOption)) return 2;
+  if (!takeBudget(kProgram, argc, argv, budgetOption)) return 2;
   const Args args = parseArgs(argc, argv, kProgram);
   const double pixelScale = static_cast<double>(args.size) * args.size / (1024.0 * 1024.0);
   const uint64_t budget =

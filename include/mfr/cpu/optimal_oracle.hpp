@@ -1,8 +1,8 @@
 // The optimal k-buffer's pre-pass over a frame (DHOIT sec. 3.1.2): an exact A-buffer, each pixel's
 // fragments sorted, and its hybrid error curve err_p(k) (optimal_allocation.hpp). The A-buffer is
 // tile-local (each worker rasterizes one tile's fragments, groups them by pixel and sorts them;
-// no count pass), so only n(p) and the curves exist for the whole frame. The curves do not depend on the budget, so one pre-pass serves any
-// number of budgets (mfr dataset).
+// no count pass), so only n(p) and the curves exist for the whole frame. The curves do not depend
+// on the budget, so one pre-pass serves any number of budgets (mfr dataset).
 #pragma once
 
 #include <cstdint>
