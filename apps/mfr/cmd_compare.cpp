@@ -8,6 +8,7 @@
 #include <memory>
 #include <set>
 #include <sstream>
+#include <utility>
 
 #include "commands.hpp"
 #include "common.hpp"
@@ -78,6 +79,18 @@ std::string commandLine() {
   return line.empty() ? std::string("mfr compare") : line;
 }
 
+/// What results.json and the report record of this run: the version number ("mfr 1.2" -> "1.2")
+/// and the report's version, command line and time.
+std::pair<std::string, ReportInfo> provenance(const std::string& version) {
+  std::string number = version;
+  if (number.rfind("mfr ", 0) == 0) number.erase(0, 4);
+  ReportInfo info;
+  info.mfrVersion = version.empty() ? "mfr" : version;
+  info.commandLine = commandLine();
+  info.generated = utcTimestamp();
+  return {number, info};
+}
+
 std::string psnrCell(double psnr) {
   if (!std::isfinite(psnr)) return "inf";
   char buffer[32];
@@ -119,12 +132,7 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
       a.orbitStep > 0.0 ? static_cast<float>(a.orbitStep) : 360.0f / static_cast<float>(frames);
   const std::vector<Camera> path = orbitPath(prepared.cameras.front(), frames, step);
   const fs::path dir(a.out);
-  std::string versionNumber = version;
-  if (versionNumber.rfind("mfr ", 0) == 0) versionNumber.erase(0, 4);
-  ReportInfo info;
-  info.mfrVersion = version.empty() ? "mfr" : version;
-  info.commandLine = commandLine();
-  info.generated = utcTimestamp();
+  const auto [versionNumber, info] = provenance(version);
   TemporalStability temporal(a.pixelsPerDegree);
   std::vector<std::string> folders;
   std::vector<float> previousCosine;  // vkb's Fresnel term: the previous frame's nearest |n.v|
@@ -300,12 +308,7 @@ int run(const CompareArgs& a, const std::string& version) {
 
   // files
   progress.set("writing " + a.out);
-  std::string versionNumber = version;
-  if (versionNumber.rfind("mfr ", 0) == 0) versionNumber.erase(0, 4);
-  ReportInfo info;
-  info.mfrVersion = version.empty() ? "mfr" : version;
-  info.commandLine = commandLine();
-  info.generated = utcTimestamp();
+  const auto [versionNumber, info] = provenance(version);
   auto written = writeComparison(r, a.out, versionNumber, info);
   if (!written) return fail(written.error().message);
   const std::string& jsonText = written.value();
