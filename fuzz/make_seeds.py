@@ -301,6 +301,71 @@ def png_seeds():
     write("png", "not_png.png", b"GIF89a")
 
 
+def issue29_seeds():
+    """The hostile inputs of issue 29 (tests/test_hostile_inputs.cpp), small versions."""
+    # GLB whose BIN chunk claims 8 bytes more than the file holds
+    doc = triangle_gltf(None, {"bufferView": 0, "mimeType": "image/png"})
+    good = glb(doc, BUFFER)
+    js_len = struct.unpack_from("<I", good, 12)[0]
+    bin_at = 20 + js_len
+    write("glb", "issue29_bin_past_end.glb",
+          good[:bin_at] + struct.pack("<I", struct.unpack_from("<I", good, bin_at)[0] + 8) +
+          good[bin_at + 4:])
+    write("glb", "issue29_truncated.glb", good[:-16])
+
+    def required(name):
+        return lambda d: d.update({"extensionsUsed": [name], "extensionsRequired": [name]})
+    for name in ("KHR_texture_basisu", "EXT_texture_webp", "MFR_unknown"):
+        write("gltf", "issue29_requires_%s.gltf" % name,
+              json.dumps(triangle_gltf("buffer.bin", {"uri": "texture.png"}, extra=required(name))))
+    write("gltf", "issue29_stride.gltf", json.dumps(triangle_gltf(
+        "buffer.bin", {"uri": "texture.png"},
+        extra=lambda d: d["bufferViews"][1].update({"byteStride": 2147483644}))))
+    write("gltf", "issue29_datauri_length.gltf", json.dumps(triangle_gltf(
+        data_uri("application/octet-stream", BUFFER), {"uri": "texture.png"},
+        extra=lambda d: d["buffers"][0].update({"byteLength": 10 ** 15}))))
+    for i, yfov in enumerate((0, -1, 3.14159265358979)):
+        write("gltf", "issue29_yfov_%d.gltf" % i, json.dumps(triangle_gltf(
+            "buffer.bin", {"uri": "texture.png"},
+            extra=lambda d, y=yfov: d["cameras"][0]["perspective"].update({"yfov": y}))))
+    text = json.dumps(triangle_gltf("buffer.bin", {"uri": "texture.png"}))
+    write("gltf", "issue29_nan_literal.gltf", text.replace('"count": 3', '"count": NaN', 1))
+    far = struct.pack("<9f", 0, 0, 0, 1e38, 0, 0, 0, 1e38, 0) + BUFFER[36:]
+    write("gltf", "issue29_far_vertices.gltf", json.dumps(triangle_gltf(
+        data_uri("application/octet-stream", far), {"uri": "texture.png"})))
+    header = (b"\x89PNG\r\n\x1a\n" + struct.pack(">I", 13) + b"IHDR" +
+              struct.pack(">IIBBBBB", 60000, 60000, 8, 6, 0, 0, 0) + b"\0" * 4 +
+              struct.pack(">I", 0) + b"IEND" + b"\0" * 4)
+    write("gltf", "issue29_png_60000.gltf", json.dumps(triangle_gltf(
+        "buffer.bin", {"uri": data_uri("image/png", header)})))
+    write("png", "issue29_60000.png", header)
+    # OBJ: indices beyond 32 bits, a large convex face, a non-convex face past the limit
+    body = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+    write("obj", "issue29_index_wraps.obj", body + "f 1 2 4294967299\n")
+    write("obj", "issue29_index_negative.obj", body + "f 1 2 2147483648\n")
+    import math
+    n = 5000
+    disc = "".join("v %.6f %.6f 0\n" % (math.cos(2 * math.pi * i / n), math.sin(2 * math.pi * i / n))
+                   for i in range(n))
+    write("obj", "issue29_disc_5000.obj", disc + "f " + " ".join(str(i + 1) for i in range(n)) + "\n")
+    n = 2048
+    star = "".join("v %.6f %.6f 0\n" % ((1 if i % 2 == 0 else 0.5) * math.cos(2 * math.pi * i / n),
+                                        (1 if i % 2 == 0 else 0.5) * math.sin(2 * math.pi * i / n))
+                   for i in range(n))
+    write("obj", "issue29_star_2048.obj", star + "f " + " ".join(str(i + 1) for i in range(n)) + "\n")
+    pentagram = "".join("v %.6f %.6f 0\n" % (math.cos(2 * math.pi * (2 * i % 5) / 5),
+                                             math.sin(2 * math.pi * (2 * i % 5) / 5)) for i in range(5))
+    write("obj", "issue29_pentagram.obj", pentagram + "f 1 2 3 4 5\n")
+    # PLY: a header of 20,000 element lines
+    write("ply", "issue29_many_elements.ply",
+          "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+          "property float z\nelement face 1\nproperty list uchar int vertex_indices\n" +
+          "".join("element e%d 0\n" % i for i in range(20000)) +
+          "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    # a JSON scene whose mesh name is 100 kB long
+    write("json_scene", "issue29_long_mesh_name.json", json.dumps({"mesh": "m" * 100000 + ".obj"}))
+
+
 if __name__ == "__main__":
     gltf_seeds()
     obj_seeds()
@@ -312,4 +377,5 @@ if __name__ == "__main__":
     mfrnn_seeds()
     mfrds_seeds()
     png_seeds()
+    issue29_seeds()
     print("seeds written to", SEEDS)

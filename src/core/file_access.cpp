@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <cstring>
 #include <system_error>
+#include <utility>
 
 namespace mfr {
 namespace {
@@ -24,31 +25,49 @@ std::string notRegular(const struct stat& st) {
   return "is not a regular file";
 }
 
-template <class Buffer>
-Result<Buffer> readWhole(const fs::path& path, const std::string& what, uint64_t maxBytes) {
-  auto size = checkRegularFile(path, what);
-  if (!size) return size.error();
-  // O_NONBLOCK: should the path have become a FIFO since the stat, the open returns at once and
-  // the fstat below refuses it.
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) return makeError(what + ": cannot be read (" + std::strerror(errno) + ")");
-  struct FdCloser {
-    int fd;
-    ~FdCloser() { ::close(fd); }
-  } closer{fd};
+Error readError(const std::string& what, int err) {
+  return makeError(what + ": cannot be read (" + std::strerror(err) + ")");
+}
+
+/// An open() error as the checks would have said it.
+Error openError(const std::string& what, int err) {
+  if (err == ENOENT || err == ENOTDIR) return makeError(what + ": no such file");
+  return readError(what, err);
+}
+
+/// The path of an open descriptor as the kernel resolved it (symbolic links followed), from
+/// /proc/self/fd; empty when /proc cannot tell.
+fs::path descriptorPath(int fd) {
+  std::error_code ec;
+  fs::path path = fs::read_symlink("/proc/self/fd/" + std::to_string(fd), ec);
+  if (ec || !path.is_absolute()) return {};
+  return path;
+}
+
+/// The checks on an open descriptor: a regular file; its size.
+Result<OpenFile> checkedOpenFile(int fd, fs::path path, const std::string& what) {
   struct stat st {};
-  if (::fstat(fd, &st) != 0)
-    return makeError(what + ": cannot be read (" + std::strerror(errno) + ")");
-  if (const std::string problem = notRegular(st); !problem.empty())
+  if (::fstat(fd, &st) != 0) {
+    const int err = errno;
+    ::close(fd);
+    return readError(what, err);
+  }
+  if (const std::string problem = notRegular(st); !problem.empty()) {
+    ::close(fd);
     return makeError(what + ": " + problem);
-  const auto bytes = static_cast<uint64_t>(st.st_size);
-  if (bytes > maxBytes)
-    return makeError(what + ": " + std::to_string(bytes) + " bytes, more than the " +
+  }
+  return OpenFile(fd, std::move(path), static_cast<uint64_t>(st.st_size), what);
+}
+
+template <class Buffer>
+Result<Buffer> readDescriptor(int fd, uint64_t size, const std::string& what, uint64_t maxBytes) {
+  if (size > maxBytes)
+    return makeError(what + ": " + std::to_string(size) + " bytes, more than the " +
                      std::to_string(maxBytes) + " bytes allowed for it");
-  Buffer out(static_cast<size_t>(bytes), 0);
+  Buffer out(static_cast<size_t>(size), 0);
   size_t done = 0;
   while (done < out.size()) {
-    const ssize_t got = ::read(fd, out.data() + done, out.size() - done);
+    const ssize_t got = ::pread(fd, out.data() + done, out.size() - done, static_cast<off_t>(done));
     if (got < 0 && errno == EINTR) continue;
     if (got < 0) return makeError(what + ": read error (" + std::strerror(errno) + ")");
     if (got == 0) break;  // the file shrank since the fstat
@@ -87,19 +106,48 @@ Result<uint64_t> checkRegularFile(const fs::path& path, const std::string& what)
   return static_cast<uint64_t>(st.st_size);
 }
 
+OpenFile::OpenFile(OpenFile&& other) noexcept
+    : fd_(std::exchange(other.fd_, -1)),
+      path_(std::move(other.path_)),
+      size_(other.size_),
+      what_(std::move(other.what_)) {}
+
+OpenFile::~OpenFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+Result<std::vector<unsigned char>> OpenFile::read(uint64_t maxBytes) const {
+  return readDescriptor<std::vector<unsigned char>>(fd_, size_, what_, maxBytes);
+}
+
+Result<std::string> OpenFile::readText(uint64_t maxBytes) const {
+  return readDescriptor<std::string>(fd_, size_, what_, maxBytes);
+}
+
+Result<OpenFile> openRegularFile(const fs::path& path, const std::string& what) {
+  // O_NONBLOCK: a FIFO opens at once (and the fstat refuses it) instead of blocking the open
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return openError(what, errno);
+  return checkedOpenFile(fd, path, what);
+}
+
 Result<std::string> readRegularFile(const fs::path& path, const std::string& what,
                                     uint64_t maxBytes) {
-  return readWhole<std::string>(path, what, maxBytes);
+  auto file = openRegularFile(path, what);
+  if (!file) return file.error();
+  return file->readText(maxBytes);
 }
 
 Result<std::vector<unsigned char>> readRegularFileBytes(const fs::path& path,
                                                         const std::string& what,
                                                         uint64_t maxBytes) {
-  return readWhole<std::vector<unsigned char>>(path, what, maxBytes);
+  auto file = openRegularFile(path, what);
+  if (!file) return file.error();
+  return file->read(maxBytes);
 }
 
-Result<fs::path> resolveReference(const fs::path& referencingFile, const std::string& reference,
-                                  const std::string& what, bool allowOutside) {
+Result<OpenFile> openReference(const fs::path& referencingFile, const std::string& reference,
+                               const std::string& what, bool allowOutside) {
   static const std::string kHint = " (--allow-outside-references allows it)";
   if (reference.empty()) return makeError(what + ": empty file name");
   if (reference.find('\0') != std::string::npos)
@@ -114,22 +162,33 @@ Result<fs::path> resolveReference(const fs::path& referencingFile, const std::st
       return makeError(what + ": refused: it leads outside the folder of the file naming it" +
                        kHint);
   }
-  const fs::path joined = ref.is_absolute() ? ref : folder / ref;
-  std::error_code ec;
-  const fs::path target = fs::weakly_canonical(joined, ec);
-  if (ec) return makeError(what + ": cannot be resolved (" + ec.message() + ")");
+  // The folder is opened once; the reference is opened relative to that descriptor, and where
+  // the kernel resolved both is read back from the descriptors, so the check below is about the
+  // very file that is then read.
+  const int dir = ::open(folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (dir < 0)
+    return makeError(what + ": cannot open the folder of the file naming it (" +
+                     std::strerror(errno) + ")");
+  const int fd = ::openat(dir, ref.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  const int openErrno = errno;
+  const fs::path root = descriptorPath(dir);
+  ::close(dir);
+  if (fd < 0) return openError(what, openErrno);
+  const fs::path target = descriptorPath(fd);
   if (!allowOutside) {
-    const fs::path root = fs::weakly_canonical(folder, ec);
-    if (ec) return makeError(what + ": cannot resolve the folder of the file naming it");
-    if (!isInside(target, root))
+    if (root.empty() || target.empty()) {
+      ::close(fd);
+      return makeError(what + ": refused: where it leads cannot be checked (no /proc/self/fd)");
+    }
+    if (!isInside(target, root)) {
+      ::close(fd);
       return makeError(what +
                        ": refused: it resolves (through a symbolic link) outside the folder of "
                        "the file naming it" +
                        kHint);
+    }
   }
-  auto size = checkRegularFile(target, what);
-  if (!size) return size.error();
-  return target;
+  return checkedOpenFile(fd, target.empty() ? folder / ref : target, what);
 }
 
 bool isNoSuchFileError(const Error& error) {

@@ -1,6 +1,7 @@
 #include "mfr/core/image.hpp"
 
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -74,6 +75,16 @@ Result<void> checkPngChunks(const uint8_t* bytes, size_t size, const std::string
       return makeError(what + ": PNG chunk " + quoteInput(type) + " declares " +
                        std::to_string(length) + " bytes, the file has " +
                        std::to_string(left >= 4 ? left - 4 : 0) + " left");
+    if (type == "IHDR" && length >= 8) {  // the size, before any decoder sees it
+      const uint8_t* d = bytes + offset + 8;
+      const uint32_t width =
+          uint32_t{d[0]} << 24 | uint32_t{d[1]} << 16 | uint32_t{d[2]} << 8 | d[3];
+      const uint32_t height =
+          uint32_t{d[4]} << 24 | uint32_t{d[5]} << 16 | uint32_t{d[6]} << 8 | d[7];
+      MFR_TRY(checkImageDimensions(
+          static_cast<int>(std::min<uint32_t>(width, static_cast<uint32_t>(INT32_MAX))),
+          static_cast<int>(std::min<uint32_t>(height, static_cast<uint32_t>(INT32_MAX))), what));
+    }
     offset += 12 + size_t{length};
     if (type == "IEND") break;
   }

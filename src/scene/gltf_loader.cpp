@@ -17,21 +17,25 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <map>
 #include <new>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <tbb/parallel_for.h>
+#include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
 #include <nlohmann/json.hpp>
 
+#include "file_loaders.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/memory_limit.hpp"
@@ -120,13 +124,14 @@ std::string decodeUri(const std::string& uri) {
   return out;
 }
 
-/// What the file-system callbacks know (their user data).
+/// What the file-system callbacks know (their user data): every external file, read once before
+/// tinygltf runs, by the reference tinygltf will ask for.
 struct GltfFiles {
   std::string path;  // the glTF file
   bool allowOutside = false;
-  uint64_t maxFileBytes = 0;                      // cap for any external file
-  std::map<std::string, uint64_t> expectedBytes;  // canonical path -> a buffer's byteLength
-  std::string refusal;  // the first reference refused inside tinygltf (fails the load)
+  uint64_t maxFileBytes = 0;                                // cap for any external file
+  std::map<std::string, std::vector<unsigned char>> bytes;  // decoded reference -> contents
+  std::map<std::string, int> readsLeft;  // how many uris name it (the last read takes the bytes)
 
   /// The reference inside the glTF that tinygltf's candidate path `candidate` stands for; empty
   /// for tinygltf's second guess, the working folder (never allowed).
@@ -136,17 +141,12 @@ struct GltfFiles {
     const std::string prefix = base.back() == '/' ? base : base + "/";
     return candidate.rfind(prefix, 0) == 0 ? candidate.substr(prefix.size()) : std::string();
   }
-  Result<std::filesystem::path> resolve(const std::string& candidate) {
-    const std::string reference = referenceOf(candidate);
-    if (reference.empty()) return makeError("");
-    auto resolved = resolveReference(path, reference, "uri " + quoteInput(reference), allowOutside);
-    if (!resolved && refusal.empty()) refusal = resolved.error().message;
-    return resolved;
-  }
 };
 
 bool gltfFileExists(const std::string& candidate, void* user) {
-  return static_cast<GltfFiles*>(user)->resolve(candidate).ok();
+  const auto* files = static_cast<GltfFiles*>(user);
+  const std::string reference = files->referenceOf(candidate);
+  return !reference.empty() && files->bytes.count(reference) != 0;
 }
 
 /// No expansion of `~` or variables: a uri is a relative path, nothing else.
@@ -154,22 +154,20 @@ std::string gltfExpandFilePath(const std::string& path, void*) {
   return path;
 }
 
+/// Hands tinygltf a file read by checkReferences; tinygltf never opens a file itself.
 bool gltfReadWholeFile(std::vector<unsigned char>* out, std::string* err,
                        const std::string& candidate, void* user) {
   auto* files = static_cast<GltfFiles*>(user);
-  auto resolved = files->resolve(candidate);
-  if (!resolved) return false;
-  uint64_t maxBytes = files->maxFileBytes;
-  if (auto it = files->expectedBytes.find(resolved->string()); it != files->expectedBytes.end())
-    maxBytes = it->second;
-  auto bytes =
-      readRegularFileBytes(*resolved, "uri " + quoteInput(files->referenceOf(candidate)), maxBytes);
-  if (!bytes) {
-    if (files->refusal.empty()) files->refusal = bytes.error().message;
-    if (err) *err += bytes.error().message + "\n";
+  const std::string reference = files->referenceOf(candidate);
+  const auto it = reference.empty() ? files->bytes.end() : files->bytes.find(reference);
+  if (it == files->bytes.end()) {
+    if (err) *err += "uri " + quoteInput(reference) + ": not named by the file\n";
     return false;
   }
-  *out = std::move(*bytes);
+  if (--files->readsLeft[reference] <= 0)
+    *out = std::move(it->second);
+  else
+    *out = it->second;
   return true;
 }
 
@@ -179,59 +177,165 @@ bool gltfWriteWholeFile(std::string* err, const std::string&, const std::vector<
   return false;
 }
 
-/// The JSON of a .gltf, or of a GLB's first (JSON) chunk; discarded when it does not parse
-/// (tinygltf then reports the problem).
-nlohmann::json gltfJson(const std::vector<unsigned char>& bytes) {
+/// The JSON of a .gltf, or of a GLB's first (JSON) chunk (checkGlb has checked the chunks).
+Result<nlohmann::json> gltfJson(const std::vector<unsigned char>& bytes) {
   const unsigned char* begin = bytes.data();
   size_t size = bytes.size();
   if (startsWithGlbMagic(bytes)) {
-    uint32_t chunkLength = 0, chunkType = 0;
-    if (size < 20) return nlohmann::json::value_t::discarded;
+    uint32_t chunkLength = 0;
     std::memcpy(&chunkLength, begin + 12, 4);
-    std::memcpy(&chunkType, begin + 16, 4);
-    if (chunkType != 0x4E4F534Au || chunkLength > size - 20)
-      return nlohmann::json::value_t::discarded;
     begin += 20;
     size = chunkLength;
   }
-  return nlohmann::json::parse(begin, begin + size, nullptr, false);
+  try {
+    return nlohmann::json::parse(begin, begin + size);
+  } catch (const nlohmann::json::exception& e) {
+    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at ..."
+    if (what.rfind("[json.exception.", 0) == 0 && what.find("] ") != std::string::npos)
+      what = what.substr(what.find("] ") + 2);
+    return makeError("JSON error: " + oneLine(what, 200));
+  }
 }
 
-/// Every external uri of the glTF resolved and checked before tinygltf opens anything: regular
-/// files inside the folder (unless allowed outside), a buffer's file exactly its byteLength.
-/// Records the buffers' sizes for the read callback.
+uint32_t le32(const std::vector<unsigned char>& bytes, size_t offset) {
+  uint32_t v = 0;
+  std::memcpy(&v, bytes.data() + offset, 4);
+  return v;
+}
+
+/// A binary glTF's header and chunk lengths against the file (glTF 2.0 section 4.4), before the
+/// loader trusts them: version 2, a declared length within the file, a JSON chunk first, every
+/// chunk inside the declared length.
+Result<void> checkGlb(const std::vector<unsigned char>& bytes) {
+  if (bytes.size() < 12)
+    return makeError("GLB file of " + std::to_string(bytes.size()) +
+                     " bytes is shorter than its 12-byte header");
+  const uint32_t version = le32(bytes, 4), length = le32(bytes, 8);
+  if (version != 2)
+    return makeError("GLB version " + std::to_string(version) + " (only version 2 is supported)");
+  if (length > bytes.size())
+    return makeError("GLB header declares " + std::to_string(length) + " bytes, the file has " +
+                     std::to_string(bytes.size()));
+  size_t offset = 12;
+  for (int chunk = 0; offset < length; ++chunk) {
+    if (length - offset < 8)
+      return makeError("GLB chunk " + std::to_string(chunk) + " at byte " + std::to_string(offset) +
+                       " is cut off in its 8-byte header");
+    const uint32_t chunkLength = le32(bytes, offset), type = le32(bytes, offset + 4);
+    const size_t left = length - offset - 8;
+    const std::string name = type == 0x4E4F534Au   ? "JSON"
+                             : type == 0x004E4942u ? "BIN"
+                                                   : "of type " + std::to_string(type);
+    if (chunkLength > left)
+      return makeError("GLB chunk " + std::to_string(chunk) + " (" + name + ") declares " +
+                       std::to_string(chunkLength) + " bytes, only " + std::to_string(left) +
+                       " are left in the file");
+    if (chunk == 0 && type != 0x4E4F534Au)
+      return makeError("GLB file does not start with a JSON chunk");
+    offset += 8 + size_t{chunkLength};
+  }
+  if (offset == 12) return makeError("GLB file has no JSON chunk");
+  return {};
+}
+
+/// The number of bytes a base64 data URI's payload decodes to, or nullopt when it is not base64.
+std::optional<uint64_t> dataUriBytes(const std::string& uri) {
+  const size_t comma = uri.find(',');
+  static const std::string kBase64 = ";base64";
+  if (comma == std::string::npos || comma < kBase64.size() ||
+      uri.compare(comma - kBase64.size(), kBase64.size(), kBase64) != 0)
+    return std::nullopt;
+  uint64_t chars = uri.size() - comma - 1;
+  size_t padding = 0;
+  for (size_t i = uri.size(); i > comma + 1 && uri[i - 1] == '=' && padding < 2; --i) ++padding;
+  return chars / 4 * 3 + (chars % 4 == 0 ? 0 : chars % 4 - 1) - (chars % 4 == 0 ? padding : 0);
+}
+
+/// The glTF extensions mfr implements: an asset that requires any other must be refused (glTF 2.0
+/// section 3.12). KHR_mesh_quantization only widens the accessor types, which readAccessor reads.
+bool isImplementedExtension(const std::string& name) {
+  return name == "KHR_materials_transmission" || name == "KHR_mesh_quantization";
+}
+
+/// What the JSON says before tinygltf reads it: required extensions mfr implements, buffer views'
+/// strides, data URIs' lengths; then every external uri opened and read once (regular files
+/// inside the folder unless allowed outside, a buffer's file exactly its byteLength), kept for the
+/// read callback.
 Result<void> checkReferences(const nlohmann::json& doc, GltfFiles& files) {
   if (!doc.is_object()) return {};
+  if (auto it = doc.find("extensionsRequired"); it != doc.end() && it->is_array())
+    for (const nlohmann::json& name : *it)
+      if (name.is_string() && !isImplementedExtension(name.get<std::string>()))
+        return makeError("requires extension " + quoteInput(name.get<std::string>()) +
+                         ", which mfr does not implement (it implements "
+                         "KHR_materials_transmission and KHR_mesh_quantization)");
+  if (auto it = doc.find("bufferViews"); it != doc.end() && it->is_array())
+    for (size_t i = 0; i < it->size(); ++i) {
+      const nlohmann::json& view = (*it)[i];
+      if (!view.is_object() || !view.contains("byteStride")) continue;
+      const nlohmann::json& stride = view["byteStride"];
+      const bool valid = stride.is_number_integer() && stride.get<int64_t>() >= 4 &&
+                         stride.get<int64_t>() <= 252 && stride.get<int64_t>() % 4 == 0;
+      if (!valid)
+        return makeError("bufferViews[" + std::to_string(i) + "].byteStride " +
+                         oneLine(stride.dump(), 40) + ": must be a multiple of 4 in [4, 252]");
+    }
   const auto external = [](const nlohmann::json& item) {
     return item.is_object() && item.contains("uri") && item["uri"].is_string() &&
            !tinygltf::IsDataURI(item["uri"].get<std::string>());
   };
+  const auto read = [&files](const std::string& uri, const std::string& what,
+                             std::optional<uint64_t> declared) -> Result<void> {
+    const std::string reference = decodeUri(uri);
+    if (auto known = files.bytes.find(reference); known != files.bytes.end()) {
+      if (declared && known->second.size() != *declared)
+        return makeError(what + ": byteLength " + std::to_string(*declared) +
+                         " differs from the file's size, " + std::to_string(known->second.size()) +
+                         " bytes");
+      ++files.readsLeft[reference];
+      return {};
+    }
+    auto file = openReference(files.path, reference, what, files.allowOutside);
+    if (!file) return file.error();
+    if (declared && file->size() != *declared)
+      return makeError(what + ": byteLength " + std::to_string(*declared) +
+                       " differs from the file's size, " + std::to_string(file->size()) + " bytes");
+    auto bytes = file->read(declared.value_or(files.maxFileBytes));
+    if (!bytes) return bytes.error();
+    if (declared && bytes->size() != *declared)
+      return makeError(what + ": the file shrank while it was read");
+    files.bytes.emplace(reference, std::move(*bytes));
+    files.readsLeft[reference] = 1;
+    return {};
+  };
   if (auto it = doc.find("buffers"); it != doc.end() && it->is_array())
     for (size_t i = 0; i < it->size(); ++i) {
       const nlohmann::json& buffer = (*it)[i];
+      const auto length = buffer.is_object() ? buffer.find("byteLength") : buffer.end();
+      const bool hasLength = length != buffer.end() && length->is_number_unsigned();
+      if (buffer.is_object() && buffer.contains("uri") && buffer["uri"].is_string() &&
+          !external(buffer) && hasLength) {
+        const std::string& uri = buffer["uri"].get_ref<const std::string&>();
+        const auto decoded = dataUriBytes(uri);
+        if (decoded && *decoded != length->get<uint64_t>())
+          return makeError("buffer " + std::to_string(i) + ": byteLength " +
+                           std::to_string(length->get<uint64_t>()) +
+                           " differs from the size of its data URI, " + std::to_string(*decoded) +
+                           " bytes");
+      }
       if (!external(buffer)) continue;
       const std::string uri = buffer["uri"].get<std::string>();
       const std::string what = "buffer " + std::to_string(i) + " uri " + quoteInput(uri);
-      auto resolved = resolveReference(files.path, decodeUri(uri), what, files.allowOutside);
-      if (!resolved) return resolved.error();
-      const auto length = buffer.find("byteLength");
-      if (length == buffer.end() || !length->is_number_unsigned()) continue;  // tinygltf reports
-      const uint64_t declared = length->get<uint64_t>();
-      auto size = checkRegularFile(*resolved, what);
-      if (!size) return size.error();
-      if (*size != declared)
-        return makeError(what + ": byteLength " + std::to_string(declared) +
-                         " differs from the file's size, " + std::to_string(*size) + " bytes");
-      files.expectedBytes.emplace(resolved->string(), declared);
+      std::optional<uint64_t> declared;
+      if (hasLength) declared = length->get<uint64_t>();
+      MFR_TRY(read(uri, what, declared));
     }
   if (auto it = doc.find("images"); it != doc.end() && it->is_array())
     for (size_t i = 0; i < it->size(); ++i) {
       const nlohmann::json& image = (*it)[i];
       if (!external(image)) continue;
       const std::string uri = image["uri"].get<std::string>();
-      const std::string what = "image " + std::to_string(i) + " uri " + quoteInput(uri);
-      auto resolved = resolveReference(files.path, decodeUri(uri), what, files.allowOutside);
-      if (!resolved) return resolved.error();
+      MFR_TRY(read(uri, "image " + std::to_string(i) + " uri " + quoteInput(uri), std::nullopt));
     }
   return {};
 }
@@ -341,7 +445,7 @@ class GltfSceneBuilder {
   uint32_t materialIndex(int gltfMaterial);
   int textureIndex(int gltfTexture);
   Result<void> decodeTextures();
-  void addCameras();
+  Result<void> addCameras();
 
   const tinygltf::Model& model_;
   const EncodedImages& images_;
@@ -783,12 +887,20 @@ Result<void> GltfSceneBuilder::decodeTextures() {
 /// Perspective cameras of the visited nodes: eye at the node origin looking down its -Z axis with
 /// +Y up. The target is put on the view axis at the depth of the scene centre so that orbits
 /// around it (see orbit()) circle the scene.
-void GltfSceneBuilder::addCameras() {
+Result<void> GltfSceneBuilder::addCameras() {
   const Bounds bounds = sceneBounds(scene_);
   for (const auto& [cameraIndex, world] : cameraNodes_) {
     if (cameraIndex < 0 || static_cast<size_t>(cameraIndex) >= model_.cameras.size()) continue;
     const tinygltf::Camera& src = model_.cameras[static_cast<size_t>(cameraIndex)];
     if (src.type != "perspective") continue;
+    // glTF 2.0 section 5.13: yfov > 0 (and below pi, a half-space at most)
+    const double yfov = src.perspective.yfov;
+    if (!(yfov > 0.0 && yfov < glm::pi<double>())) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", yfov);
+      return fail("camera " + std::to_string(cameraIndex) + ": perspective.yfov " + value +
+                  " must be in (0, pi) radians");
+    }
     const glm::vec3 eye(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
     glm::dvec3 forward = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
     glm::dvec3 up = glm::dmat3(world) * glm::dvec3(0.0, 1.0, 0.0);
@@ -804,27 +916,27 @@ void GltfSceneBuilder::addCameras() {
     camera.fovYDegrees = static_cast<float>(glm::degrees(src.perspective.yfov));
     camera.zNear = std::max(0.0f, static_cast<float>(src.perspective.znear));
     camera.zFar = std::max(0.0f, static_cast<float>(src.perspective.zfar));  // 0: infinite
-    if (!(camera.fovYDegrees > 0.0f && camera.fovYDegrees < 180.0f)) camera.fovYDegrees = 45.0f;
     scene_.cameras.push_back(camera);
   }
+  return {};
 }
 
 Result<Scene> GltfSceneBuilder::build() {
   scene_.name = path_;
-  for (const std::string& extension : model_.extensionsRequired)
-    if (extension == "KHR_draco_mesh_compression" || extension == "EXT_meshopt_compression")
-      return fail("requires unsupported extension " + extension);
+  for (const std::string& extension : model_.extensionsRequired)  // checkReferences, too
+    if (!isImplementedExtension(extension))
+      return fail("requires extension " + quoteInput(extension) + ", which mfr does not implement");
   MFR_TRY(visitNodes());
   MFR_TRY(decodeTextures());
   if (!anyUvs_) scene_.uvs.clear();
-  addCameras();
+  MFR_TRY(addCameras());
   MFR_TRY(validateScene(scene_));
   return std::move(scene_);
 }
 
 }  // namespace
 
-Result<Scene> loadGltf(const std::string& path, const LoadOptions& options) {
+Result<Scene> loadGltf(const std::string& path, const OpenFile& file, const LoadOptions& options) {
   try {
     GltfFiles files;
     files.path = path;
@@ -832,10 +944,14 @@ Result<Scene> loadGltf(const std::string& path, const LoadOptions& options) {
     const uint64_t limit = options.memoryLimitBytes.value_or(defaultMemoryLimit());
     // tinygltf takes the file's length and image sizes as 32-bit integers
     files.maxFileBytes = std::min<uint64_t>(limit, std::numeric_limits<int>::max());
-    auto bytes = readRegularFileBytes(path, path, std::min<uint64_t>(limit, UINT32_MAX));
+    auto bytes = file.read(std::min<uint64_t>(limit, UINT32_MAX));
     if (!bytes) return bytes.error();
     if (bytes->empty()) return makeError(path + ": empty file");
-    if (auto checked = checkReferences(gltfJson(*bytes), files); !checked)
+    if (startsWithGlbMagic(*bytes))
+      if (auto glb = checkGlb(*bytes); !glb) return makeError(path + ": " + glb.error().message);
+    auto doc = gltfJson(*bytes);
+    if (!doc) return makeError(path + ": " + doc.error().message);
+    if (auto checked = checkReferences(*doc, files); !checked)
       return makeError(path + ": " + checked.error().message);
 
     tinygltf::Model model;
@@ -853,10 +969,9 @@ Result<Scene> loadGltf(const std::string& path, const LoadOptions& options) {
             ? loader.LoadBinaryFromMemory(&model, &err, &warn, bytes->data(), size, baseDir)
             : loader.LoadASCIIFromString(
                   &model, &err, &warn, reinterpret_cast<const char*>(bytes->data()), size, baseDir);
-    if (!files.refusal.empty()) return makeError(path + ": " + files.refusal);
     if (!ok) {
       const std::string reason = firstLine(err);
-      return makeError(path + ": " + (reason.empty() ? "invalid glTF file" : reason));
+      return makeError(path + ": " + (reason.empty() ? "invalid glTF file" : oneLine(reason, 300)));
     }
     return GltfSceneBuilder(model, images, path, options).build();
   } catch (const std::bad_alloc&) {

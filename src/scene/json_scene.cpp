@@ -16,6 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "file_loaders.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
@@ -100,8 +101,9 @@ Result<Camera> parseCamera(const Checker& check, const json& value, const std::s
 
 }  // namespace
 
-Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options) {
-  auto text = readRegularFile(path, path);
+Result<Scene> loadJsonScene(const std::string& path, const OpenFile& file,
+                            const LoadOptions& options) {
+  auto text = file.readText();
   if (!text) return text.error();
   json root;
   try {
@@ -110,7 +112,7 @@ Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options)
     std::string what = e.what();  // "[json.exception.parse_error.101] parse error at ..."
     if (what.rfind("[json.exception.", 0) == 0 && what.find("] ") != std::string::npos)
       what = what.substr(what.find("] ") + 2);
-    return makeError(path + ": JSON error: " + what);
+    return makeError(path + ": JSON error: " + oneLine(what, 200));
   }
   const Checker check{path};
   if (!root.is_object()) return makeError(path + ": JSON error: top level must be an object");
@@ -155,22 +157,26 @@ Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options)
 
   // Files resolve against this file's directory and must lie inside it (unless allowed outside,
   // file_access.hpp); JSON scene files do not nest.
-  std::string source = mesh;
-  if (mesh.rfind("procedural:", 0) != 0) {
+  Result<Scene> loaded = makeError("");
+  if (mesh.rfind("procedural:", 0) == 0) {
+    loaded = loadScene(mesh, meshOptions);
+  } else {
     const std::filesystem::path meshPath(mesh);
     std::string extension = meshPath.extension().string();
     for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     if (extension == ".json") return check.fail("mesh", "must not be another JSON scene file");
-    auto resolved =
-        resolveReference(path, mesh, "'mesh' " + oneLine(mesh), options.allowOutsideReferences);
-    if (!resolved) return makeError(path + ": " + resolved.error().message);
-    source =
+    // opened once, relative to this file's folder; the mesh loader reads that descriptor
+    auto meshFile =
+        openReference(path, mesh, "'mesh' " + oneLine(mesh, 200), options.allowOutsideReferences);
+    if (!meshFile) return makeError(path + ": " + meshFile.error().message);
+    const std::string source =
         meshPath.is_absolute()
             ? mesh
             : (std::filesystem::path(path).parent_path() / meshPath).lexically_normal().string();
+    loaded = loadOpenFile(source, *meshFile, meshOptions);
+    if (loaded) loaded->name = source;
   }
-  auto loaded = loadScene(source, meshOptions);
-  if (!loaded) return makeError(path + ": mesh: " + loaded.error().message);
+  if (!loaded) return makeError(path + ": mesh: " + oneLine(loaded.error().message, 1000));
 
   Scene scene = std::move(*loaded);
   scene.name = path;

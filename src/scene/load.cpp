@@ -3,12 +3,11 @@
 // has vertex normals, passes validateScene and is named after the source string.
 #include "mfr/scene/load.hpp"
 
-#include <unistd.h>
-
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
 
+#include "file_loaders.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/scene/procedural.hpp"
@@ -18,6 +17,8 @@ namespace mfr {
 namespace {
 
 constexpr const char* kProceduralPrefix = "procedural:";
+/// However much of its input a loader or library quotes, an error stays a readable line.
+constexpr size_t kMaxMessage = 1000;
 
 std::string lowercaseExtension(const std::string& path) {
   std::string extension = std::filesystem::path(path).extension().string();
@@ -26,22 +27,51 @@ std::string lowercaseExtension(const std::string& path) {
   return extension;
 }
 
-Result<Scene> loadFile(const std::string& path, const LoadOptions& options) {
-  // stat, not open: a FIFO or device named as the scene is refused instead of blocking the open
-  if (auto regular = checkRegularFile(path, path); !regular) return regular.error();
-  if (::access(path.c_str(), R_OK) != 0) return makeError(path + ": cannot be read");
-
+Result<void> checkExtension(const std::string& path) {
   const std::string extension = lowercaseExtension(path);
-  if (extension == ".gltf" || extension == ".glb") return loadGltf(path, options);
-  if (extension == ".obj") return loadObj(path, options);
-  if (extension == ".ply") return loadPly(path, options);
-  if (extension == ".json") return loadJsonScene(path, options);
+  for (const char* known : {".gltf", ".glb", ".obj", ".ply", ".json"})
+    if (extension == known) return {};
   return makeError(path + ": unsupported scene format " +
-                   (extension.empty() ? "(no extension)" : "'" + extension + "'") +
+                   (extension.empty() ? "(no extension)" : quoteInput(extension, 20)) +
                    " (expected .gltf, .glb, .obj, .ply, .json)");
 }
 
+Result<Scene> loadFile(const std::string& path, const LoadOptions& options) {
+  // opened once, non-blocking: a FIFO or device named as the scene is refused on the descriptor
+  auto file = openRegularFile(path, path);
+  if (!file) return file.error();
+  return loadOpenFile(path, *file, options);
+}
+
 }  // namespace
+
+Result<Scene> loadOpenFile(const std::string& path, const OpenFile& file,
+                           const LoadOptions& options) {
+  MFR_TRY(checkExtension(path));
+  const std::string extension = lowercaseExtension(path);
+  if (extension == ".gltf" || extension == ".glb") return loadGltf(path, file, options);
+  if (extension == ".obj") return loadObj(path, file, options);
+  if (extension == ".ply") return loadPly(path, file, options);
+  return loadJsonScene(path, file, options);
+}
+
+/// The public loaders open the file, then read it from the descriptor.
+Result<Scene> loadGltf(const std::string& path, const LoadOptions& options) {
+  auto file = openRegularFile(path, path);
+  return file ? loadGltf(path, *file, options) : Result<Scene>(file.error());
+}
+Result<Scene> loadObj(const std::string& path, const LoadOptions& options) {
+  auto file = openRegularFile(path, path);
+  return file ? loadObj(path, *file, options) : Result<Scene>(file.error());
+}
+Result<Scene> loadPly(const std::string& path, const LoadOptions& options) {
+  auto file = openRegularFile(path, path);
+  return file ? loadPly(path, *file, options) : Result<Scene>(file.error());
+}
+Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options) {
+  auto file = openRegularFile(path, path);
+  return file ? loadJsonScene(path, *file, options) : Result<Scene>(file.error());
+}
 
 Result<Scene> loadScene(const std::string& source, const LoadOptions& options) {
   const std::string prefix = kProceduralPrefix;
@@ -53,8 +83,8 @@ Result<Scene> loadScene(const std::string& source, const LoadOptions& options) {
     const std::string& message = loaded.error().message;
     // one line whatever the source and the file hold (a name or a key may contain newlines)
     if (message.find(source) == std::string::npos)
-      return makeError(oneLine(source, 200) + ": " + oneLine(message));
-    return makeError(oneLine(message));
+      return makeError(oneLine(source, 200) + ": " + oneLine(message, kMaxMessage));
+    return makeError(oneLine(message, kMaxMessage));
   }
   Scene scene = std::move(*loaded);
   scene.name = source;

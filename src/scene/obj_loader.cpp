@@ -1,4 +1,5 @@
-// Wavefront OBJ + MTL loader on top of tinyobjloader (polygons triangulated by tinyobjloader).
+// Wavefront OBJ + MTL loader on top of tinyobjloader (polygons triangulated by polygon.hpp:
+// tinyobjloader's own ear clipping is quadratic and folds large discs onto themselves).
 //
 // Conventions:
 //  - Texture coordinates are flipped (uv.y = 1 - v): OBJ puts v = 0 at the bottom of the image,
@@ -21,23 +22,26 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <initializer_list>
 #include <limits>
 #include <map>
 #include <new>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
+#include "file_loaders.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
+#include "polygon.hpp"
 
 #include <stb_image.h>  // Debian libstb (linked by the library)
 
@@ -57,19 +61,23 @@ class MtlReader : public tinyobj::MaterialReader {
                   std::map<std::string, int>* materialMap, std::string* warn,
                   std::string* err) override {
     const std::string what = "mtllib " + quoteInput(name);
-    auto path = resolveReference(objFile_, name, what, allowOutside_);
-    if (!path && !isNoSuchFileError(path.error())) {
-      if (refusal.empty()) refusal = path.error().message;  // refused, not missing
+    auto file = openReference(objFile_, name, what, allowOutside_);
+    if (!file && !isNoSuchFileError(file.error())) {
+      if (refusal.empty()) refusal = file.error().message;  // refused, not missing
       return false;
     }
-    auto text = path ? readRegularFile(*path, what) : Result<std::string>(path.error());
-    if (!text) {
+    if (!file) {
       if (warn) *warn += "material file " + what + " not found\n";
+      return false;
+    }
+    auto text = file->readText();
+    if (!text) {
+      if (refusal.empty()) refusal = text.error().message;
       return false;
     }
     std::istringstream stream(std::move(*text));
     tinyobj::LoadMtl(materialMap, materials, &stream, warn, err);
-    files.resize(materials->size(), *path);
+    files.resize(materials->size(), file->path());  // its textures resolve against its folder
     return true;
   }
 
@@ -104,8 +112,8 @@ std::string lineContaining(const std::string& text, std::initializer_list<const 
 }
 
 /// tinyobjloader parses "nan" and "inf" as 0: put the real (non-finite) values back.
-void restoreNonFiniteCoordinates(const std::string& path, std::vector<float>& vertices) {
-  std::ifstream in(path);
+void restoreNonFiniteCoordinates(const std::string& text, std::vector<float>& vertices) {
+  std::istringstream in(text);
   std::string line;
   size_t vertex = 0;
   while (std::getline(in, line)) {
@@ -128,10 +136,9 @@ void restoreNonFiniteCoordinates(const std::string& path, std::vector<float>& ve
 
 /// A texture file (already resolved): header checked against the size cap and the memory limit
 /// before decoding. `decodedBytes` adds up the textures' bytes so far.
-Result<Texture> loadTexture(const fs::path& file, const std::string& what, uint64_t memoryLimit,
+Result<Texture> loadTexture(const OpenFile& file, const std::string& what, uint64_t memoryLimit,
                             uint64_t& decodedBytes) {
-  auto bytes = readRegularFileBytes(
-      file, what, std::min<uint64_t>(memoryLimit, std::numeric_limits<int>::max()));
+  auto bytes = file.read(std::min<uint64_t>(memoryLimit, std::numeric_limits<int>::max()));
   if (!bytes) return bytes.error();
   MFR_TRY(checkPngChunks(bytes->data(), bytes->size(), what));  // before stb trusts a chunk length
   const auto size = static_cast<int>(bytes->size());
@@ -145,8 +152,8 @@ Result<Texture> loadTexture(const fs::path& file, const std::string& what, uint6
   stbi_uc* pixels = stbi_load_from_memory(bytes->data(), size, &width, &height, &channels, 4);
   if (!pixels) {
     const char* reason = stbi_failure_reason();
-    return makeError("cannot load texture " + what + " (" + quoteInput(file.string(), 200) + ")" +
-                     (reason ? ": " + oneLine(reason) : std::string()));
+    return makeError("cannot load texture " + what + " (" + quoteInput(file.path().string(), 200) +
+                     ")" + (reason ? ": " + oneLine(reason) : std::string()));
   }
   Texture texture;
   texture.width = width;
@@ -170,17 +177,62 @@ struct CornerHash {
   }
 };
 
-Result<Scene> buildObjScene(const std::string& path, const LoadOptions& options) {
-  MFR_TRY(checkRegularFile(path, path));  // before the open: a FIFO would block it
-  std::ifstream stream(path);
-  if (!stream) return makeError(path + ": cannot be read");
+/// The corner count of every face of the text with three or more corners, in file order (the
+/// order tinyobjloader keeps them in, which stores the count in a byte: a 300-corner face reads
+/// as 44). Also checks what tinyobjloader reads without overflow checks: every index of an `f`
+/// line must be a 32-bit integer (4294967299 wrapped to 3). Linear in the text.
+Result<std::vector<uint32_t>> scanFaces(const std::string& text) {
+  std::vector<uint32_t> faces;
+  size_t line = 1;
+  for (size_t at = 0; at < text.size(); ++line) {
+    size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    size_t i = text.find_first_not_of(" \t", at);
+    if (i < end && text[i] == 'f' && i + 1 < end && (text[i + 1] == ' ' || text[i + 1] == '\t')) {
+      uint32_t corners = 0;
+      bool inToken = false;
+      for (i += 1; i < end && text[i] != '#'; ++i) {
+        const char c = text[i];
+        const bool space = c == ' ' || c == '\t' || c == '\r';
+        if (!space && !inToken) ++corners;
+        inToken = !space;
+        if (c != '-' && (c < '0' || c > '9')) continue;
+        const size_t start = i;
+        if (c == '-') ++i;
+        uint64_t value = 0;
+        bool overflow = false;
+        for (; i < end && text[i] >= '0' && text[i] <= '9'; ++i) {
+          value = value * 10 + static_cast<uint64_t>(text[i] - '0');
+          overflow = overflow || value > uint64_t{INT32_MAX};
+        }
+        if (overflow)
+          return makeError("line " + std::to_string(line) + ": face index " +
+                           quoteInput(std::string_view(text).substr(start, i - start), 40) +
+                           " is out of range (at most " + std::to_string(INT32_MAX) + ")");
+        --i;  // the loop steps past the last digit
+      }
+      if (corners >= 3) faces.push_back(corners);
+    }
+    at = end + 1;
+  }
+  return faces;
+}
+
+Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
+                            const LoadOptions& options) {
+  const uint64_t memoryLimit = options.memoryLimitBytes.value_or(defaultMemoryLimit());
+  auto text = file.readText(memoryLimit);
+  if (!text) return text.error();
+  auto faceCorners = scanFaces(*text);
+  if (!faceCorners) return makeError(path + ": " + faceCorners.error().message);
+  std::istringstream stream(*text);
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
   std::vector<tinyobj::material_t> objMaterials;
   std::string warn, err;
   MtlReader mtlReader(path, options.allowOutsideReferences);
   const bool loaded = tinyobj::LoadObj(&attrib, &shapes, &objMaterials, &warn, &err, &stream,
-                                       &mtlReader, /*triangulate=*/true);
+                                       &mtlReader, /*triangulate=*/false);  // polygon.hpp
   if (!mtlReader.refusal.empty()) return makeError(path + ": " + mtlReader.refusal);
   if (!loaded) {
     const std::string reason = firstLine(err);
@@ -190,14 +242,13 @@ Result<Scene> buildObjScene(const std::string& path, const LoadOptions& options)
   if (const std::string bad = lineContaining(warn, {"out of bounds", "invalid vertex index"});
       !bad.empty())
     return makeError(path + ": " + bad);
-  restoreNonFiniteCoordinates(path, attrib.vertices);
+  restoreNonFiniteCoordinates(*text, attrib.vertices);
 
   Scene scene;
   scene.name = path;
 
   // Materials (plus a default one, appended when some face needs it).
   std::map<std::string, int> textureByPath;
-  const uint64_t memoryLimit = options.memoryLimitBytes.value_or(defaultMemoryLimit());
   uint64_t textureBytes = 0;
   for (size_t m = 0; m < objMaterials.size(); ++m) {
     const tinyobj::material_t& src = objMaterials[m];
@@ -211,13 +262,14 @@ Result<Scene> buildObjScene(const std::string& path, const LoadOptions& options)
       std::replace(name.begin(), name.end(), '\\', '/');  // paths written on Windows
       const fs::path mtlFile = m < mtlReader.files.size() ? mtlReader.files[m] : fs::path(path);
       const std::string what = "map_Kd " + quoteInput(name);
-      auto file = resolveReference(mtlFile, name, what, options.allowOutsideReferences);
+      auto file = openReference(mtlFile, name, what, options.allowOutsideReferences);
       if (!file) return makeError(path + ": " + file.error().message);
-      auto it = textureByPath.find(file->string());
+      auto it = textureByPath.find(file->path().string());
       if (it == textureByPath.end()) {
         auto texture = loadTexture(*file, what, memoryLimit, textureBytes);
         if (!texture) return makeError(path + ": " + texture.error().message);
-        it = textureByPath.emplace(file->string(), static_cast<int>(scene.textures.size())).first;
+        it = textureByPath.emplace(file->path().string(), static_cast<int>(scene.textures.size()))
+                 .first;
         scene.textures.push_back(std::move(*texture));
       }
       material.baseColorTexture = it->second;
@@ -257,19 +309,45 @@ Result<Scene> buildObjScene(const std::string& path, const LoadOptions& options)
       anyUvs = anyUvs || corner.texcoord_index >= 0;
     }
 
-  // One scene vertex per distinct (position, normal, uv) corner.
+  // One scene vertex per distinct (position, normal, uv) corner; polygons triangulated here
+  // (polygon.hpp), in time linear in their corners when convex.
   std::unordered_map<CornerKey, uint32_t, CornerHash> vertexOf;
+  // tinyobjloader keeps each face's corner count in a byte: the scan's counts, when they agree
+  // with what it stored (they always should), else its own.
+  size_t storedFaces = 0, storedCorners = 0;
+  for (const tinyobj::shape_t& shape : shapes) {
+    storedFaces += shape.mesh.num_face_vertices.size();
+    storedCorners += shape.mesh.indices.size();
+  }
+  uint64_t scannedCorners = 0;
+  for (const uint32_t corners : *faceCorners) scannedCorners += corners;
+  const bool useScan = faceCorners->size() == storedFaces && scannedCorners == storedCorners;
+  size_t face = 0;
+  std::vector<glm::vec3> polygon;
+  std::vector<uint32_t> triangles;
   for (const tinyobj::shape_t& shape : shapes) {
     const tinyobj::mesh_t& mesh = shape.mesh;
     size_t offset = 0;
-    for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f) {
-      const size_t corners = mesh.num_face_vertices[f];
-      if (corners != 3 || offset + 3 > mesh.indices.size()) {  // not triangulated: skip
+    for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f, ++face) {
+      const size_t corners = useScan ? (*faceCorners)[face] : mesh.num_face_vertices[f];
+      if (corners < 3 || offset + corners > mesh.indices.size()) {  // no surface: skip
         offset += corners;
         continue;
       }
-      for (size_t k = 0; k < 3; ++k) {
-        const tinyobj::index_t& corner = mesh.indices[offset + k];
+      polygon.clear();
+      for (size_t k = 0; k < corners; ++k) {
+        const auto v = static_cast<size_t>(mesh.indices[offset + k].vertex_index);
+        polygon.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
+                             attrib.vertices[3 * v + 2]);
+      }
+      triangles.clear();
+      if (auto split = triangulatePolygon(polygon, triangles); !split)
+        return makeError(path + ": " + split.error().message + " (the face starting at vertex " +
+                         std::to_string(mesh.indices[offset].vertex_index + 1) + ")");
+      const uint32_t material =
+          materialFor(f < mesh.material_ids.size() ? mesh.material_ids[f] : -1);
+      for (size_t t = 0; t < triangles.size(); ++t) {
+        const tinyobj::index_t& corner = mesh.indices[offset + triangles[t]];
         const CornerKey key{corner.vertex_index, allNormals ? corner.normal_index : -1,
                             corner.texcoord_index};
         auto [it, inserted] =
@@ -286,17 +364,16 @@ Result<Scene> buildObjScene(const std::string& path, const LoadOptions& options)
             scene.normals.push_back(length > 0.0f ? normal / length : normal);
           }
           if (anyUvs) {
-            const auto t = static_cast<size_t>(key.t);
-            scene.uvs.push_back(
-                key.t < 0 ? glm::vec2(0.0f)
-                          : glm::vec2(attrib.texcoords[2 * t], 1.0f - attrib.texcoords[2 * t + 1]));
+            const auto uv = static_cast<size_t>(key.t);
+            scene.uvs.push_back(key.t < 0 ? glm::vec2(0.0f)
+                                          : glm::vec2(attrib.texcoords[2 * uv],
+                                                      1.0f - attrib.texcoords[2 * uv + 1]));
           }
         }
         scene.indices.push_back(it->second);
+        if (t % 3 == 2) scene.triangleMaterial.push_back(material);
       }
-      scene.triangleMaterial.push_back(
-          materialFor(f < mesh.material_ids.size() ? mesh.material_ids[f] : -1));
-      offset += 3;
+      offset += corners;
     }
   }
   if (scene.materials.empty()) materialFor(-1);  // no faces: still a well-formed material list
@@ -308,9 +385,9 @@ Result<Scene> buildObjScene(const std::string& path, const LoadOptions& options)
 
 }  // namespace
 
-Result<Scene> loadObj(const std::string& path, const LoadOptions& options) {
+Result<Scene> loadObj(const std::string& path, const OpenFile& file, const LoadOptions& options) {
   try {
-    return buildObjScene(path, options);
+    return buildObjScene(path, file, options);
   } catch (const std::bad_alloc&) {
     return makeError(path + ": out of memory");
   } catch (const std::exception& e) {

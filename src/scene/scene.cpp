@@ -1,7 +1,10 @@
 #include "mfr/scene/scene.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
+
+#include "mfr/core/quote.hpp"
 
 namespace mfr {
 
@@ -43,15 +46,25 @@ Result<void> validateScene(const Scene& scene) {
     if (!finite(scene.positions[i]))
       return makeError(name + ": vertex " + std::to_string(i) +
                        " has a NaN or infinite coordinate");
+  for (size_t i = 0; i < scene.positions.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      if (std::abs(scene.positions[i][c]) > kMaxCoordinate) {
+        char value[32];
+        std::snprintf(value, sizeof value, "%g", static_cast<double>(scene.positions[i][c]));
+        return makeError(name + ": vertex " + std::to_string(i) + " has coordinate " + value +
+                         ", beyond the +-1e18 that the single-precision bounds, framing and "
+                         "clipping arithmetic can square");
+      }
   for (size_t i = 0; i < scene.normals.size(); ++i)
     if (!finite(scene.normals[i]))
       return makeError(name + ": normal " + std::to_string(i) + " is NaN or infinite");
   for (const Material& m : scene.materials) {
     if (m.baseColorTexture >= static_cast<int>(scene.textures.size()))
-      return makeError(name + ": material '" + m.name + "' names a missing texture");
+      return makeError(name + ": material " + quoteInput(m.name) + " names a missing texture");
     for (int c = 0; c < 4; ++c)
       if (!std::isfinite(m.baseColor[c]))
-        return makeError(name + ": material '" + m.name + "' has a non-finite base colour");
+        return makeError(name + ": material " + quoteInput(m.name) +
+                         " has a non-finite base colour");
   }
   for (const Texture& t : scene.textures)
     if (t.width <= 0 || t.height <= 0 ||

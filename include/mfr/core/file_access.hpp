@@ -1,16 +1,19 @@
-// Reading files that other people made. Every file mfr reads is first checked, without opening it,
-// to be a regular file (a FIFO would block the open forever, a device can be endless), and files
-// named from inside a scene file (glTF buffers and images, OBJ mtllib and texture maps, a JSON
-// scene's mesh) must resolve to regular files inside the referencing file's folder: absolute
-// paths, `..` escapes and symbolic links leading outside are refused before anything is opened,
-// unless the caller allows references outside the folder (LoadOptions::allowOutsideReferences,
-// `--allow-outside-references`), which never allows non-regular files.
+// Reading files that other people made. Every file mfr reads is opened once, non-blocking (a FIFO
+// would block the open forever), and checked on the open descriptor to be a regular file (a device
+// can be endless); nothing is re-opened by name after a check. Files named from inside a scene
+// file (glTF buffers and images, OBJ mtllib and texture maps, a JSON scene's mesh) must be regular
+// files inside the referencing file's folder: absolute paths and `..` escapes are refused before
+// anything is opened, and a file whose opened path (symbolic links followed) lies outside is
+// refused before a byte of it is read, unless the caller allows references outside the folder
+// (LoadOptions::allowOutsideReferences, `--allow-outside-references`), which never allows
+// non-regular files.
 #pragma once
 
 #include <cstdint>
 #include <filesystem>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mfr/core/result.hpp"
@@ -29,28 +32,59 @@ inline constexpr uint64_t kMaxImagePixels = uint64_t{kMaxImageDimension} * kMaxI
 /// ...".
 Result<uint64_t> checkRegularFile(const std::filesystem::path& path, const std::string& what);
 
-/// Reads a whole regular file: checkRegularFile first, then the file is opened non-blocking and
-/// checked again on the open descriptor (so a file swapped for a FIFO in between cannot block),
-/// and refused before reading when it is larger than `maxBytes`.
+/// Reads a whole regular file: openRegularFile, then OpenFile::read (refused before reading when
+/// it is larger than `maxBytes`).
 Result<std::string> readRegularFile(const std::filesystem::path& path, const std::string& what,
                                     uint64_t maxBytes = std::numeric_limits<uint64_t>::max());
 Result<std::vector<unsigned char>> readRegularFileBytes(
     const std::filesystem::path& path, const std::string& what,
     uint64_t maxBytes = std::numeric_limits<uint64_t>::max());
 
-/// Resolves `reference`, a file named inside `referencingFile`, to the canonical path of a
-/// regular file. Relative references resolve against the referencing file's folder. Unless
-/// `allowOutside`: an absolute reference, a reference that leaves the folder lexically (`..`),
-/// and one whose canonical path (symbolic links followed) lies outside the folder's canonical
-/// path are refused; the first two without touching the file system. Always: the file must exist
-/// and be a regular file (checked with stat before anything opens it).
-/// Errors are "<what>: <problem>", `what` naming the reference (e.g. "buffer 0 uri 'a.bin'").
-Result<std::filesystem::path> resolveReference(const std::filesystem::path& referencingFile,
-                                               const std::string& reference,
-                                               const std::string& what, bool allowOutside);
+/// A file opened once: every check (regular file, inside the folder, size) is made on this
+/// descriptor, and the bytes are read from it, so a name swapped on disk between the check and
+/// the read (for a symbolic link, a FIFO, another file) can never be read unchecked.
+class OpenFile {
+ public:
+  OpenFile(int fd, std::filesystem::path path, uint64_t size, std::string what)
+      : fd_(fd), path_(std::move(path)), size_(size), what_(std::move(what)) {}
+  OpenFile(OpenFile&& other) noexcept;
+  OpenFile& operator=(OpenFile&&) = delete;
+  OpenFile(const OpenFile&) = delete;
+  ~OpenFile();
 
-/// Whether an error of checkRegularFile or resolveReference says that the file does not exist
-/// (as opposed to a refusal or a read error).
+  /// Where the kernel resolved the name (canonical, symbolic links followed).
+  const std::filesystem::path& path() const { return path_; }
+  /// The size fstat gave for the open file.
+  uint64_t size() const { return size_; }
+  /// All of the file; refused before reading when it is larger than `maxBytes`.
+  Result<std::vector<unsigned char>> read(
+      uint64_t maxBytes = std::numeric_limits<uint64_t>::max()) const;
+  Result<std::string> readText(uint64_t maxBytes = std::numeric_limits<uint64_t>::max()) const;
+
+ private:
+  int fd_ = -1;
+  std::filesystem::path path_;
+  uint64_t size_ = 0;
+  std::string what_;
+};
+
+/// Opens a file the user named (non-blocking, so a FIFO cannot block the open) and checks on the
+/// descriptor that it is a regular file. Errors as checkRegularFile's.
+Result<OpenFile> openRegularFile(const std::filesystem::path& path, const std::string& what);
+
+/// Opens `reference`, a file named inside `referencingFile`, exactly once. Relative references
+/// resolve against the referencing file's folder, opened first as a descriptor: the reference is
+/// opened relative to it (openat, non-blocking). Unless `allowOutside`: an absolute reference and
+/// one that leaves the folder lexically (`..`) are refused without touching the file system, and
+/// the file the kernel opened (its path in /proc/self/fd, symbolic links followed) must lie inside
+/// the folder the folder descriptor names. Always: the open file must be a regular file.
+/// Errors are "<what>: <problem>", `what` naming the reference (e.g. "buffer 0 uri 'a.bin'").
+Result<OpenFile> openReference(const std::filesystem::path& referencingFile,
+                               const std::string& reference, const std::string& what,
+                               bool allowOutside);
+
+/// Whether an error of checkRegularFile, openRegularFile or openReference says that the file does
+/// not exist (as opposed to a refusal or a read error).
 bool isNoSuchFileError(const Error& error);
 
 /// Checks an image header's dimensions against kMaxImageDimension and kMaxImagePixels.

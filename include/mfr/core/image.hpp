@@ -39,7 +39,9 @@ ImageRGB decodeSrgb(const Image8& image);
 /// Walks the chunks of a PNG held in memory (after the 8-byte signature, up to IEND): every chunk's
 /// declared length must fit in the bytes that follow. stb_image grows its buffer to a chunk's
 /// declared length before reading it, so without this a 100-byte file makes it allocate 2 GiB.
-/// Not a PNG (no signature): ok, nothing to check. Errors name `what`.
+/// An IHDR chunk's width and height are checked against kMaxImageDimension here too (stb_image
+/// refuses a large header only as an "unknown format"). Not a PNG (no signature): ok, nothing to
+/// check. Errors name `what`.
 Result<void> checkPngChunks(const uint8_t* bytes, size_t size, const std::string& what);
 
 Result<void> writePng(const std::string& path, const Image8& image);

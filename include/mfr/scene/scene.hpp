@@ -71,8 +71,12 @@ struct Bounds {
 /// Axis-aligned bounds of the vertices referenced by triangles.
 Bounds sceneBounds(const Scene& scene);
 
-/// Checks the invariants every consumer relies on (index ranges, sizes, finite values, at least one
-/// triangle). The message names the scene.
+/// Vertex coordinates beyond this are refused by validateScene: the scene's bounds, the framing
+/// camera and clipping square and sum them in single precision (FLT_MAX is 3.4e38).
+inline constexpr float kMaxCoordinate = 1e18f;
+
+/// Checks the invariants every consumer relies on (index ranges, sizes, finite values within
+/// +-kMaxCoordinate, at least one triangle). The message names the scene.
 Result<void> validateScene(const Scene& scene);
 
 /// Fills `normals` with area-weighted vertex normals when empty.
