@@ -457,4 +457,29 @@ TEST_F(HostileInputs, PlyHeaderOf200000ElementLinesIsRefusedAtOnce) {
   EXPECT_TRUE(refused(mfr::loadScene(twice), twice, {"'vertex' is declared twice"}));
 }
 
+TEST_F(HostileInputs, PlyThatAbortedAssimpsTriangulationLoads) {
+  // fuzz_ply's finding (fuzz/crashes/ply/crash-844b72d...): an element named "ver/ex" before the
+  // vertex element made assimp's Triangulate step abort the process (ai_assert); mfr splits the
+  // faces itself now
+  const std::string path =
+      write("aborts.ply",
+            "ply\nformat ascii 1.0\nelement ver/ex 1\nproperty float x\nproperty float y\n"
+            "property float z\nelement vertex 4\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 3 2 1\n");
+  auto scene = mfr::loadScene(path);
+  ASSERT_TRUE(scene.ok()) << scene.error().message;
+  EXPECT_GE(scene->triangleCount(), 1u);
+  // a quad and a convex pentagon are split into 2 and 3 triangles covering their area once
+  const std::string polygons =
+      write("polygons.ply",
+            "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
+            "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+            "0 0 0\n2 0 0\n2 1 0\n1 2 0\n0 1 0\n4 0 1 2 4\n5 0 1 2 3 4\n");
+  auto split = mfr::loadScene(polygons);
+  ASSERT_TRUE(split.ok()) << split.error().message;
+  EXPECT_EQ(split->triangleCount(), 5u);
+  EXPECT_NEAR(summedArea(*split), 2.0 + 3.0, 1e-6);
+}
+
 }  // namespace

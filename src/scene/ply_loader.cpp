@@ -1,6 +1,7 @@
 // Stanford PLY loader (ASCII and binary) on top of assimp, restricted to assimp's PLY importer:
 // the file is read into memory and handed to assimp with the "ply" format hint, so no other
-// importer ever looks at it. Triangulated, identical vertices joined; node transforms applied;
+// importer ever looks at it. Polygons split by polygon.hpp (assimp's Triangulate step aborted the
+// process on some files), identical vertices joined; node transforms applied;
 // file normals used when every mesh has them (otherwise computed); vertex colours ignored.
 // PLY has no materials: everything gets one opaque light-grey material.
 //
@@ -33,6 +34,7 @@
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
+#include "polygon.hpp"
 
 namespace mfr {
 namespace {
@@ -308,6 +310,7 @@ struct PlyBuilder {
   const aiScene& ai;
   Scene scene;
   bool allNormals = true;
+  std::string error;  // the first face that cannot be triangulated
 
   void visit(const aiNode& node, const glm::mat4& parent, unsigned depth) {
     const glm::mat4 world = parent * toGlm(node.mTransformation);
@@ -334,14 +337,29 @@ struct PlyBuilder {
         scene.normals.push_back(length > 0.0f ? normal / length : normal);
       }
     }
+    // Polygons are split here (polygon.hpp), not by assimp's Triangulate step, which aborts the
+    // process on some files (an ai_assert in TriangulateProcess.cpp, found by fuzz_ply).
+    std::vector<glm::vec3> corners;
+    std::vector<uint32_t> triangles;
     for (unsigned f = 0; f < mesh.mNumFaces; ++f) {
       const aiFace& face = mesh.mFaces[f];
-      if (face.mNumIndices != 3) continue;  // points and lines
+      if (face.mNumIndices < 3 || !face.mIndices) continue;  // points and lines
       bool valid = true;
-      for (unsigned k = 0; k < 3; ++k) valid = valid && face.mIndices[k] < mesh.mNumVertices;
+      corners.clear();
+      for (unsigned k = 0; k < face.mNumIndices && valid; ++k) {
+        valid = face.mIndices[k] < mesh.mNumVertices;
+        if (valid) corners.push_back(scene.positions[base + face.mIndices[k]]);
+      }
       if (!valid) continue;
-      for (unsigned k = 0; k < 3; ++k) scene.indices.push_back(base + face.mIndices[k]);
-      scene.triangleMaterial.push_back(0);
+      triangles.clear();
+      if (auto split = triangulatePolygon(corners, triangles); !split) {
+        if (error.empty()) error = "face " + std::to_string(f) + ": " + split.error().message;
+        continue;
+      }
+      for (size_t t = 0; t < triangles.size(); ++t) {
+        scene.indices.push_back(base + face.mIndices[triangles[t]]);
+        if (t % 3 == 2) scene.triangleMaterial.push_back(0);
+      }
     }
   }
 };
@@ -363,14 +381,13 @@ Result<Scene> loadPly(const std::string& path, const OpenFile& file, const LoadO
     // Belt and braces: assimp validates its own output before the other post-processing steps.
     const aiScene* ai = importer.ReadFileFromMemory(
         bytes.data(), bytes.size(),
-        aiProcess_ValidateDataStructure | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices,
-        "ply");
+        aiProcess_ValidateDataStructure | aiProcess_JoinIdenticalVertices, "ply");
     if (!ai || !ai->mRootNode) {
       const std::string reason = importer.GetErrorString();
       return makeError(path + ": " + (reason.empty() ? "invalid PLY file" : reason));
     }
 
-    PlyBuilder builder{*ai, {}};
+    PlyBuilder builder{*ai, {}, true, {}};
     builder.scene.name = path;
     uint64_t vertices = 0;
     for (unsigned m = 0; m < ai->mNumMeshes; ++m)
@@ -378,6 +395,7 @@ Result<Scene> loadPly(const std::string& path, const OpenFile& file, const LoadO
     if (vertices > std::numeric_limits<uint32_t>::max())
       return makeError(path + ": more than 2^32 vertices");
     builder.visit(*ai->mRootNode, glm::mat4(1.0f), 0);
+    if (!builder.error.empty()) return makeError(path + ": " + builder.error);
     Scene& scene = builder.scene;
     if (!builder.allNormals) scene.normals.clear();
 
