@@ -476,6 +476,18 @@ TEST_F(HostileInputs, PlyThatAbortedAssimpsTriangulationLoads) {
             "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n"
             "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
             "0 0 0\n2 0 0\n2 1 0\n1 2 0\n0 1 0\n4 0 1 2 4\n5 0 1 2 3 4\n");
+  // fuzz_ply's second finding (crash-a214f36...): assimp read a 41-digit element name as a count
+  // and asked for 45 GB; element and property names start with a letter or '_' (std::bad_alloc
+  // reached the user as "std::bad_alloc")
+  const std::string digits =
+      write("digits.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement " +
+                std::string(37, '7') +
+                "face 2\nproperty list uchar int vertex_indices\nend_header\n"
+                "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n");
+  EXPECT_TRUE(refused(mfr::loadScene(digits), digits,
+                      {"PLY element name '7777", "must start with a letter or '_'"}));
   auto split = mfr::loadScene(polygons);
   ASSERT_TRUE(split.ok()) << split.error().message;
   EXPECT_EQ(split->triangleCount(), 5u);

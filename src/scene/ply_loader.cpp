@@ -13,6 +13,7 @@
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -115,6 +116,11 @@ class PlyChecker {
     return true;
   }
 
+  static bool startsLikeAName(const std::string& word) {
+    const unsigned char c = word.empty() ? 0 : static_cast<unsigned char>(word[0]);
+    return std::isalpha(c) || c == '_';
+  }
+
   static std::vector<std::string> words(std::string_view line) {
     std::istringstream in{std::string(line)};
     std::vector<std::string> out;
@@ -156,6 +162,8 @@ class PlyChecker {
       } else if (w[0] == "element") {
         char* end = nullptr;
         if (w.size() != 3) return "bad PLY element line";
+        if (!startsLikeAName(w[1]))  // assimp reads a long name of digits as a count (45 GB)
+          return "PLY element name " + quoteInput(w[1], 40) + " must start with a letter or '_'";
         const unsigned long long count = std::strtoull(w[2].c_str(), &end, 10);
         if (*end != '\0' || w[2][0] == '-' || count > std::numeric_limits<uint32_t>::max())
           return "bad PLY element count " + quoteInput(w[2], 40);
@@ -177,6 +185,9 @@ class PlyChecker {
         } else {
           return "bad PLY property line";
         }
+        if (!startsLikeAName(property.name))
+          return "PLY property name " + quoteInput(property.name, 40) +
+                 " must start with a letter or '_'";
         elements_.back().properties.push_back(property);
       } else {
         return "unknown PLY header line " + quoteInput(line, 40);
@@ -383,7 +394,8 @@ Result<Scene> loadPly(const std::string& path, const OpenFile& file, const LoadO
         bytes.data(), bytes.size(),
         aiProcess_ValidateDataStructure | aiProcess_JoinIdenticalVertices, "ply");
     if (!ai || !ai->mRootNode) {
-      const std::string reason = importer.GetErrorString();
+      std::string reason = importer.GetErrorString();
+      if (reason.find("bad_alloc") != std::string::npos) reason = "out of memory";  // assimp's
       return makeError(path + ": " + (reason.empty() ? "invalid PLY file" : reason));
     }
 
