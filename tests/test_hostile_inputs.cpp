@@ -488,6 +488,14 @@ TEST_F(HostileInputs, PlyThatAbortedAssimpsTriangulationLoads) {
                 "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n");
   EXPECT_TRUE(refused(mfr::loadScene(digits), digits,
                       {"PLY element name '7777", "must start with a letter or '_'"}));
+  // fuzz_ply's third finding (leak-1e37540...): assimp leaked the faces of a triangle strip with
+  // indices out of range; strip indices are checked like face indices (-1 restarts a strip)
+  const std::string strip =
+      write("strip.ply",
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+            "property float z\nelement tristrips 1\nproperty list int int vertex_indices\n"
+            "end_header\n0 0 0\n1 2 0\n1 1 0\n6 0 1 2 -9 900 901\n");
+  EXPECT_TRUE(refused(mfr::loadScene(strip), strip, {"PLY triangle strip index -9 out of range"}));
   auto split = mfr::loadScene(polygons);
   ASSERT_TRUE(split.ok()) << split.error().message;
   EXPECT_EQ(split->triangleCount(), 5u);

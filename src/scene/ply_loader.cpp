@@ -81,6 +81,13 @@ bool isFaceIndexList(const PlyElement& element, const PlyProperty& property) {
          (property.name == "vertex_indices" || property.name == "vertex_index");
 }
 
+/// assimp reads triangle strips (element "tristrips", -1 restarts a strip) as faces too; an index
+/// out of range makes it leak the faces it built.
+bool isStripIndexList(const PlyElement& element, const PlyProperty& property) {
+  return element.name == "tristrips" && property.isList() &&
+         (property.name == "vertex_indices" || property.name == "vertex_index");
+}
+
 /// An integer of the given type in the file's byte order, widened to 64 bits.
 int64_t readInteger(const unsigned char* p, const PlyType& type, bool bigEndian) {
   uint64_t v = 0;
@@ -222,6 +229,14 @@ class PlyChecker {
     return {};
   }
 
+  std::string stripProblem(const std::vector<int64_t>& indices) const {
+    for (int64_t index : indices)
+      if (index < -1 || (index >= 0 && static_cast<uint64_t>(index) >= vertexCount_))
+        return "PLY triangle strip index " + std::to_string(index) + " out of range (" +
+               std::to_string(vertexCount_) + " vertices, -1 restarts a strip)";
+    return {};
+  }
+
   std::string checkBinaryBody() {
     const bool bigEndian = format_ == PlyFormat::BinaryBigEndian;
     const auto* data = reinterpret_cast<const unsigned char*>(bytes_.data());
@@ -243,11 +258,14 @@ class PlyChecker {
           pos_ += countSize;
           if (count < 0) return "negative PLY list count";
           if (static_cast<uint64_t>(count) > (size - pos_) / itemSize) return truncated;
-          if (isFaceIndexList(element, property)) {
+          if (isFaceIndexList(element, property) || isStripIndexList(element, property)) {
             indices.clear();
             for (size_t i = 0; i < static_cast<size_t>(count); ++i)
               indices.push_back(readInteger(data + pos_ + i * itemSize, property.type, bigEndian));
-            if (std::string problem = faceProblem(count, indices); !problem.empty()) return problem;
+            const std::string problem = isFaceIndexList(element, property)
+                                            ? faceProblem(count, indices)
+                                            : stripProblem(indices);
+            if (!problem.empty()) return problem;
           }
           pos_ += static_cast<size_t>(count) * itemSize;
         }
@@ -291,10 +309,12 @@ class PlyChecker {
             if (!number(&value)) return "bad PLY " + element.name + " line";
             indices.push_back(value == std::floor(value) && std::abs(value) < 1e18
                                   ? static_cast<int64_t>(value)
-                                  : -1);
+                                  : std::numeric_limits<int64_t>::min());  // never valid
           }
           if (isFaceIndexList(element, property))
             if (std::string problem = faceProblem(count, indices); !problem.empty()) return problem;
+          if (isStripIndexList(element, property))
+            if (std::string problem = stripProblem(indices); !problem.empty()) return problem;
         }
         if (line.find_first_not_of(" \t", next) != std::string_view::npos)
           return "bad PLY " + element.name + " line (extra values)";
