@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 #include <thread>
@@ -496,6 +497,11 @@ TEST_F(HostileInputs, PlyThatAbortedAssimpsTriangulationLoads) {
             "property float z\nelement tristrips 1\nproperty list int int vertex_indices\n"
             "end_header\n0 0 0\n1 2 0\n1 1 0\n6 0 1 2 -9 900 901\n");
   EXPECT_TRUE(refused(mfr::loadScene(strip), strip, {"PLY triangle strip index -9 out of range"}));
+  std::ifstream in(strip);
+  std::string renamed{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  renamed.replace(renamed.find("vertex_indices"), 14, "vertex_edniics");  // any name (leak-c295b12)
+  const std::string other = write("strip_name.ply", renamed);
+  EXPECT_TRUE(refused(mfr::loadScene(other), other, {"PLY triangle strip index -9 out of range"}));
   auto split = mfr::loadScene(polygons);
   ASSERT_TRUE(split.ok()) << split.error().message;
   EXPECT_EQ(split->triangleCount(), 5u);

@@ -81,11 +81,10 @@ bool isFaceIndexList(const PlyElement& element, const PlyProperty& property) {
          (property.name == "vertex_indices" || property.name == "vertex_index");
 }
 
-/// assimp reads triangle strips (element "tristrips", -1 restarts a strip) as faces too; an index
-/// out of range makes it leak the faces it built.
+/// assimp reads triangle strips (element "tristrips", -1 restarts a strip) as faces too, from an
+/// integer list of whatever name; an index out of range makes it leak the faces it built.
 bool isStripIndexList(const PlyElement& element, const PlyProperty& property) {
-  return element.name == "tristrips" && property.isList() &&
-         (property.name == "vertex_indices" || property.name == "vertex_index");
+  return element.name == "tristrips" && property.isList() && property.type.integral;
 }
 
 /// An integer of the given type in the file's byte order, widened to 64 bits.
