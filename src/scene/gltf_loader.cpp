@@ -1,7 +1,8 @@
 // glTF 2.0 loader (.gltf and .glb) on top of tinygltf, following the Khronos glTF 2.0 specification
 // (accessors incl. sparse and normalized integers, node hierarchy with matrix or TRS transforms,
 // triangle primitives, metallic-roughness base colour, alpha modes, perspective cameras) and the
-// KHR_materials_transmission extension (folded into alpha, see LoadOptions).
+// KHR_materials_transmission (folded into alpha, see LoadOptions), KHR_mesh_quantization and
+// EXT_mesh_gpu_instancing (one copy of the mesh per instance) extensions.
 //
 // Images are not decoded while tinygltf parses the file: a custom image callback keeps the encoded
 // bytes, and only images used as a base colour texture are decoded (in parallel) afterwards.
@@ -252,9 +253,11 @@ std::optional<uint64_t> dataUriBytes(const std::string& uri) {
 }
 
 /// The glTF extensions mfr implements: an asset that requires any other must be refused (glTF 2.0
-/// section 3.12). KHR_mesh_quantization only widens the accessor types, which readAccessor reads.
+/// section 3.12). KHR_mesh_quantization only widens the accessor types, which readAccessor reads;
+/// EXT_mesh_gpu_instancing is expanded into one copy of the mesh per instance.
 bool isImplementedExtension(const std::string& name) {
-  return name == "KHR_materials_transmission" || name == "KHR_mesh_quantization";
+  return name == "KHR_materials_transmission" || name == "KHR_mesh_quantization" ||
+         name == "EXT_mesh_gpu_instancing";
 }
 
 /// What the JSON says before tinygltf reads it: required extensions mfr implements, buffer views'
@@ -268,7 +271,8 @@ Result<void> checkReferences(const nlohmann::json& doc, GltfFiles& files) {
       if (name.is_string() && !isImplementedExtension(name.get<std::string>()))
         return makeError("requires extension " + quoteInput(name.get<std::string>()) +
                          ", which mfr does not implement (it implements "
-                         "KHR_materials_transmission and KHR_mesh_quantization)");
+                         "KHR_materials_transmission, KHR_mesh_quantization and "
+                         "EXT_mesh_gpu_instancing)");
   if (auto it = doc.find("bufferViews"); it != doc.end() && it->is_array())
     for (size_t i = 0; i < it->size(); ++i) {
       const nlohmann::json& view = (*it)[i];
@@ -439,6 +443,7 @@ class GltfSceneBuilder {
   Result<std::vector<double>> readAccessor(int index, int expectedType,
                                            const std::string& what) const;
   Result<void> visitNodes();
+  Result<void> addMeshInstances(const tinygltf::Node& node, int nodeIndex, const glm::dmat4& world);
   Result<void> addMesh(int meshIndex, const glm::dmat4& world);
   Result<void> addPrimitive(const tinygltf::Primitive& primitive, const glm::dmat4& world,
                             const std::string& what);
@@ -591,10 +596,69 @@ Result<void> GltfSceneBuilder::visitNodes() {
     visited[static_cast<size_t>(index)] = 1;
     const tinygltf::Node& node = model_.nodes[static_cast<size_t>(index)];
     const glm::dmat4 world = parent * localTransform(node);
-    if (node.mesh >= 0) MFR_TRY(addMesh(node.mesh, world));
+    if (node.mesh >= 0) MFR_TRY(addMeshInstances(node, index, world));
     if (node.camera >= 0) cameraNodes_.emplace_back(node.camera, world);
     for (auto it = node.children.rbegin(); it != node.children.rend(); ++it)
       stack.emplace_back(*it, world);
+  }
+  return {};
+}
+
+/// A node's mesh, once, or once per instance of EXT_mesh_gpu_instancing: instance i is the
+/// node's world transform times T(i) R(i) S(i) from the TRANSLATION, ROTATION (unit quaternions,
+/// possibly normalized integers) and SCALE accessors, each optional, all of one count.
+Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int nodeIndex,
+                                                const glm::dmat4& world) {
+  const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
+  if (ext == node.extensions.end() || !ext->second.Has("attributes") ||
+      !ext->second.Get("attributes").IsObject())
+    return addMesh(node.mesh, world);
+  const tinygltf::Value& attributes = ext->second.Get("attributes");
+  const std::string what = "node " + std::to_string(nodeIndex) + " EXT_mesh_gpu_instancing";
+  std::vector<double> values[3];  // translation, rotation, scale
+  const char* names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+  const int types[3] = {TINYGLTF_TYPE_VEC3, TINYGLTF_TYPE_VEC4, TINYGLTF_TYPE_VEC3};
+  std::optional<size_t> count;
+  for (int a = 0; a < 3; ++a) {
+    if (!attributes.Has(names[a])) continue;
+    const tinygltf::Value& accessor = attributes.Get(names[a]);
+    if (!accessor.IsInt()) return fail(what + " " + names[a] + ": must be an accessor index");
+    auto read = readAccessor(accessor.GetNumberAsInt(), types[a], what + " " + names[a]);
+    if (!read) return read.error();
+    const size_t n = read->size() / (a == 1 ? 4 : 3);
+    if (count && *count != n)
+      return fail(what + ": " + names[a] + " has " + std::to_string(n) +
+                  " instances, another attribute " + std::to_string(*count));
+    count = n;
+    values[a] = std::move(*read);
+  }
+  if (!count) return addMesh(node.mesh, world);
+  const size_t before = scene_.positions.size() * sizeof(glm::vec3) * 3 +
+                        scene_.indices.size() * sizeof(uint32_t) * 2;
+  for (size_t i = 0; i < *count; ++i) {
+    glm::dmat4 instance(1.0);
+    if (!values[0].empty())
+      instance = glm::translate(
+          instance, glm::dvec3(values[0][3 * i], values[0][3 * i + 1], values[0][3 * i + 2]));
+    if (!values[1].empty()) {
+      const glm::dquat q(values[1][4 * i + 3], values[1][4 * i], values[1][4 * i + 1],
+                         values[1][4 * i + 2]);  // stored x, y, z, w
+      if (!(glm::length(q) > 0.0))
+        return fail(what + ": ROTATION " + std::to_string(i) + " is not a unit quaternion");
+      instance *= glm::mat4_cast(glm::normalize(q));
+    }
+    if (!values[2].empty())
+      instance = glm::scale(
+          instance, glm::dvec3(values[2][3 * i], values[2][3 * i + 1], values[2][3 * i + 2]));
+    MFR_TRY(addMesh(node.mesh, world * instance));
+    if (i == 0) {  // what one instance costs, times the count, against the memory limit
+      const size_t after = scene_.positions.size() * sizeof(glm::vec3) * 3 +
+                           scene_.indices.size() * sizeof(uint32_t) * 2;
+      if (auto fits = checkMemory(saturatingAdd(before, saturatingMul(after - before, *count)),
+                                  memoryLimit_, "its " + std::to_string(*count) + " instances");
+          !fits)
+        return fail(what + ": " + fits.error().message);
+    }
   }
   return {};
 }
