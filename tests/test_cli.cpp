@@ -2,10 +2,12 @@
 // exit (never a crash); good input writes the promised files with the promised keys.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <utility>
 
 #include <nlohmann/json.hpp>
 
@@ -142,6 +144,70 @@ TEST(Cli, OrbitWritesOneImagePerView) {
   ASSERT_EQ(r.exitCode, 0) << r.err;
   for (const char* f : {"o_v000.png", "o_v001.png", "o_v002.png"})
     EXPECT_TRUE(fs::exists(dir / f)) << f;
+}
+
+// Command-line syntax errors: one "mfr: error: ..." line on stderr and exit 2 (not CLI11's exit
+// codes 104-114 and its two lines); --help and --version still print and exit 0.
+TEST(Cli, SyntaxErrorsAreOneLineAndExitTwo) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"render --width 1.5 procedural:spheres", "--width"},
+      {"render --no-such-option procedural:spheres", "--no-such-option"},
+      {"render procedural:spheres --width", "--width"},
+      {"render", "scene"},
+      {"", "subcommand"},
+      {"rendr procedural:spheres", "'rendr'"},
+  };
+  for (const auto& [args, needle] : cases) {
+    const CliRun r = runCli(args);
+    EXPECT_FALSE(r.signaled) << args;
+    EXPECT_EQ(r.exitCode, 2) << args << "\n" << r.err;
+    EXPECT_EQ(r.err.rfind("mfr: error: ", 0), 0u) << args << "\n" << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << args << "\n" << r.err;
+    EXPECT_NE(r.err.find(needle), std::string::npos) << args << "\n" << r.err;
+    EXPECT_TRUE(r.out.empty()) << args;
+  }
+  // an echoed value is cut short: the line stays bounded whatever the argument's length
+  const CliRun longValue =
+      runCli("render --width " + std::string(5000, '7') + "x procedural:spheres");
+  EXPECT_EQ(longValue.exitCode, 2) << longValue.err;
+  EXPECT_LT(longValue.err.size(), 400u) << longValue.err;
+}
+
+TEST(Cli, HelpAndVersionExitZero) {
+  for (const char* args : {"--help", "render --help", "--version"}) {
+    const CliRun r = runCli(args);
+    EXPECT_EQ(r.exitCode, 0) << args << "\n" << r.err;
+    EXPECT_FALSE(r.out.empty()) << args;
+    EXPECT_TRUE(r.err.empty()) << args << "\n" << r.err;
+  }
+}
+
+// Past the file-size limit (ulimit -f) the write fails with EFBIG: one line naming the output and
+// the reason, a non-zero exit, no signal (SIGXFSZ) and no partial file.
+TEST(Cli, FileSizeLimitIsAWriteErrorNotASignal) {
+  const fs::path dir = tempDir() / "fsize";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path image = dir / "out.png", stats = dir / "stats.json";
+  // 10 blocks of 512 bytes: a 512x512 noisy render's PNG is far larger
+  const std::string limited = "sh -c 'ulimit -f 10; exec " MFR_CLI_PATH;
+  const CliRun r =
+      mfr::test::runShell(limited + " render procedural:hairball --width 512 --height 512 -q -o " +
+                              image.string() + "'",
+                          tempDir());
+  EXPECT_FALSE(r.signaled) << r.exitCode << " " << r.err;
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(r.err.rfind("mfr: error: " + image.string() + ": ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find("write error (File too large)"), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_TRUE(fs::is_empty(dir)) << "a partial or temporary file was left";
+
+  // stdout past the limit (--json into a file) is an error too, not a silently cut output
+  const CliRun json = mfr::test::runShell(
+      "sh -c 'ulimit -f 1; exec " MFR_CLI_PATH " presets --format json'", tempDir());
+  EXPECT_FALSE(json.signaled) << json.err;
+  EXPECT_EQ(json.exitCode, 1) << json.err;
+  EXPECT_EQ(json.err, "mfr: error: stdout: write error (File too large)\n");
 }
 
 }  // namespace
