@@ -96,6 +96,17 @@ TEST(Cli, BadBudgetsAreErrors) {
   expectCleanFailure("render procedural:spheres --method kplus-heap -q", "budget");
 }
 
+TEST(Cli, ThreadsOutsideZeroTo1024AreErrorsAndZeroIsAllCores) {
+  expectCleanFailure("render procedural:spheres --threads -1 -q",
+                     "--threads -1: must be in [0, 1024], 0 = all cores");
+  expectCleanFailure("render procedural:spheres --threads 1025 -q",
+                     "--threads 1025: must be in [0, 1024], 0 = all cores");
+  const CliRun r = runCli("render procedural:spheres --width 16 --height 16 --threads 0 -q --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_GE(j["engine_counters"]["threads"].get<int>(), 1);
+}
+
 TEST(Cli, UnknownMethodAndNonFiniteCameraAreErrors) {
   expectCleanFailure("render procedural:spheres --method kbuffer9 -q", "kbuffer9");
   expectCleanFailure("render procedural:spheres --camera nan,0,5,0,0,0 -q", "--camera");

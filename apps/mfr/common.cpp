@@ -30,7 +30,8 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
   app.add_option("--orbit-view", orbitView, "With --orbit N: only view I of the N (0-based)");
   app.add_option("--zoom", zoom,
                  "Move the camera Z times closer to its target (default 1; 2 = half the distance)");
-  app.add_option("--threads", threads, "Worker threads (default: all cores)");
+  app.add_option("--threads", threads,
+                 "Worker threads, 0-" + std::to_string(kMaxThreads) + " (default 0: all cores)");
   app.add_option("--seed", seed, "Seed for procedural scenes and noise (default 1)");
   app.add_option("--shuffle-draw-order", shuffleDrawOrder,
                  "Submit the scene's triangles in the random order of this seed");
@@ -96,8 +97,7 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
     return makeError("--width/--height " + std::to_string(o.width) + "x" +
                      std::to_string(o.height) + ": must be in [1, " +
                      std::to_string(kMaxImageSize) + "]");
-  if (o.threads < 0 || o.threads > 1024)
-    return makeError("--threads " + std::to_string(o.threads) + ": must be in [1, 1024]");
+  MFR_TRY(checkThreads(o.threads, "--threads"));
   if (o.orbit < 0 || o.orbit > 10000)
     return makeError("--orbit " + std::to_string(o.orbit) + ": must be in [1, 10000]");
   if (o.orbitView >= 0 && o.orbitView >= o.orbit)

@@ -86,8 +86,8 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
     camera: (eye xyz, target xyz[, up xyz[, fov degrees]]) as 6, 9 or 10 numbers; view: index of
         a camera of the scene file; default: the scene's own camera, or one framing its bounds.
         zoom: moves the camera zoom times closer to its target.
-    threads: worker threads (0: all cores; the output does not depend on it). seed: procedural
-        scenes and vkb's noise.
+    threads: worker threads in [0, 1024] (0: all cores; the output does not depend on it).
+        seed: procedural scenes and vkb's noise.
     memory_limit: refuse runs whose buffers need more (bytes or "8GB"; default 75% of the
         physical memory, as `mfr --memory-limit`).
     depth_complexity: also count the fragments per pixel when the method does not.

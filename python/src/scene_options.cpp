@@ -115,8 +115,7 @@ RasterOptions rasterArgument(int width, int height, int threads) {
   if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize)
     throw LibraryError("width/height " + std::to_string(width) + "x" + std::to_string(height) +
                        ": must be in [1, " + std::to_string(kMaxImageSize) + "]");
-  if (threads < 0 || threads > 1024)
-    throw LibraryError("threads " + std::to_string(threads) + ": must be in [0, 1024]");
+  unwrap(checkThreads(threads, "threads"));
   RasterOptions ro;
   ro.width = width;
   ro.height = height;

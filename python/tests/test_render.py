@@ -238,6 +238,8 @@ def test_errors_carry_the_librarys_messages(tmp_path, cli_error):
     (dict(method="vkb", budget="1MB", importance={"colour": 1}), r"unknown parameter 'colour'"),
     (dict(method="vkb", budget="1MB", importance={"alpha": 2}), r"importance\['alpha'\]"),
     (dict(width=0), r"^width/height 0x32: must be in \[1, 16384\]"),
+    (dict(threads=-1), r"^threads -1: must be in \[0, 1024\], 0 = all cores$"),
+    (dict(threads=1025), r"^threads 1025: must be in \[0, 1024\], 0 = all cores$"),
     (dict(camera=(1, 2, 3)), r"^camera: expected 6, 9 or 10 numbers"),
     (dict(camera=(0, 0, 1, 0, 0, float("nan"))), r"^camera: values must be finite"),
     (dict(camera=(1, 1, 1, 1, 1, 1)), r"^camera: eye and target must differ"),
@@ -254,6 +256,16 @@ def test_bad_options_raise_mfr_error(kwargs, pattern):
     args.update(kwargs)
     with pytest.raises(mfr.Error, match=pattern):
         mfr.render("procedural:bottles", **args)
+
+
+def test_threads_range_is_the_clis(tmp_path, cli_error):
+    # CLI, viewer (the same options) and Python: [0, 1024], 0 = all cores
+    for threads in (-1, 1025):
+        with pytest.raises(mfr.Error) as e:
+            mfr.render("procedural:bottles", width=W, height=H, threads=threads)
+        assert "--" + str(e.value) == cli_error("render", "procedural:bottles", "--threads",
+                                                threads, "-o", tmp_path / "x.png")
+    assert mfr.render("procedural:bottles", width=W, height=H, threads=0).srgb.shape[:2] == (H, W)
 
 
 def test_wrong_types_raise_type_error():
