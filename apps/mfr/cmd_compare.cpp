@@ -280,14 +280,20 @@ int run(const CompareArgs& a, const std::string& version) {
   if (auto ready = prepareOutputFolder(a.out); !ready) return fail(ready.error().message);
   const fs::path dir(a.out);
 
+  auto memoryLimit = a.scene.memoryLimitBytes();
+  if (!memoryLimit) return fail(memoryLimit.error().message);
+  options.memoryLimitBytes = memoryLimit.value();
+  auto engine = makeSceneEngine(a.scene);
+  if (!engine) return fail(engine.error().message);
+  // the ground truth's (the A-buffer's) buffers at this size, before the scene is loaded
+  if (auto fits = checkComparisonFits(**engine, a.scene.width, a.scene.height, options); !fits)
+    return fail(a.scene.source + ": " + fits.error().message);
+
   Progress progress(!a.scene.quiet);
   progress.set("loading " + a.scene.source);
   auto prepared = prepareScene(a.scene);
   if (!prepared) return fail(prepared.error().message);
-  options.memoryLimitBytes = a.scene.memoryLimitBytes().value();  // checked by prepareScene
   options.background = prepared->scene.background;
-  auto engine = makeSceneEngine(a.scene);
-  if (!engine) return fail(engine.error().message);
   if (temporal) return runTemporal(a, options, version, **engine, *prepared, progress);
   progress.set("setting up " + a.scene.source);
   auto view = (*engine)->prepare(sceneView(*prepared, a.scene, prepared->cameras.front()));

@@ -146,17 +146,23 @@ int run(const RenderArgs& a) {
     return fail("--capture '" + a.capture + "': expected tile or parallel");
   if (a.out.empty()) return fail("--out: empty path");
 
+  auto memoryLimit = a.scene.memoryLimitBytes();
+  if (!memoryLimit) return fail(memoryLimit.error().message);
+  options.memoryLimitBytes = memoryLimit.value();
+  auto engine = makeSceneEngine(a.scene);
+  if (!engine) return fail(engine.error().message);
+  // what the image size alone decides, before the scene is loaded and set up
+  if (auto fits = (*engine)->preflight(a.scene.width, a.scene.height, *method, options); !fits)
+    return fail(a.scene.source + ": " + fits.error().message);
+
   Progress progress(!a.scene.quiet);
   progress.set("loading " + a.scene.source);
   auto prepared = prepareScene(a.scene);
   if (!prepared) return fail(prepared.error().message);
-  options.memoryLimitBytes = a.scene.memoryLimitBytes().value();  // checked by prepareScene
   const Scene& scene = prepared->scene;
   options.background = scene.background;
   const int views = static_cast<int>(prepared->cameras.size());
   nlohmann::json allStats = nlohmann::json::array();
-  auto engine = makeSceneEngine(a.scene);
-  if (!engine) return fail(engine.error().message);
   std::vector<float> previousCosine;  // importance methods: nearest |n.v| of the previous view
   if (prepared->previousCamera && method->allocation == AllocationPolicy::Importance &&
       method->importanceSource == ImportanceSource::Heuristic) {

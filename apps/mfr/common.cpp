@@ -51,7 +51,9 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
   app.add_option("--memory-limit", memoryLimit,
                  "Refuse to allocate buffers larger than this, e.g. 8GB (default: " +
                      std::to_string(static_cast<int>(kDefaultMemoryShare * 100)) +
-                     "% of the physical memory, " + formatBytes(defaultMemoryLimit()) + ")");
+                     "% of the physical memory, of the address-space limit (ulimit -v) or of the "
+                     "cgroup's memory limit, whichever is least: " +
+                     formatBytes(defaultMemoryLimit()) + ")");
   if (engineOption) {
     std::string names;
     for (const std::string& n : engineNames()) names += (names.empty() ? "" : "|") + n;

@@ -126,6 +126,8 @@ py::object compare(const py::object& sceneArg, const std::string& out,
   {
     py::gil_scoped_release release;
     CpuEngine engine(EngineOptions{ro.threads, ro.tileSize});
+    if (auto fits = checkComparisonFits(engine, ro.width, ro.height, options); !fits)
+      throw LibraryError(scene.source + ": " + fits.error().message);
     auto view = engine.prepare(View{&*scene.scene, cam, ro.width, ro.height});
     if (!view) throw LibraryError(scene.source + ": " + view.error().message);
     auto result = runComparison(engine, **view, options);

@@ -122,6 +122,8 @@ PyRenderResult renderScene(const py::object& sceneArg, const std::string& method
   {
     py::gil_scoped_release release;
     CpuEngine engine(EngineOptions{ro.threads, ro.tileSize});
+    if (auto fits = engine.preflight(ro.width, ro.height, m, options); !fits)
+      throw LibraryError(scene.source + ": " + fits.error().message);
     auto view = engine.prepare(View{&*scene.scene, cam, ro.width, ro.height});
     if (!view) throw LibraryError(scene.source + ": " + view.error().message);
     auto rendered = engine.render(**view, m, options);

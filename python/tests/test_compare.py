@@ -84,6 +84,11 @@ def test_compare_errors(tmp_path):
     blocker.write_text("not a folder")
     with pytest.raises(mfr.Error, match="cannot create the output folder"):
         mfr.compare(SCENE, blocker, "40KB", methods=["fkb"], **kwargs)
+    # the ground truth's buffers at this size do not fit: refused before the frame is set up
+    with pytest.raises(mfr.Error, match=r"^procedural:hairball: ground truth \(abuffer\): "
+                                        r"abuffer at 16384 x 16384 pixels: its per-pixel buffers"):
+        mfr.compare("procedural:hairball", tmp_path / "c", "40KB", methods=["fkb"], width=16384,
+                    height=16384, memory_limit="1GB")
     # a budget too small for a method is recorded, not raised
     r = mfr.compare(SCENE, tmp_path / "b", "2KB", methods=["fkb"], **kwargs)
     assert "error" in r["methods"][0]

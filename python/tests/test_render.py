@@ -214,6 +214,10 @@ def test_errors_carry_the_librarys_messages(tmp_path, cli_error):
                             memory_limit="1KB"),
          ["render", "procedural:bottles", "-m", "fkb", "--k", 2, "--width", W, "--height", H,
           "--memory-limit", "1KB", "-o", out]),
+        # the image size alone does not fit: refused before the frame is set up (fast)
+        (lambda: mfr.render("procedural:hairball", width=16384, height=16384, memory_limit="1GB"),
+         ["render", "procedural:hairball", "--width", 16384, "--height", 16384,
+          "--memory-limit", "1GB", "-o", out]),
     ]
     for call, args in cases:
         with pytest.raises(mfr.Error) as e:
