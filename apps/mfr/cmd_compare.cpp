@@ -126,12 +126,13 @@ void printSummary(const CompareResult& r) {
 // stability of each method along the path (mfr/compare/temporal.hpp) in DIR/results.json,
 // DIR/report.html and one plot per budget.
 int runTemporal(const CompareArgs& a, CompareOptions options, const std::string& version,
-                Engine& engine, const PreparedScene& prepared, Progress& progress) {
+                Engine& engine, const PreparedScene& prepared, Progress& progress,
+                OutputFolder& outFolder) {
   const int frames = a.scene.orbit;
   const float step =
       a.orbitStep > 0.0 ? static_cast<float>(a.orbitStep) : 360.0f / static_cast<float>(frames);
   const std::vector<Camera> path = orbitPath(prepared.cameras.front(), frames, step);
-  const fs::path dir(a.out);
+  const fs::path dir(outFolder.staging());  // put in place as --out once complete
   const auto [versionNumber, info] = provenance(version);
   TemporalStability temporal(a.pixelsPerDegree);
   std::vector<std::string> folders;
@@ -193,6 +194,7 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
                                                  plots, folders, info.commandLine));
       !w)
     return fail(w.error().message);
+  if (auto placed = outFolder.commit(); !placed) return fail(placed.error().message);
   progress.clear();
   if (!a.scene.quiet) {
     std::fprintf(stderr, "%s, %d frames %.3g degrees apart; ground truth flicker %.4f\n",
@@ -202,7 +204,7 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
     for (const TemporalSeries& s : t.series)
       std::fprintf(stderr, "  %-20s %8s %9.4f %9.4f %12.4f\n", s.method.c_str(),
                    s.budgetLabel.c_str(), s.flicker, s.excessFlicker, s.meanErrorChange);
-    std::fprintf(stderr, "report: %s\n", (dir / "report.html").string().c_str());
+    std::fprintf(stderr, "report: %s\n", (fs::path(a.out) / "report.html").string().c_str());
   }
   if (a.scene.json) std::fputs(jsonText.c_str(), stdout);
   return 0;
@@ -276,8 +278,9 @@ int run(const CompareArgs& a, const std::string& version) {
   else if (a.capture != "tile")
     return fail("--capture '" + a.capture + "': expected tile or parallel");
 
-  // output folder: created and probed before any work
-  if (auto ready = prepareOutputFolder(a.out); !ready) return fail(ready.error().message);
+  // output folder: checked and its staging folder made before any work; put in place at the end
+  auto outFolder = OutputFolder::begin(a.out);
+  if (!outFolder) return fail(outFolder.error().message);
   const fs::path dir(a.out);
 
   auto memoryLimit = a.scene.memoryLimitBytes();
@@ -294,7 +297,8 @@ int run(const CompareArgs& a, const std::string& version) {
   auto prepared = prepareScene(a.scene);
   if (!prepared) return fail(prepared.error().message);
   options.background = prepared->scene.background;
-  if (temporal) return runTemporal(a, options, version, **engine, *prepared, progress);
+  if (temporal)
+    return runTemporal(a, options, version, **engine, *prepared, progress, outFolder.value());
   progress.set("setting up " + a.scene.source);
   auto view = (*engine)->prepare(sceneView(*prepared, a.scene, prepared->cameras.front()));
   if (!view) return fail(a.scene.source + ": " + view.error().message);
@@ -315,8 +319,9 @@ int run(const CompareArgs& a, const std::string& version) {
   // files
   progress.set("writing " + a.out);
   const auto [versionNumber, info] = provenance(version);
-  auto written = writeComparison(r, a.out, versionNumber, info);
+  auto written = writeComparison(r, outFolder->staging(), versionNumber, info);
   if (!written) return fail(written.error().message);
+  if (auto placed = outFolder->commit(); !placed) return fail(placed.error().message);
   const std::string& jsonText = written.value();
   progress.clear();
 

@@ -114,7 +114,8 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     options.compositing = unwrap(parseCompositing(composite.cast<std::string>()));
   options.capture = captureArgument(capture);
   const RasterOptions ro = rasterArgument(width, height, threads);
-  unwrap(prepareOutputFolder(out));
+  // checked and staged before any work; put in place as `out` once complete (as mfr compare)
+  OutputFolder folder = unwrap(OutputFolder::begin(out));
 
   options.memoryLimitBytes = memoryLimitArgument(memoryLimitArg);
   const SceneArgument scene =
@@ -136,7 +137,8 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     info.mfrVersion = std::string("mfr ") + MFR_VERSION;
     info.commandLine = commandLine;
     info.generated = utcTimestamp();
-    jsonText = unwrap(writeComparison(result.value(), out, MFR_VERSION, info));
+    jsonText = unwrap(writeComparison(result.value(), folder.staging(), MFR_VERSION, info));
+    unwrap(folder.commit());
   }
   return py::module_::import("json").attr("loads")(jsonText);
 }

@@ -94,6 +94,28 @@ def test_compare_errors(tmp_path):
     assert "error" in r["methods"][0]
 
 
+def test_an_old_folder_is_replaced_whole_and_another_never(tmp_path):
+    out = tmp_path / "out"
+    mfr.compare(SCENE, out, "40KB", methods=["fkb", "vkb"], width=16, height=16)
+    assert (out / "vkb_40KB.png").exists()
+    # a failing compare (here its ground truth does not fit) leaves the old folder as it was
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    with pytest.raises(mfr.Error, match="memory limit"):
+        mfr.compare(SCENE, out, "40KB", methods=["fkb"], width=64, height=64, memory_limit="4KB")
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    # a complete one replaces it whole, as `mfr compare` does: no file of the old one is left
+    mfr.compare(SCENE, out, "40KB", methods=["fkb"], width=24, height=24)
+    assert read_json(out / "results.json")["width"] == 24
+    assert not (out / "vkb_40KB.png").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder left
+    # a folder holding files a comparison does not write is never replaced
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep")
+    with pytest.raises(mfr.Error, match=r"holds 'notes.txt', which a comparison does not write"):
+        mfr.compare(SCENE, tmp_path / "mine", "40KB", methods=["fkb"], width=16, height=16)
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
+
+
 def test_default_methods_are_the_clis(run_cli):
     help_text = run_cli("compare", "--help").stdout
     default = re.search(r"--methods TEXT +Methods, comma-separated \(default ([a-z0-9+,-]+)\)",
