@@ -241,6 +241,7 @@ Image8 image8Argument(const py::array& image, const char* what) {
     const auto pixels = py::array_t<float, py::array::c_style | py::array::forcecast>(image);
     ImageRGB linear(static_cast<int>(w), static_cast<int>(h));
     std::memcpy(linear.pixels.data(), pixels.data(), sizeof(float) * 3 * linear.pixels.size());
+    unwrap(checkFinite(linear, name));
     return encodeSrgb(linear);
   }
   throw py::value_error(name + ": expected uint8 sRGB or floating-point linear values, got dtype " +
