@@ -111,7 +111,8 @@ py::object compare(const py::object& sceneArg, const std::string& out,
   if (options.budgets.empty())
     throw LibraryError("budgets: no budget given (e.g. budgets=[\"20MB\", \"40MB\"])");
   if (!composite.is_none())
-    options.compositing = unwrap(parseCompositing(composite.cast<std::string>()));
+    options.compositing =
+        unwrap(parseCompositing(castArgument<std::string>(composite, "composite")));
   options.capture = captureArgument(capture);
   const RasterOptions ro = rasterArgument(width, height, threads);
   // checked and staged before any work; put in place as `out` once complete (as mfr compare)

@@ -52,7 +52,7 @@ py::array viewOf(const Scalar* data, std::vector<py::ssize_t> shape, py::handle 
 }
 
 Result<uint32_t> parseK(const py::object& k) {
-  const long long v = k.cast<long long>();
+  const long long v = castArgument<long long>(k, "k");
   if (v < 1 || v > (1 << 20)) return makeError("k: must be in [1, 1048576]");
   return static_cast<uint32_t>(v);
 }
@@ -73,7 +73,7 @@ MethodDesc buildMethod(const std::string& name, const py::object& k, const py::o
   }
   if (!composite.is_none()) {
     applicable(MethodOption::Composite, "composite");
-    m.compositing = unwrap(parseCompositing(composite.cast<std::string>()));
+    m.compositing = unwrap(parseCompositing(castArgument<std::string>(composite, "composite")));
   }
   if (!model.is_none()) {
     applicable(MethodOption::Model, "model");
@@ -82,13 +82,14 @@ MethodDesc buildMethod(const std::string& name, const py::object& k, const py::o
   if (!importance.is_none()) applicable(MethodOption::ImportanceParams, "importance");
   if (m.allocation == AllocationPolicy::Importance) {
     ImportanceParams ip;
-    if (!importance.is_none()) ip = importanceArgument(importance.cast<py::dict>());
+    if (!importance.is_none())
+      ip = importanceArgument(castArgument<py::dict>(importance, "importance"));
     ip.seed = seed;
     m.importance = ip;
   }
   if (!occupancyD.is_none()) {
     applicable(MethodOption::OccupancyD, "occupancy_d");
-    const long long d = occupancyD.cast<long long>();
+    const long long d = castArgument<long long>(occupancyD, "occupancy_d");
     if (d < 1 || d > 64) throw LibraryError("occupancy_d: must be in [1, 64]");
     m.occupancyWords = static_cast<int>(d);
   }

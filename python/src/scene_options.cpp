@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/scene/camera_spec.hpp"
@@ -14,8 +15,13 @@ namespace {
 
 std::vector<double> numbers(const py::object& value, const char* what) {
   if (py::isinstance<py::str>(value)) throw LibraryError(std::string(what) + ": expected numbers");
+  if (!py::isinstance<py::iterable>(value))
+    throw py::type_error(std::string(what) + ": expected a sequence of numbers, got " +
+                         std::string(py::str(value.get_type().attr("__name__"))));
   std::vector<double> v;
-  for (const py::handle item : value) v.push_back(item.cast<double>());
+  for (const py::handle item : value)
+    v.push_back(
+        castArgument<double>(item, std::string(what) + "[" + std::to_string(v.size()) + "]"));
   for (double x : v)
     if (!std::isfinite(x))
       throw LibraryError(std::string(what) + ": values must be finite numbers");
@@ -26,7 +32,7 @@ std::vector<double> numbers(const py::object& value, const char* what) {
 
 std::optional<float> alphaArgument(const py::object& alpha) {
   if (alpha.is_none()) return std::nullopt;
-  const double a = alpha.cast<double>();
+  const double a = castArgument<double>(alpha, "alpha");
   if (!(a >= 0.0 && a <= 1.0)) throw LibraryError("alpha: must be in [0, 1]");
   return static_cast<float>(a);
 }
@@ -133,12 +139,16 @@ Camera cameraArgument(const Scene& scene, const py::object& camera, const py::ob
     if (py::isinstance<py::str>(camera)) {  // the command line's text, "EX,EY,EZ,TX,TY,TZ,..."
       c = unwrap(parseCameraSpec(camera.cast<std::string>(), "camera"));
     } else {
+      if (!py::isinstance<py::iterable>(camera))
+        throw py::type_error("camera: expected 6, 9 or 10 numbers or a str, got " +
+                             std::string(py::str(camera.get_type().attr("__name__"))));
       std::vector<double> v;
-      for (const py::handle item : camera) v.push_back(item.cast<double>());
+      for (const py::handle item : camera)
+        v.push_back(castArgument<double>(item, "camera[" + std::to_string(v.size()) + "]"));
       c = unwrap(cameraFromNumbers(v, "camera"));
     }
   } else if (!view.is_none()) {
-    const long long i = view.cast<long long>();
+    const long long i = castArgument<long long>(view, "view");
     if (i < 0) throw LibraryError("view: must be a camera index (0-based)");
     if (i >= static_cast<long long>(scene.cameras.size()))
       throw LibraryError(scene.name + ": view " + std::to_string(i) + " but the scene has " +
@@ -175,11 +185,12 @@ ImportanceParams importanceArgument(const py::dict& params) {
   ImportanceParams ip;
   for (const auto& [key, value] : params) {
     const std::string k = py::str(key);
+    const std::string name = "importance[" + quoteInput(k) + "]";
     const auto number = [&](float lo, float hi, bool openLow) {
-      const double v = value.cast<double>();
+      const double v = castArgument<double>(value, name);
       if (!(openLow ? v > lo : v >= lo) || !(v <= hi))
-        throw LibraryError("importance['" + k + "']: must be in " + (openLow ? "(" : "[") +
-                           std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        throw LibraryError(name + ": must be in " + (openLow ? "(" : "[") + std::to_string(lo) +
+                           ", " + std::to_string(hi) + "]");
       return static_cast<float>(v);
     };
     if (k == "alpha") {
@@ -195,16 +206,16 @@ ImportanceParams importanceArgument(const py::dict& params) {
       if (v.size() != 2) throw LibraryError("importance['fovea']: expected two pixel coordinates");
       ip.fovea = glm::vec2(v[0], v[1]);
     } else if (k == "depth_term") {
-      ip.useDepth = value.cast<bool>();
+      ip.useDepth = castArgument<bool>(value, name);
     } else if (k == "periphery_term") {
-      ip.usePeriphery = value.cast<bool>();
+      ip.usePeriphery = castArgument<bool>(value, name);
     } else if (k == "fresnel_term") {
-      ip.useFresnel = value.cast<bool>();
+      ip.useFresnel = castArgument<bool>(value, name);
     } else if (k == "noise_term") {
-      ip.useNoise = value.cast<bool>();
+      ip.useNoise = castArgument<bool>(value, name);
     } else {
-      throw LibraryError("importance: unknown parameter '" + k +
-                         "' (alpha, n_limit, periphery_d, fovea, noise, depth_term, "
+      throw LibraryError("importance: unknown parameter " + quoteInput(k) +
+                         " (alpha, n_limit, periphery_d, fovea, noise, depth_term, "
                          "periphery_term, fresnel_term, noise_term)");
     }
   }

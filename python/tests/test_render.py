@@ -279,6 +279,53 @@ def test_wrong_types_raise_type_error():
         mfr.render("procedural:bottles", width="wide")
 
 
+@pytest.mark.parametrize("kwargs,message", [
+    # before: "Unable to cast Python instance to C++ type (#define PYBIND11_DETAILED_ERROR_...)"
+    (dict(method="vkb", budget="1MB", importance={"alpha": "x"}),
+     "importance['alpha']: expected a number, got str"),
+    (dict(method="vkb", budget="1MB", importance={"noise_term": "no"}),
+     "importance['noise_term']: expected True or False, got str"),
+    (dict(method="vkb", budget="1MB", importance={"fovea": [1, "a"]}),
+     "importance['fovea'][1]: expected a number, got str"),
+    (dict(method="vkb", budget="1MB", importance=[("alpha", 1)]),
+     "importance: expected a dict, got list"),
+    (dict(method="fkb", k="4"), "k: expected an integer, got str"),
+    (dict(method="fkb", k=2.5), "k: expected an integer, got float"),
+    (dict(method="fkb+occupancy", budget="1MB", occupancy_d="x"),
+     "occupancy_d: expected an integer, got str"),
+    (dict(camera=[0, 0, 3, 0, 0, "z"]), "camera[5]: expected a number, got str"),
+    (dict(camera=5), "camera: expected 6, 9 or 10 numbers or a str, got int"),
+    (dict(view="first"), "view: expected an integer, got str"),
+    (dict(alpha="half"), "alpha: expected a number, got str"),
+    (dict(background=[0, "r", 0]), "background[1]: expected a number, got str"),
+    (dict(composite=1), "composite: expected a str, got int"),
+    # pybind11's own conversions of typed keywords: "incompatible function arguments" + signature
+    (dict(width="wide"), "width: expected an integer, got str"),
+    (dict(zoom="near"), "zoom: expected a number, got str"),
+    (dict(capture=None), "capture: expected a str, got NoneType"),
+    (dict(threads=1.5), "threads: expected an integer, got float"),
+])
+def test_type_errors_name_the_parameter_and_the_type(kwargs, message):
+    args = dict(width=W, height=H)
+    args.update(kwargs)
+    with pytest.raises(TypeError) as e:
+        mfr.render("procedural:bottles", **args)
+    assert str(e.value) == message
+
+
+def test_type_errors_of_other_functions_name_the_parameter(tmp_path):
+    with pytest.raises(TypeError, match=r"^seed: expected an integer, got str$"):
+        mfr.load_scene("procedural:bottles", seed="one")
+    with pytest.raises(TypeError, match=r"^ppd: expected a number, got str$"):
+        mfr.metrics(np.zeros((2, 2, 3), np.uint8), np.zeros((2, 2, 3), np.uint8), ppd="x")
+    with pytest.raises(TypeError, match=r"^methods: expected a list of str, got list$"):
+        mfr.compare("procedural:bottles", tmp_path / "c", "40KB", methods=["fkb", 3], width=W,
+                    height=H)
+    with pytest.raises(TypeError, match=r"^height: expected an integer, got str$"):
+        mfr.compare("procedural:bottles", tmp_path / "c", "40KB", methods=["fkb"], width=W,
+                    height="tall")
+
+
 def test_gil_is_released_while_rendering():
     # while a render runs in another thread, this thread keeps running Python: the longest pause
     # it sees is far shorter than that render (which would block it entirely, holding the GIL)
