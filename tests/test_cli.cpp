@@ -184,6 +184,30 @@ TEST(Cli, SyntaxErrorsAreOneLineAndExitTwo) {
   EXPECT_LT(longValue.err.size(), 400u) << longValue.err;
 }
 
+// An option value echoed in an error is cut (quoteInput): a 5000-character value gives a line of
+// bounded length, its start quoted.
+TEST(Cli, EchoedOptionValuesAreCutShort) {
+  const std::string huge(5000, 'q');
+  const std::pair<std::string, std::string> cases[] = {
+      {"render procedural:spheres -q --capture " + huge, "--capture 'qqqq"},
+      {"render procedural:spheres -q --memory-limit " + huge, "--memory-limit 'qqqq"},
+      {"render procedural:spheres -q --method " + huge, "method 'qqqq"},
+      {"compare procedural:spheres -q --budget 1MB --methods fkb,fkb" + huge + ",fkb" + huge +
+           " --out " + (tempDir() / "never").string(),
+       "--methods: method 'fkbqqqq"},
+      {"dataset procedural:spheres -q --budget 1MB" + huge + " -o " +
+           (tempDir() / "never.mfrds").string(),
+       "--budget"},
+  };
+  for (const auto& [args, needle] : cases) {
+    const CliRun r = runCli(args);
+    EXPECT_EQ(r.exitCode, 1) << r.err.substr(0, 300);
+    EXPECT_LT(r.err.size(), 400u) << r.err.substr(0, 300);
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err.substr(0, 300);
+    EXPECT_NE(r.err.find(needle), std::string::npos) << r.err.substr(0, 300);
+  }
+}
+
 TEST(Cli, HelpAndVersionExitZero) {
   for (const char* args : {"--help", "render --help", "--version"}) {
     const CliRun r = runCli(args);

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "mfr/core/memory_limit.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/raster_frame.hpp"
@@ -84,8 +85,8 @@ Result<uint64_t> SceneOptions::memoryLimitBytes() const {
   if (memoryLimit.empty()) return defaultMemoryLimit();
   auto bytes = parseByteSize(memoryLimit);
   if (!bytes)
-    return makeError("--memory-limit '" + memoryLimit +
-                     "': expected a size such as 8GB, 512MB or 1048576 (at most 1 TiB)");
+    return makeError("--memory-limit " + quoteInput(memoryLimit) +
+                     ": expected a size such as 8GB, 512MB or 1048576 (at most 1 TiB)");
   return bytes.value();
 }
 
@@ -146,8 +147,8 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
     camera = *explicitCamera;
   } else if (o.view >= 0) {
     if (o.view >= static_cast<int>(scene.cameras.size()))
-      return makeError(o.source + ": --view " + std::to_string(o.view) + " but the scene has " +
-                       std::to_string(scene.cameras.size()) + " camera(s)");
+      return makeError(echoPath(o.source) + ": --view " + std::to_string(o.view) +
+                       " but the scene has " + std::to_string(scene.cameras.size()) + " camera(s)");
     camera = scene.cameras[o.view];
   } else if (scene.defaultCamera) {
     camera = *scene.defaultCamera;

@@ -4,6 +4,7 @@
 #include "common.hpp"
 #include "mfr/compare/compare.hpp"
 #include "mfr/compare/compare_output.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/method/method_options.hpp"
@@ -85,7 +86,7 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     if (name.empty()) throw LibraryError("methods: empty method name in the list");
     unwrap(methodPreset(name));
     for (const std::string& seen : options.methods)
-      if (seen == name) throw LibraryError("methods: method '" + name + "' listed twice");
+      if (seen == name) throw LibraryError("methods: method " + quoteInput(name) + " listed twice");
     options.methods.push_back(name);
   }
   if (options.methods.empty()) throw LibraryError("methods: the method list is empty");
@@ -129,11 +130,11 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     py::gil_scoped_release release;
     CpuEngine engine(EngineOptions{ro.threads, ro.tileSize});
     if (auto fits = checkComparisonFits(engine, ro.width, ro.height, options); !fits)
-      throw LibraryError(scene.source + ": " + fits.error().message);
+      throw LibraryError(echoPath(scene.source) + ": " + fits.error().message);
     auto view = engine.prepare(View{&*scene.scene, cam, ro.width, ro.height});
-    if (!view) throw LibraryError(scene.source + ": " + view.error().message);
+    if (!view) throw LibraryError(echoPath(scene.source) + ": " + view.error().message);
     auto result = runComparison(engine, **view, options);
-    if (!result) throw LibraryError(scene.source + ": " + result.error().message);
+    if (!result) throw LibraryError(echoPath(scene.source) + ": " + result.error().message);
     ReportInfo info;
     info.mfrVersion = std::string("mfr ") + MFR_VERSION;
     info.commandLine = commandLine;

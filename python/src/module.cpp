@@ -8,6 +8,7 @@
 
 #include "common.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/cpu/deep_importance.hpp"
@@ -124,11 +125,11 @@ PyRenderResult renderScene(const py::object& sceneArg, const std::string& method
     py::gil_scoped_release release;
     CpuEngine engine(EngineOptions{ro.threads, ro.tileSize});
     if (auto fits = engine.preflight(ro.width, ro.height, m, options); !fits)
-      throw LibraryError(scene.source + ": " + fits.error().message);
+      throw LibraryError(echoPath(scene.source) + ": " + fits.error().message);
     auto view = engine.prepare(View{&*scene.scene, cam, ro.width, ro.height});
-    if (!view) throw LibraryError(scene.source + ": " + view.error().message);
+    if (!view) throw LibraryError(echoPath(scene.source) + ": " + view.error().message);
     auto rendered = engine.render(**view, m, options);
-    if (!rendered) throw LibraryError(scene.source + ": " + rendered.error().message);
+    if (!rendered) throw LibraryError(echoPath(scene.source) + ": " + rendered.error().message);
     out = std::move(rendered.value());
     if (wantDepthComplexity && out.depthComplexity.empty())
       out.depthComplexity = unwrap(engine.countFragments(**view));

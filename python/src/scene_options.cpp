@@ -100,8 +100,8 @@ std::optional<uint64_t> memoryLimitArgument(const py::object& limit) {
   if (py::isinstance<py::str>(limit)) {
     auto bytes = parseByteSize(limit.cast<std::string>());
     if (!bytes)
-      throw LibraryError("memory_limit '" + limit.cast<std::string>() +
-                         "': " + bytes.error().message);
+      throw LibraryError("memory_limit " + quoteInput(limit.cast<std::string>()) + ": " +
+                         bytes.error().message);
     return bytes.value();
   }
   if (py::isinstance<py::bool_>(limit) || !py::isinstance<py::int_>(limit))
@@ -114,7 +114,7 @@ std::optional<uint64_t> memoryLimitArgument(const py::object& limit) {
 CaptureMode captureArgument(const std::string& capture) {
   if (capture == "tile") return CaptureMode::TileOwned;
   if (capture == "parallel") return CaptureMode::FragmentParallel;
-  throw LibraryError("capture '" + capture + "': expected tile or parallel");
+  throw LibraryError("capture " + quoteInput(capture) + ": expected tile or parallel");
 }
 
 RasterOptions rasterArgument(int width, int height, int threads) {
