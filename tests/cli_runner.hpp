@@ -29,12 +29,10 @@ inline std::filesystem::path processTempDir(const std::string& tag) {
   return dir;
 }
 
-/// `mfr ARGS` with stdin closed; stdout and stderr go through files in `scratch`.
-inline CliRun runCli(const std::string& args, const std::filesystem::path& scratch) {
+/// The shell command `command` with stdin closed; stdout and stderr go through files in `scratch`.
+inline CliRun runShell(const std::string& command, const std::filesystem::path& scratch) {
   const std::filesystem::path err = scratch / "stderr.txt", out = scratch / "stdout.txt";
-  std::string cmd = MFR_CLI_PATH;
-  cmd += " ";
-  cmd += args;
+  std::string cmd = command;
   cmd += " >" + out.string();
   cmd += " 2>" + err.string();
   cmd += " </dev/null";
@@ -49,6 +47,14 @@ inline CliRun runCli(const std::string& args, const std::filesystem::path& scrat
   r.err = es.str();
   r.out = os.str();
   return r;
+}
+
+/// `mfr ARGS` with stdin closed; stdout and stderr go through files in `scratch`.
+inline CliRun runCli(const std::string& args, const std::filesystem::path& scratch) {
+  std::string cmd = MFR_CLI_PATH;
+  cmd += " ";
+  cmd += args;
+  return runShell(cmd, scratch);
 }
 
 }  // namespace mfr::test

@@ -9,6 +9,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <set>
 #include <sstream>
 
@@ -16,6 +18,7 @@
 
 #include "cli_runner.hpp"
 #include "mfr/compare/compare.hpp"
+#include "mfr/core/image.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
@@ -578,6 +581,110 @@ TEST(CompareCliErrors, BadInputIsOneLineNamingIt) {
   std::ofstream(file) << "x";
   const std::string dir = (file / "sub").string();
   expectCleanFailure(scene + " --budget 200KB --out " + dir, dir);
+}
+
+// ---- the output folder: one whole comparison, never a mix ----------------------------------
+
+std::set<std::string> entriesOf(const fs::path& dir) {
+  std::set<std::string> names;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir))
+    names.insert(e.path().filename().string());
+  return names;
+}
+
+/// The folders beside `dir` that a comparison stages into (".NAME.compare-tmp.*").
+std::set<std::string> stagingBeside(const fs::path& dir) {
+  std::set<std::string> left;
+  std::string prefix = ".";  // appended piece by piece (GCC 12 warns on "." + string)
+  prefix += dir.filename().string();
+  prefix += ".compare-tmp.";
+  for (const std::string& name : entriesOf(dir.parent_path()))
+    if (name.rfind(prefix, 0) == 0) left.insert(name);
+  return left;
+}
+
+std::string compareArgs(int size, const std::string& methods, const fs::path& out) {
+  // double quotes: the tests wrap some commands in sh -c '...'
+  return "compare \"" + std::string(kScene) + "\" --width " + std::to_string(size) + " --height " +
+         std::to_string(size) + " --threads 2 --budget 200KB --methods " + methods +
+         " -q --out \"" + out.string() + "\"";
+}
+
+/// Every file of `dir` and its bytes.
+std::map<std::string, std::string> contentsOf(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const std::string& name : entriesOf(dir)) {
+    std::ifstream in(dir / name, std::ios::binary);
+    files[name] = std::string((std::istreambuf_iterator<char>(in)), {});
+  }
+  return files;
+}
+
+int resultsWidth(const fs::path& dir) {
+  return nlohmann::json::parse(std::ifstream(dir / "results.json"))["width"].get<int>();
+}
+
+TEST(CompareOutputFolder, AFailedCompareLeavesTheOldFolderWholeAndANewOneReplacesIt) {
+  const fs::path root = tempDir() / "replace", dir = root / "out";
+  fs::remove_all(root);
+  fs::create_directories(root);
+  ASSERT_EQ(runCli(compareArgs(16, "fkb,vkb", dir)).exitCode, 0);
+  const std::map<std::string, std::string> first = contentsOf(dir);
+  ASSERT_TRUE(first.count("vkb_200KB.png"));
+
+  // a 64x64 compare whose larger files hit the file-size limit (the small ones fit): before, the
+  // small new files landed beside the old 16x16 results.json
+  const CompareCliRun cut = mfr::test::runShell(
+      "sh -c 'ulimit -f 4; exec " MFR_CLI_PATH " " + compareArgs(64, "fkb", dir) + "'", root);
+  EXPECT_EQ(cut.exitCode, 1) << cut.err;
+  EXPECT_NE(cut.err.find("write error (File too large)"), std::string::npos) << cut.err;
+  EXPECT_TRUE(contentsOf(dir) == first) << "the old folder was changed";
+  EXPECT_TRUE(stagingBeside(dir).empty());
+
+  // a complete one replaces the folder whole: no file of the old comparison is left
+  ASSERT_EQ(runCli(compareArgs(24, "fkb", dir)).exitCode, 0);
+  EXPECT_EQ(resultsWidth(dir), 24);
+  EXPECT_FALSE(fs::exists(dir / "vkb_200KB.png"));
+  EXPECT_TRUE(stagingBeside(dir).empty());
+  fs::remove_all(root);
+}
+
+TEST(CompareOutputFolder, AFolderHoldingOtherFilesIsNeverReplaced) {
+  const fs::path dir = tempDir() / "foreign";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "frame_000");
+  std::ofstream(dir / "frame_000" / "notes.txt") << "mine";
+  const CompareCliRun r = runCli(compareArgs(16, "fkb", dir));
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_EQ(r.err, "mfr: error: " + dir.string() +
+                       ": holds 'frame_000/notes.txt', which a comparison does not write: not "
+                       "replacing it (choose another folder)\n");
+  EXPECT_TRUE(fs::exists(dir / "frame_000" / "notes.txt"));
+  EXPECT_TRUE(stagingBeside(dir).empty());
+  fs::remove_all(dir);
+}
+
+TEST(CompareOutputFolder, ConcurrentComparesIntoOneFolderLeaveOneWholeComparison) {
+  const fs::path root = tempDir() / "concurrent", dir = root / "out";
+  fs::remove_all(root);
+  fs::create_directories(root);
+  // a staging folder of a process that is gone (killed mid-compare) is cleaned up
+  fs::create_directories(root / ".out.compare-tmp.999999999.0");
+  const std::string a = MFR_CLI_PATH " " + compareArgs(16, "fkb", dir);
+  const std::string b = MFR_CLI_PATH " " + compareArgs(24, "fkb,vkb", dir);
+  const CompareCliRun r = mfr::test::runShell(
+      "sh -c '" + a + " & a=$!; " + b + " & b=$!; wait $a && wait $b && echo both'", root);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_EQ(r.out, "both\n") << r.err;
+  // the folder is one of the two, whole: its results.json, images and file set agree
+  const int width = resultsWidth(dir);
+  ASSERT_TRUE(width == 16 || width == 24) << width;
+  auto truth = readPng((dir / "ground_truth.png").string());
+  ASSERT_TRUE(truth.ok());
+  EXPECT_EQ(truth->width, width);
+  EXPECT_EQ(fs::exists(dir / "vkb_200KB.png"), width == 24);
+  EXPECT_TRUE(stagingBeside(dir).empty());
+  fs::remove_all(root);
 }
 
 }  // namespace

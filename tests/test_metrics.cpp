@@ -150,6 +150,25 @@ TEST(ImageMetrics, SizeMismatchIsAnErrorNamingBothSizes) {
   EXPECT_NE(f.error().message.find("2x3"), std::string::npos) << f.error().message;
 }
 
+TEST(ImageMetrics, NonFiniteLinearValuesAreAnErrorNamingTheImageAndThePixel) {
+  ImageRGB image(4, 3, glm::vec3(0.25f));
+  EXPECT_TRUE(checkFinite(image, "reference").ok());
+  image.at(2, 1).g = std::numeric_limits<float>::quiet_NaN();
+  image.at(3, 2).r = std::numeric_limits<float>::infinity();  // later in row order
+  auto bad = checkFinite(image, "reference");
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.error().message,
+            "reference: pixel (2, 1) is not finite (nan in g): the image must hold finite values");
+  image.at(2, 1).g = 0.0f;
+  image.at(3, 2).r = -std::numeric_limits<float>::infinity();
+  EXPECT_EQ(checkFinite(image, "test").error().message,
+            "test: pixel (3, 2) is not finite (-inf in r): the image must hold finite values");
+  // an all-NaN image against black: an error, never MSE 0 and PSNR inf
+  ImageRGB nan(2, 2, glm::vec3(std::numeric_limits<float>::quiet_NaN()));
+  EXPECT_EQ(checkFinite(nan, "test").error().message,
+            "test: pixel (0, 0) is not finite (nan in r): the image must hold finite values");
+}
+
 TEST(ImageMetrics, MagmaTableMatchesMatplotlib) {
   // spot checks of matplotlib's magma (first, middle, last entries)
   const auto& t = magmaTable();

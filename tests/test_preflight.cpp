@@ -16,6 +16,7 @@
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/memory_limit.hpp"
+#include "mfr/core/units.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/method.hpp"
@@ -96,16 +97,103 @@ TEST(Preflight, MemoryLimitOptionIsParsedAndDocumented) {
                 contains(help.out, "--allow-outside-references"))
         << command << ": " << help.out;
   }
-  // the default: 75% of sysconf(_SC_PHYS_PAGES) * sysconf(_SC_PAGE_SIZE)
-  const uint64_t physical = mfr::physicalMemoryBytes();
-  ASSERT_GT(physical, 0u);
-  EXPECT_EQ(mfr::defaultMemoryLimit(), static_cast<uint64_t>(static_cast<double>(physical) * 0.75));
+  // the default: 75% of the least of sysconf(_SC_PHYS_PAGES) * sysconf(_SC_PAGE_SIZE), RLIMIT_AS
+  // and the cgroup's limit
+  const mfr::MemoryBounds bounds = mfr::memoryBounds();
+  ASSERT_GT(bounds.physical, 0u);
+  EXPECT_EQ(bounds.physical, mfr::physicalMemoryBytes());
+  EXPECT_EQ(mfr::defaultMemoryLimit(), mfr::defaultMemoryLimit(bounds));
+  EXPECT_LE(mfr::defaultMemoryLimit(),
+            static_cast<uint64_t>(static_cast<double>(bounds.physical) * 0.75));
   // a limit that fits renders
   const CliRun fits = mfr::test::runCliTimed(
       "render procedural:spheres --width 64 --height 64 --memory-limit 64MB -q -o " +
           (scratch() / "fits.png").string(),
       scratch());
   EXPECT_EQ(fits.exitCode, 0) << fits.err;
+}
+
+TEST(Preflight, DefaultLimitIsTheShareOfTheSmallestOfPhysicalAddressSpaceAndCgroup) {
+  const auto limit = [](uint64_t physical, uint64_t addressSpace, uint64_t cgroup) {
+    return mfr::defaultMemoryLimit(mfr::MemoryBounds{physical, addressSpace, cgroup});
+  };
+  const uint64_t gib = uint64_t{1} << 30;
+  EXPECT_EQ(limit(16 * gib, 0, 0), 12 * gib);       // physical only (0: unlimited)
+  EXPECT_EQ(limit(16 * gib, 8 * gib, 0), 6 * gib);  // ulimit -v below the memory
+  EXPECT_EQ(limit(16 * gib, 0, 4 * gib), 3 * gib);  // a cgroup below the memory
+  EXPECT_EQ(limit(16 * gib, 8 * gib, 4 * gib), 3 * gib);
+  EXPECT_EQ(limit(16 * gib, 2 * gib, 4 * gib), 3 * gib / 2);
+  EXPECT_EQ(limit(4 * gib, 64 * gib, 32 * gib), 3 * gib);  // larger bounds change nothing
+  EXPECT_EQ(limit(0, 8 * gib, 0), 6 * gib);                // physical memory unknown
+  EXPECT_EQ(limit(0, 0, 0), UINT64_MAX);                   // nothing known: no limit
+  // the process's own RLIMIT_AS is read: under ulimit -v 4000000 (KiB) the default is 75% of it
+  // (2.86 GiB) unless the memory or the cgroup is smaller still
+  mfr::MemoryBounds capped = mfr::memoryBounds();
+  capped.addressSpace = uint64_t{4000000} * 1024;
+  const CliRun r = mfr::test::runCliTimed("render procedural:spheres --help", scratch(),
+                                          mfr::test::capped(10, 4000000));
+  EXPECT_TRUE(contains(
+      r.out, "whichever is least: " + mfr::formatBytes(mfr::defaultMemoryLimit(capped)) + ")"))
+      << r.out;
+}
+
+TEST(Preflight, CgroupLimitFilesAreParsed) {
+  EXPECT_EQ(mfr::parseCgroupMemoryLimit("max\n"), 0u);                  // v2 without a limit
+  EXPECT_EQ(mfr::parseCgroupMemoryLimit("9223372036854771712\n"), 0u);  // v1 without a limit
+  EXPECT_EQ(mfr::parseCgroupMemoryLimit("1073741824\n"), uint64_t{1} << 30);
+  EXPECT_EQ(mfr::parseCgroupMemoryLimit("536870912"), uint64_t{1} << 29);
+  EXPECT_EQ(mfr::parseCgroupMemoryLimit(""), 0u);  // no such file
+  EXPECT_EQ(mfr::parseCgroupMemoryLimit("12 apples"), 0u);
+  EXPECT_EQ(mfr::parseCgroupMemoryLimit("-5"), 0u);
+}
+
+// The per-pixel buffers, which the image size alone decides, are refused before the scene is set
+// up: at 16384 x 16384 building the hairball's frame alone takes about 20 s.
+TEST(Preflight, ImageSizeAloneIsRefusedBeforeTheFrameIsBuilt) {
+  const std::string big = "procedural:hairball --width 16384 --height 16384 --memory-limit 1GB ";
+  for (const std::string& command :
+       {"render " + big + "-q -o " + (scratch() / "never.png").string(),
+        "compare " + big + "--budget 10MB --methods fkb -q --out " +
+            (scratch() / "never_compare").string()}) {
+    const auto start = std::chrono::steady_clock::now();
+    const CliRun r = mfr::test::runCliTimed(command, scratch(), mfr::test::capped(30, 0));
+    EXPECT_TRUE(cleanError(r, {"procedural:hairball: ",
+                               "abuffer at 16384 x 16384 pixels: its "
+                               "per-pixel buffers need 8.25 GiB (8858370048 bytes), more than "
+                               "the memory limit of 1.00 GiB (1073741824 bytes"}))
+        << command;
+    EXPECT_LT(secondsSince(start), 5.0) << command;
+  }
+  EXPECT_FALSE(fs::exists(scratch() / "never.png"));
+  // the library's check is the one render() makes first
+  mfr::RenderOptions options;
+  options.memoryLimitBytes = uint64_t{1} << 30;
+  const auto abuffer = mfr::methodPreset("abuffer").value();
+  auto refused = mfr::checkPixelBuffers(16384, 16384, abuffer, options);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(neededBytes(refused.error().message), 8858370048u);
+  EXPECT_TRUE(mfr::checkPixelBuffers(1024, 1024, abuffer, options).ok());
+  EXPECT_TRUE(mfr::checkPixelBuffers(0, 16384, abuffer, options).ok());  // the frame names it
+}
+
+// Under `ulimit -v` the default limit is the address space's share: the case fails fast,
+// naming the bytes needed and that limit.
+TEST(Preflight, AddressSpaceLimitLowersTheDefaultAndFailsFast) {
+  const uint64_t capKiB = 8000000;
+  mfr::MemoryBounds bounds = mfr::memoryBounds();
+  bounds.addressSpace = capKiB * 1024;
+  std::string limitText = "(";  // appended piece by piece (GCC 12 warns on "(" + string)
+  limitText += std::to_string(mfr::defaultMemoryLimit(bounds));
+  limitText += " bytes; --memory-limit)";
+  const auto start = std::chrono::steady_clock::now();
+  const CliRun r =
+      mfr::test::runCliTimed("render procedural:hairball --width 16384 --height 16384 -q -o " +
+                                 (scratch() / "never.png").string(),
+                             scratch(), mfr::test::capped(30, capKiB));
+  EXPECT_TRUE(cleanError(r, {"procedural:hairball: abuffer at 16384 x 16384 pixels",
+                             "(8858370048 bytes), more than the memory limit of", limitText}));
+  EXPECT_LT(secondsSince(start), 5.0);
+  EXPECT_FALSE(fs::exists(scratch() / "never.png"));
 }
 
 TEST(Preflight, CheckMemoryNamesWhatTheBytesAndTheLimit) {

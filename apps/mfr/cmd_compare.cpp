@@ -17,6 +17,7 @@
 #include "mfr/compare/temporal.hpp"
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/dkb_model.hpp"
 
@@ -126,12 +127,13 @@ void printSummary(const CompareResult& r) {
 // stability of each method along the path (mfr/compare/temporal.hpp) in DIR/results.json,
 // DIR/report.html and one plot per budget.
 int runTemporal(const CompareArgs& a, CompareOptions options, const std::string& version,
-                Engine& engine, const PreparedScene& prepared, Progress& progress) {
+                Engine& engine, const PreparedScene& prepared, Progress& progress,
+                OutputFolder& outFolder) {
   const int frames = a.scene.orbit;
   const float step =
       a.orbitStep > 0.0 ? static_cast<float>(a.orbitStep) : 360.0f / static_cast<float>(frames);
   const std::vector<Camera> path = orbitPath(prepared.cameras.front(), frames, step);
-  const fs::path dir(a.out);
+  const fs::path dir(outFolder.staging());  // put in place as --out once complete
   const auto [versionNumber, info] = provenance(version);
   TemporalStability temporal(a.pixelsPerDegree);
   std::vector<std::string> folders;
@@ -139,14 +141,14 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
   std::string engineName;
   for (int f = 0; f < frames; ++f) {
     auto view = engine.prepare(sceneView(prepared, a.scene, path[f]));
-    if (!view) return fail(a.scene.source + ": " + view.error().message);
+    if (!view) return fail(echoPath(a.scene.source) + ": " + view.error().message);
     options.previousNearestCosine = previousCosine;
     options.progress = [&progress, f, frames](const std::string& stage, int done, int total) {
       progress.set("frame " + std::to_string(f + 1) + "/" + std::to_string(frames) + ": " + stage,
                    done, total);
     };
     auto result = runComparison(engine, **view, options);
-    if (!result) return fail(a.scene.source + ": " + result.error().message);
+    if (!result) return fail(echoPath(a.scene.source) + ": " + result.error().message);
     engineName = result->engine;
     char folder[32];
     std::snprintf(folder, sizeof folder, "frame_%03d", f);
@@ -157,7 +159,7 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
     if (!written) return fail(written.error().message);
     if (auto added = temporal.add(result.value()); !added) return fail(added.error().message);
     auto cosine = engine.nearestCosine(**view);
-    if (!cosine) return fail(a.scene.source + ": " + cosine.error().message);
+    if (!cosine) return fail(echoPath(a.scene.source) + ": " + cosine.error().message);
     previousCosine = std::move(cosine.value());
   }
   progress.set("writing " + a.out);
@@ -193,6 +195,7 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
                                                  plots, folders, info.commandLine));
       !w)
     return fail(w.error().message);
+  if (auto placed = outFolder.commit(); !placed) return fail(placed.error().message);
   progress.clear();
   if (!a.scene.quiet) {
     std::fprintf(stderr, "%s, %d frames %.3g degrees apart; ground truth flicker %.4f\n",
@@ -202,7 +205,7 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
     for (const TemporalSeries& s : t.series)
       std::fprintf(stderr, "  %-20s %8s %9.4f %9.4f %12.4f\n", s.method.c_str(),
                    s.budgetLabel.c_str(), s.flicker, s.excessFlicker, s.meanErrorChange);
-    std::fprintf(stderr, "report: %s\n", (dir / "report.html").string().c_str());
+    std::fprintf(stderr, "report: %s\n", (fs::path(a.out) / "report.html").string().c_str());
   }
   if (a.scene.json) std::fputs(jsonText.c_str(), stdout);
   return 0;
@@ -227,11 +230,12 @@ int run(const CompareArgs& a, const std::string& version) {
 
   // methods
   for (const std::string& name : splitList(a.methods)) {
-    if (name.empty()) return fail("--methods '" + a.methods + "': empty method name in the list");
+    if (name.empty())
+      return fail("--methods " + quoteInput(a.methods) + ": empty method name in the list");
     auto preset = methodPreset(name);
     if (!preset) return fail("--methods: " + preset.error().message);
     for (const std::string& seen : options.methods)
-      if (seen == name) return fail("--methods: method '" + name + "' listed twice");
+      if (seen == name) return fail("--methods: method " + quoteInput(name) + " listed twice");
     options.methods.push_back(name);
   }
   if (options.methods.empty()) return fail("--methods: the method list is empty");
@@ -249,11 +253,12 @@ int run(const CompareArgs& a, const std::string& version) {
   }
   // budgets
   for (const std::string& text : splitList(a.budgets)) {
-    if (text.empty()) return fail("--budget '" + a.budgets + "': empty budget in the list");
+    if (text.empty())
+      return fail("--budget " + quoteInput(a.budgets) + ": empty budget in the list");
     auto spec = parseBudgetSpec(text);
     if (!spec) return fail("--budget: " + spec.error().message);
     for (const BudgetSpec& seen : options.budgets)
-      if (seen == spec.value()) return fail("--budget '" + text + "': listed twice");
+      if (seen == spec.value()) return fail("--budget " + quoteInput(text) + ": listed twice");
     options.budgets.push_back(spec.value());
   }
   if (options.budgets.empty())
@@ -274,43 +279,52 @@ int run(const CompareArgs& a, const std::string& version) {
   if (a.capture == "parallel")
     options.capture = CaptureMode::FragmentParallel;
   else if (a.capture != "tile")
-    return fail("--capture '" + a.capture + "': expected tile or parallel");
+    return fail("--capture " + quoteInput(a.capture) + ": expected tile or parallel");
 
-  // output folder: created and probed before any work
-  if (auto ready = prepareOutputFolder(a.out); !ready) return fail(ready.error().message);
+  // output folder: checked and its staging folder made before any work; put in place at the end
+  auto outFolder = OutputFolder::begin(a.out);
+  if (!outFolder) return fail(outFolder.error().message);
   const fs::path dir(a.out);
+
+  auto memoryLimit = a.scene.memoryLimitBytes();
+  if (!memoryLimit) return fail(memoryLimit.error().message);
+  options.memoryLimitBytes = memoryLimit.value();
+  auto engine = makeSceneEngine(a.scene);
+  if (!engine) return fail(engine.error().message);
+  // the ground truth's (the A-buffer's) buffers at this size, before the scene is loaded
+  if (auto fits = checkComparisonFits(**engine, a.scene.width, a.scene.height, options); !fits)
+    return fail(echoPath(a.scene.source) + ": " + fits.error().message);
 
   Progress progress(!a.scene.quiet);
   progress.set("loading " + a.scene.source);
   auto prepared = prepareScene(a.scene);
   if (!prepared) return fail(prepared.error().message);
-  options.memoryLimitBytes = a.scene.memoryLimitBytes().value();  // checked by prepareScene
   options.background = prepared->scene.background;
-  auto engine = makeSceneEngine(a.scene);
-  if (!engine) return fail(engine.error().message);
-  if (temporal) return runTemporal(a, options, version, **engine, *prepared, progress);
+  if (temporal)
+    return runTemporal(a, options, version, **engine, *prepared, progress, outFolder.value());
   progress.set("setting up " + a.scene.source);
   auto view = (*engine)->prepare(sceneView(*prepared, a.scene, prepared->cameras.front()));
-  if (!view) return fail(a.scene.source + ": " + view.error().message);
+  if (!view) return fail(echoPath(a.scene.source) + ": " + view.error().message);
   if (prepared->previousCamera) {  // --orbit-view I: view I - 1 precedes it (vkb's Fresnel term)
     auto previous = (*engine)->prepare(sceneView(*prepared, a.scene, *prepared->previousCamera));
-    if (!previous) return fail(a.scene.source + ": " + previous.error().message);
+    if (!previous) return fail(echoPath(a.scene.source) + ": " + previous.error().message);
     auto cosine = (*engine)->nearestCosine(**previous);
-    if (!cosine) return fail(a.scene.source + ": " + cosine.error().message);
+    if (!cosine) return fail(echoPath(a.scene.source) + ": " + cosine.error().message);
     options.previousNearestCosine = std::move(cosine.value());
   }
   options.progress = [&progress](const std::string& stage, int done, int total) {
     progress.set(stage, done, total);
   };
   auto result = runComparison(**engine, **view, options);
-  if (!result) return fail(a.scene.source + ": " + result.error().message);
+  if (!result) return fail(echoPath(a.scene.source) + ": " + result.error().message);
   const CompareResult& r = result.value();
 
   // files
   progress.set("writing " + a.out);
   const auto [versionNumber, info] = provenance(version);
-  auto written = writeComparison(r, a.out, versionNumber, info);
+  auto written = writeComparison(r, outFolder->staging(), versionNumber, info);
   if (!written) return fail(written.error().message);
+  if (auto placed = outFolder->commit(); !placed) return fail(placed.error().message);
   const std::string& jsonText = written.value();
   progress.clear();
 

@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/method/budget_spec.hpp"
@@ -39,7 +40,7 @@ int runDataset(DatasetArgs& a) {
     auto spec = parseBudgetSpec(text);
     if (!spec) return fail("--budget: " + spec.error().message);
     if (!spec->isRelative())
-      return fail("--budget " + text +
+      return fail("--budget " + quoteInput(text) +
                   ": mfr dataset takes shares of each view's A-buffer node bytes, e.g. 25%");
     sampling.budgetPercents.push_back(spec->percent);
   }
@@ -47,7 +48,7 @@ int runDataset(DatasetArgs& a) {
   sampling.seed = a.scene.seed;
   auto rule = parseCompositing(a.composite);
   if (!rule || !kBufferFamilyRule(rule.value()))
-    return fail("--composite '" + a.composite + "': expected kbuffer or hybrid");
+    return fail("--composite " + quoteInput(a.composite) + ": expected kbuffer or hybrid");
   sampling.compositing = rule.value();
   sampling.curveTargets = !a.curveOut.empty();
   Progress progress(!a.scene.quiet);
@@ -71,10 +72,10 @@ int runDataset(DatasetArgs& a) {
       ro.height = options.height;
       ro.threads = options.threads;
       auto frame = RasterFrame::build(prepared->scene, prepared->cameras[v], ro);
-      if (!frame) return fail(source + ": " + frame.error().message);
+      if (!frame) return fail(echoPath(source) + ": " + frame.error().message);
       auto samples =
           learn::sampleView(frame.value(), sceneIndex, static_cast<uint32_t>(v), sampling);
-      if (!samples) return fail(source + ": " + samples.error().message);
+      if (!samples) return fail(echoPath(source) + ": " + samples.error().message);
       data.samples.insert(data.samples.end(), samples->begin(), samples->end());
     }
     perScene.push_back(

@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/memory_model.hpp"
 
@@ -29,9 +30,9 @@ int run(const SceneOptions& o) {
     progress.set("counting fragments", static_cast<int>(v),
                  static_cast<int>(prepared->cameras.size()));
     auto view = (*engine)->prepare(sceneView(*prepared, o, prepared->cameras[v]));
-    if (!view) return fail(o.source + ": " + view.error().message);
+    if (!view) return fail(echoPath(o.source) + ": " + view.error().message);
     auto counted = (*engine)->countFragments(**view);
-    if (!counted) return fail(o.source + ": " + counted.error().message);
+    if (!counted) return fail(echoPath(o.source) + ": " + counted.error().message);
     const std::vector<uint32_t>& n = counted.value();
     uint64_t total = 0, covered = 0;
     uint32_t maxN = 0;

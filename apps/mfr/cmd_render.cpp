@@ -10,6 +10,7 @@
 #include "common.hpp"
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/colormap.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/budget_spec.hpp"
@@ -143,48 +144,54 @@ int run(const RenderArgs& a) {
   if (a.capture == "parallel")
     options.capture = CaptureMode::FragmentParallel;
   else if (a.capture != "tile")
-    return fail("--capture '" + a.capture + "': expected tile or parallel");
+    return fail("--capture " + quoteInput(a.capture) + ": expected tile or parallel");
   if (a.out.empty()) return fail("--out: empty path");
+
+  auto memoryLimit = a.scene.memoryLimitBytes();
+  if (!memoryLimit) return fail(memoryLimit.error().message);
+  options.memoryLimitBytes = memoryLimit.value();
+  auto engine = makeSceneEngine(a.scene);
+  if (!engine) return fail(engine.error().message);
+  // what the image size alone decides, before the scene is loaded and set up
+  if (auto fits = (*engine)->preflight(a.scene.width, a.scene.height, *method, options); !fits)
+    return fail(echoPath(a.scene.source) + ": " + fits.error().message);
 
   Progress progress(!a.scene.quiet);
   progress.set("loading " + a.scene.source);
   auto prepared = prepareScene(a.scene);
   if (!prepared) return fail(prepared.error().message);
-  options.memoryLimitBytes = a.scene.memoryLimitBytes().value();  // checked by prepareScene
   const Scene& scene = prepared->scene;
   options.background = scene.background;
   const int views = static_cast<int>(prepared->cameras.size());
   nlohmann::json allStats = nlohmann::json::array();
-  auto engine = makeSceneEngine(a.scene);
-  if (!engine) return fail(engine.error().message);
   std::vector<float> previousCosine;  // importance methods: nearest |n.v| of the previous view
   if (prepared->previousCamera && method->allocation == AllocationPolicy::Importance &&
       method->importanceSource == ImportanceSource::Heuristic) {
     // --orbit-view I: view I - 1 precedes it, as in the full orbit
     auto previous = (*engine)->prepare(sceneView(*prepared, a.scene, *prepared->previousCamera));
-    if (!previous) return fail(a.scene.source + ": " + previous.error().message);
+    if (!previous) return fail(echoPath(a.scene.source) + ": " + previous.error().message);
     auto cosine = (*engine)->nearestCosine(**previous);
-    if (!cosine) return fail(a.scene.source + ": " + cosine.error().message);
+    if (!cosine) return fail(echoPath(a.scene.source) + ": " + cosine.error().message);
     previousCosine = std::move(cosine.value());
   }
   const int width = a.scene.width, height = a.scene.height;
   for (int v = 0; v < views; ++v) {
     progress.set("rendering " + method->name, v, views);
     auto view = (*engine)->prepare(sceneView(*prepared, a.scene, prepared->cameras[v]));
-    if (!view) return fail(a.scene.source + ": " + view.error().message);
+    if (!view) return fail(echoPath(a.scene.source) + ": " + view.error().message);
     options.previousNearestCosine = previousCosine.empty() ? nullptr : &previousCosine;
     if (budget && budget->isRelative()) {
       auto counted = (*engine)->countFragments(**view);
-      if (!counted) return fail(a.scene.source + ": " + counted.error().message);
+      if (!counted) return fail(echoPath(a.scene.source) + ": " + counted.error().message);
       auto bytes = resolveBudget(
           *budget, method.value(),
           MemoryModel::of(method.value(), options.capture == CaptureMode::FragmentParallel),
           FrameCounts::of(counted.value()), std::to_string(width) + "x" + std::to_string(height));
-      if (!bytes) return fail(a.scene.source + ": " + bytes.error().message);
+      if (!bytes) return fail(echoPath(a.scene.source) + ": " + bytes.error().message);
       options.budgetBytes = bytes.value();
     }
     auto result = (*engine)->render(**view, method.value(), options);
-    if (!result) return fail(a.scene.source + ": " + result.error().message);
+    if (!result) return fail(echoPath(a.scene.source) + ": " + result.error().message);
     previousCosine = result->nearestCosine;
     const std::string out = viewPath(a.out, v, views);
     auto written = writePng(out, encodeSrgb(result->image));
@@ -194,7 +201,7 @@ int run(const RenderArgs& a) {
         std::vector<uint32_t> n = result->depthComplexity;
         if (n.empty()) {
           auto counted = (*engine)->countFragments(**view);
-          if (!counted) return fail(a.scene.source + ": " + counted.error().message);
+          if (!counted) return fail(echoPath(a.scene.source) + ": " + counted.error().message);
           n = std::move(counted.value());
         }
         writeMap(viewPath(a.depthComplexity, v, views), n, width, height, "fragments per pixel");

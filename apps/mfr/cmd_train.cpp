@@ -17,6 +17,7 @@
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/plot.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/learn/model_file.hpp"
@@ -57,13 +58,13 @@ Result<Split> loadSplit(const TrainArgs& a) {
     auto rule = learn::datasetRule(data.value(), path);
     if (!rule) return rule.error();
     if (!sets.empty() && rule.value() != split.rule)
-      return makeError("dataset " + path + ": targets for " + toString(rule.value()) +
-                       " compositing, " + a.datasets.front() + " has " + toString(split.rule) +
-                       " (one model per rule: train them separately)");
+      return makeError("dataset " + echoPath(path) + ": targets for " + toString(rule.value()) +
+                       " compositing, " + echoPath(a.datasets.front()) + " has " +
+                       toString(split.rule) + " (one model per rule: train them separately)");
     split.rule = rule.value();
     if (!sets.empty() && data->targetCount != split.targetCount)
-      return makeError("dataset " + path + ": " + std::to_string(data->targetCount) +
-                       " targets per sample, " + a.datasets.front() + " has " +
+      return makeError("dataset " + echoPath(path) + ": " + std::to_string(data->targetCount) +
+                       " targets per sample, " + echoPath(a.datasets.front()) + " has " +
                        std::to_string(split.targetCount) + " (importance and curve datasets " +
                        "train different networks)");
     split.targetCount = data->targetCount;
@@ -80,7 +81,7 @@ Result<Split> loadSplit(const TrainArgs& a) {
     valid.insert(order.back());
   for (const std::string& v : valid)
     if (std::find(order.begin(), order.end(), v) == order.end())
-      return makeError("--validation-scene '" + v + "': not in the datasets");
+      return makeError("--validation-scene " + quoteInput(v) + ": not in the datasets");
   // a validation split by family: every scene of procedural:NAME, whatever its parameters
   for (const std::string& family : a.validationFamilies) {
     const std::string prefix = "procedural:" + family;
@@ -91,7 +92,7 @@ Result<Split> loadSplit(const TrainArgs& a) {
         found = true;
       }
     if (!found)
-      return makeError("--validation-family '" + family + "': no " + prefix +
+      return makeError("--validation-family " + quoteInput(family) + ": no " + prefix +
                        " scene in the datasets");
   }
   for (const std::string& s : order)
@@ -140,7 +141,7 @@ Result<void> writeLossCurve(const std::string& path, const std::vector<learn::Ep
   std::vector<PlotSeries> series{train};
   if (std::isfinite(valid.y.front())) series.push_back(valid);
   auto image = plotLines(series, options);
-  if (!image) return makeError("--loss-curve " + path + ": " + image.error().message);
+  if (!image) return makeError("--loss-curve " + echoPath(path) + ": " + image.error().message);
   return writePng(path, image.value());
 }
 
@@ -166,7 +167,7 @@ int runTrain(TrainArgs& a) {
   // now so that a bad --log fails before the training, not after it
   const std::filesystem::path logFolder = std::filesystem::path(a.log).parent_path();
   if (std::error_code ec; !std::filesystem::is_directory(logFolder.empty() ? "." : logFolder, ec))
-    return fail("--log " + a.log + ": cannot open for writing (no such folder)");
+    return fail("--log " + echoPath(a.log) + ": cannot open for writing (no such folder)");
   std::ostringstream log;
   log << "epoch,train_mse,validation_mse,seconds\n";
   Progress progress(!a.quiet);

@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "mfr/core/memory_limit.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/raster_frame.hpp"
@@ -30,7 +31,8 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
   app.add_option("--orbit-view", orbitView, "With --orbit N: only view I of the N (0-based)");
   app.add_option("--zoom", zoom,
                  "Move the camera Z times closer to its target (default 1; 2 = half the distance)");
-  app.add_option("--threads", threads, "Worker threads (default: all cores)");
+  app.add_option("--threads", threads,
+                 "Worker threads, 0-" + std::to_string(kMaxThreads) + " (default 0: all cores)");
   app.add_option("--seed", seed, "Seed for procedural scenes and noise (default 1)");
   app.add_option("--shuffle-draw-order", shuffleDrawOrder,
                  "Submit the scene's triangles in the random order of this seed");
@@ -50,7 +52,9 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
   app.add_option("--memory-limit", memoryLimit,
                  "Refuse to allocate buffers larger than this, e.g. 8GB (default: " +
                      std::to_string(static_cast<int>(kDefaultMemoryShare * 100)) +
-                     "% of the physical memory, " + formatBytes(defaultMemoryLimit()) + ")");
+                     "% of the physical memory, of the address-space limit (ulimit -v) or of the "
+                     "cgroup's memory limit, whichever is least: " +
+                     formatBytes(defaultMemoryLimit()) + ")");
   if (engineOption) {
     std::string names;
     for (const std::string& n : engineNames()) names += (names.empty() ? "" : "|") + n;
@@ -81,8 +85,8 @@ Result<uint64_t> SceneOptions::memoryLimitBytes() const {
   if (memoryLimit.empty()) return defaultMemoryLimit();
   auto bytes = parseByteSize(memoryLimit);
   if (!bytes)
-    return makeError("--memory-limit '" + memoryLimit +
-                     "': expected a size such as 8GB, 512MB or 1048576 (at most 1 TiB)");
+    return makeError("--memory-limit " + quoteInput(memoryLimit) +
+                     ": expected a size such as 8GB, 512MB or 1048576 (at most 1 TiB)");
   return bytes.value();
 }
 
@@ -96,8 +100,7 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
     return makeError("--width/--height " + std::to_string(o.width) + "x" +
                      std::to_string(o.height) + ": must be in [1, " +
                      std::to_string(kMaxImageSize) + "]");
-  if (o.threads < 0 || o.threads > 1024)
-    return makeError("--threads " + std::to_string(o.threads) + ": must be in [1, 1024]");
+  MFR_TRY(checkThreads(o.threads, "--threads"));
   if (o.orbit < 0 || o.orbit > 10000)
     return makeError("--orbit " + std::to_string(o.orbit) + ": must be in [1, 10000]");
   if (o.orbitView >= 0 && o.orbitView >= o.orbit)
@@ -144,8 +147,8 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
     camera = *explicitCamera;
   } else if (o.view >= 0) {
     if (o.view >= static_cast<int>(scene.cameras.size()))
-      return makeError(o.source + ": --view " + std::to_string(o.view) + " but the scene has " +
-                       std::to_string(scene.cameras.size()) + " camera(s)");
+      return makeError(echoPath(o.source) + ": --view " + std::to_string(o.view) +
+                       " but the scene has " + std::to_string(scene.cameras.size()) + " camera(s)");
     camera = scene.cameras[o.view];
   } else if (scene.defaultCamera) {
     camera = *scene.defaultCamera;

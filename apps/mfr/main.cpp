@@ -1,15 +1,54 @@
 // mfr: bounded-memory multi-fragment rendering from the command line. Parses, calls the library,
 // reports; every failure is one line on stderr and a non-zero exit.
+#include <cerrno>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <exception>
 #include <new>
 
 #include "commands.hpp"
+#include "mfr/core/quote.hpp"
 #ifdef MFR_HAS_GL
 #include "mfr/gl/gl_render_engine.hpp"
 #endif
 
-int main(int argc, char** argv) {
+namespace {
+
+/// Exit code of command-line syntax errors (an unknown option, a malformed or missing value, no
+/// subcommand); errors of the input itself exit 1.
+constexpr int kSyntaxErrorExit = 2;
+
+/// A CLI11 parse error as one line: --help and --version print as CLI11 does and exit 0;
+/// everything else is "mfr: error: ..." (the echoed input cut short) and kSyntaxErrorExit.
+int reportParseError(const CLI::App& app, const CLI::ParseError& e, int argc, char** argv) {
+  if (e.get_exit_code() == static_cast<int>(CLI::ExitCodes::Success)) return app.exit(e);
+  const auto commands = app.get_subcommands();
+  std::string message = mfr::oneLine(e.what(), 200);
+  if (commands.empty() && argc > 1 && argv[1][0] != '-') {  // "mfr rendr ...": name the word
+    std::string names;
+    for (const CLI::App* c : app.get_subcommands({}))
+      names += (names.empty() ? "" : ", ") + c->get_name();
+    message = "unknown command " + mfr::quoteInput(argv[1]) + " (commands: " + names + ")";
+  }
+  const std::string help =
+      commands.empty() ? "mfr --help" : "mfr " + commands.front()->get_name() + " --help";
+  std::fprintf(stderr, "mfr: error: %s (see '%s')\n", message.c_str(), help.c_str());
+  return kSyntaxErrorExit;
+}
+
+/// Flushes stdout (the --json and summary output): a failed write (a full disk, the file-size
+/// limit) is an error, not a silently truncated output.
+int finishStdout(int code) {
+  errno = 0;
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout)) return code;
+  const int err = errno;
+  std::fprintf(stderr, "mfr: error: stdout: write error (%s)\n",
+               err != 0 ? std::strerror(err) : "unknown error");
+  return code == 0 ? 1 : code;
+}
+
+int run(int argc, char** argv) {
 #ifdef MFR_HAS_GL
   mfr::gl::registerGlEngine();  // --engine gl
 #endif
@@ -29,7 +68,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return reportParseError(app, e, argc, argv);
   }
   try {
     if (app.got_subcommand("render")) return render();
@@ -54,5 +93,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "mfr: error: %s\n", e.what());
     return 1;
   }
-  return 2;
+  return kSyntaxErrorExit;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // past the file-size limit (ulimit -f) write() fails with EFBIG, reported as an error, instead
+  // of SIGXFSZ killing the process silently
+  std::signal(SIGXFSZ, SIG_IGN);
+  return finishStdout(run(argc, argv));
 }

@@ -17,15 +17,18 @@ The Python face of the C++ library (the extension module mfr._mfr):
 Errors the library reports (missing files, unknown scenes or methods, budgets too small, options
 that do not apply to a method, ...) raise mfr.Error (a RuntimeError) with the library's one-line
 message, the same text `mfr` prints after "mfr: error: ". Arrays of the wrong shape raise
-ValueError. Rendering, loading and comparing release the GIL. Returned arrays own the library's
+ValueError; arguments of the wrong type raise TypeError naming the parameter and the type
+("importance['alpha']: expected a number, got str"). Rendering, loading and comparing release the GIL. Returned arrays own the library's
 buffers (no copies); arrays that view a Scene, Model or dataset are read-only.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import json
 import os
+import re
 from typing import Any, Iterable, Sequence
 
 import numpy as np
@@ -45,9 +48,6 @@ from ._mfr import (  # noqa: F401  (re-exported)
     builtin_model,
     decode_srgb,
     encode_srgb,
-    load_scene,
-    metrics,
-    parse_bytes,
     preset_names,
     read_png,
     write_png,
@@ -60,6 +60,49 @@ __all__ = [
     "make_model", "metrics", "parse_bytes", "preset_names", "read_png", "render",
     "save_dataset", "save_model", "write_png",
 ]
+
+# --- argument types: a TypeError naming the parameter ------------------------------------------
+
+# what pybind11 converts to each C++ type of a signature, and how to say it
+_ACCEPTS = {
+    "int": ("an integer", lambda v: hasattr(type(v), "__index__")),
+    "float": ("a number", lambda v: hasattr(type(v), "__float__") or hasattr(type(v), "__index__")),
+    "str": ("a str", lambda v: isinstance(v, (str, bytes))),
+    "bool": ("True or False", lambda v: isinstance(v, (bool, np.bool_))),
+    "List[str]": ("a list of str", lambda v: isinstance(v, (list, tuple)) and
+                  all(isinstance(x, str) for x in v)),
+}
+
+
+def _named_type_errors(function):
+    """`function` (of _mfr) whose pybind11 "incompatible function arguments" TypeError (the whole
+    signature, naming no parameter) becomes "width: expected an integer, got str"."""
+    signature = (function.__doc__ or "\n").splitlines()[0]
+    parameters = re.findall(r"(?:\(|, )(\w+): ([\w.\[\]]+)", signature)
+
+    @functools.wraps(function)
+    def call(*args, **kwargs):
+        try:
+            return function(*args, **kwargs)
+        except TypeError as e:
+            if "incompatible function arguments" not in str(e):
+                raise
+            given = dict(zip((name for name, _ in parameters), args))
+            given.update(kwargs)
+            for name, kind in parameters:
+                if name in given and kind in _ACCEPTS and not _ACCEPTS[kind][1](given[name]):
+                    raise TypeError(f"{name}: expected {_ACCEPTS[kind][0]}, got "
+                                    f"{type(given[name]).__name__}") from None
+            raise
+
+    return call
+
+
+load_scene = _named_type_errors(_mfr.load_scene)
+metrics = _named_type_errors(_mfr.metrics)
+parse_bytes = _named_type_errors(_mfr.parse_bytes)
+_render = _named_type_errors(_mfr.render)
+_compare = _named_type_errors(_mfr._compare)
 
 #: The methods `mfr compare` runs when --methods is not given.
 DEFAULT_COMPARE_METHODS = ("fkb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "dkb-fill", "optimal",
@@ -86,8 +129,8 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
     camera: (eye xyz, target xyz[, up xyz[, fov degrees]]) as 6, 9 or 10 numbers; view: index of
         a camera of the scene file; default: the scene's own camera, or one framing its bounds.
         zoom: moves the camera zoom times closer to its target.
-    threads: worker threads (0: all cores; the output does not depend on it). seed: procedural
-        scenes and vkb's noise.
+    threads: worker threads in [0, 1024] (0: all cores; the output does not depend on it).
+        seed: procedural scenes and vkb's noise.
     memory_limit: refuse runs whose buffers need more (bytes or "8GB"; default 75% of the
         physical memory, as `mfr --memory-limit`).
     depth_complexity: also count the fragments per pixel when the method does not.
@@ -98,11 +141,11 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
     (float32 (h, w) for vkb*/dkb*, else None) and stats (dict, the keys of --stats-json but
     'image'). Raises mfr.Error with the library's message for bad input.
     """
-    return _mfr.render(scene, method=method, budget=budget, k=k, width=width, height=height,
-                       camera=camera, view=view, zoom=zoom, composite=composite, capture=capture,
-                       threads=threads, seed=seed, model=model, occupancy_d=occupancy_d,
-                       importance=importance, alpha=alpha, background=background,
-                       memory_limit=memory_limit, depth_complexity=depth_complexity)
+    return _render(scene, method=method, budget=budget, k=k, width=width, height=height,
+                   camera=camera, view=view, zoom=zoom, composite=composite, capture=capture,
+                   threads=threads, seed=seed, model=model, occupancy_d=occupancy_d,
+                   importance=importance, alpha=alpha, background=background,
+                   memory_limit=memory_limit, depth_complexity=depth_complexity)
 
 
 def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_METHODS, width=1024,
@@ -140,11 +183,11 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
     if model is not None:
         call.append(f"model={os.fspath(model)!r}" if not isinstance(model, Model) else
                     "model=<mfr.Model>")
-    return _mfr._compare(scene, out, budgets=list(budgets), methods=list(methods), width=width,
-                         height=height, camera=camera, view=view, zoom=zoom,
-                         composite=composite, capture=capture, threads=threads, seed=seed,
-                         model=model, ppd=ppd, alpha=alpha, background=background,
-                         memory_limit=memory_limit, command_line="mfr.compare(" + ", ".join(call) + ")")
+    return _compare(scene, out, budgets=list(budgets), methods=list(methods), width=width,
+                    height=height, camera=camera, view=view, zoom=zoom,
+                    composite=composite, capture=capture, threads=threads, seed=seed,
+                    model=model, ppd=ppd, alpha=alpha, background=background,
+                    memory_limit=memory_limit, command_line="mfr.compare(" + ", ".join(call) + ")")
 
 
 # --- the deep k-buffer's models ----------------------------------------------------------------

@@ -9,6 +9,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -53,6 +54,42 @@ inline std::string pathText(const py::object& path, const char* what = "path") {
     if (py::isinstance<py::str>(text)) return text.cast<std::string>();
   }
   throw py::type_error(std::string(what) + ": expected a str or os.PathLike path");
+}
+
+/// What castArgument<T> expects, for its TypeError.
+template <class T>
+constexpr const char* expectedTypeName() {
+  if constexpr (std::is_same_v<T, bool>)
+    return "True or False";
+  else if constexpr (std::is_integral_v<T>)
+    return "an integer";
+  else if constexpr (std::is_floating_point_v<T>)
+    return "a number";
+  else if constexpr (std::is_same_v<T, std::string>)
+    return "a str";
+  else if constexpr (std::is_same_v<T, py::dict>)
+    return "a dict";
+  else
+    return "another type";
+}
+
+/// `value` as T, or a TypeError naming the parameter and the types instead of pybind11's "Unable
+/// to cast Python instance to C++ type": "importance['alpha']: expected a number, got str".
+template <class T>
+T castArgument(py::handle value, const std::string& name) {
+  if constexpr (std::is_same_v<T, py::dict>) {
+    if (py::isinstance<py::dict>(value)) return py::reinterpret_borrow<py::dict>(value);
+  } else {
+    py::detail::make_caster<T> caster;
+    // a number takes an int (conversion); an integer or a bool takes no str ("5") and no float,
+    // and an integer no bool (True is an int)
+    const bool boolForInt =
+        std::is_integral_v<T> && !std::is_same_v<T, bool> && py::isinstance<py::bool_>(value);
+    if (!boolForInt && caster.load(value, std::is_floating_point_v<T>))
+      return py::detail::cast_op<T>(std::move(caster));
+  }
+  throw py::type_error(name + ": expected " + expectedTypeName<T>() + ", got " +
+                       std::string(py::str(value.get_type().attr("__name__"))));
 }
 
 /// A JSON value as Python objects, exactly as json.loads would read its dump (non-finite numbers

@@ -4,6 +4,7 @@
 #include "common.hpp"
 #include "mfr/compare/compare.hpp"
 #include "mfr/compare/compare_output.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/method/method_options.hpp"
@@ -85,7 +86,7 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     if (name.empty()) throw LibraryError("methods: empty method name in the list");
     unwrap(methodPreset(name));
     for (const std::string& seen : options.methods)
-      if (seen == name) throw LibraryError("methods: method '" + name + "' listed twice");
+      if (seen == name) throw LibraryError("methods: method " + quoteInput(name) + " listed twice");
     options.methods.push_back(name);
   }
   if (options.methods.empty()) throw LibraryError("methods: the method list is empty");
@@ -111,10 +112,12 @@ py::object compare(const py::object& sceneArg, const std::string& out,
   if (options.budgets.empty())
     throw LibraryError("budgets: no budget given (e.g. budgets=[\"20MB\", \"40MB\"])");
   if (!composite.is_none())
-    options.compositing = unwrap(parseCompositing(composite.cast<std::string>()));
+    options.compositing =
+        unwrap(parseCompositing(castArgument<std::string>(composite, "composite")));
   options.capture = captureArgument(capture);
   const RasterOptions ro = rasterArgument(width, height, threads);
-  unwrap(prepareOutputFolder(out));
+  // checked and staged before any work; put in place as `out` once complete (as mfr compare)
+  OutputFolder folder = unwrap(OutputFolder::begin(out));
 
   options.memoryLimitBytes = memoryLimitArgument(memoryLimitArg);
   const SceneArgument scene =
@@ -126,15 +129,18 @@ py::object compare(const py::object& sceneArg, const std::string& out,
   {
     py::gil_scoped_release release;
     CpuEngine engine(EngineOptions{ro.threads, ro.tileSize});
+    if (auto fits = checkComparisonFits(engine, ro.width, ro.height, options); !fits)
+      throw LibraryError(echoPath(scene.source) + ": " + fits.error().message);
     auto view = engine.prepare(View{&*scene.scene, cam, ro.width, ro.height});
-    if (!view) throw LibraryError(scene.source + ": " + view.error().message);
+    if (!view) throw LibraryError(echoPath(scene.source) + ": " + view.error().message);
     auto result = runComparison(engine, **view, options);
-    if (!result) throw LibraryError(scene.source + ": " + result.error().message);
+    if (!result) throw LibraryError(echoPath(scene.source) + ": " + result.error().message);
     ReportInfo info;
     info.mfrVersion = std::string("mfr ") + MFR_VERSION;
     info.commandLine = commandLine;
     info.generated = utcTimestamp();
-    jsonText = unwrap(writeComparison(result.value(), out, MFR_VERSION, info));
+    jsonText = unwrap(writeComparison(result.value(), folder.staging(), MFR_VERSION, info));
+    unwrap(folder.commit());
   }
   return py::module_::import("json").attr("loads")(jsonText);
 }

@@ -8,6 +8,7 @@
 
 #include "common.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/cpu/deep_importance.hpp"
@@ -52,7 +53,7 @@ py::array viewOf(const Scalar* data, std::vector<py::ssize_t> shape, py::handle 
 }
 
 Result<uint32_t> parseK(const py::object& k) {
-  const long long v = k.cast<long long>();
+  const long long v = castArgument<long long>(k, "k");
   if (v < 1 || v > (1 << 20)) return makeError("k: must be in [1, 1048576]");
   return static_cast<uint32_t>(v);
 }
@@ -73,7 +74,7 @@ MethodDesc buildMethod(const std::string& name, const py::object& k, const py::o
   }
   if (!composite.is_none()) {
     applicable(MethodOption::Composite, "composite");
-    m.compositing = unwrap(parseCompositing(composite.cast<std::string>()));
+    m.compositing = unwrap(parseCompositing(castArgument<std::string>(composite, "composite")));
   }
   if (!model.is_none()) {
     applicable(MethodOption::Model, "model");
@@ -82,13 +83,14 @@ MethodDesc buildMethod(const std::string& name, const py::object& k, const py::o
   if (!importance.is_none()) applicable(MethodOption::ImportanceParams, "importance");
   if (m.allocation == AllocationPolicy::Importance) {
     ImportanceParams ip;
-    if (!importance.is_none()) ip = importanceArgument(importance.cast<py::dict>());
+    if (!importance.is_none())
+      ip = importanceArgument(castArgument<py::dict>(importance, "importance"));
     ip.seed = seed;
     m.importance = ip;
   }
   if (!occupancyD.is_none()) {
     applicable(MethodOption::OccupancyD, "occupancy_d");
-    const long long d = occupancyD.cast<long long>();
+    const long long d = castArgument<long long>(occupancyD, "occupancy_d");
     if (d < 1 || d > 64) throw LibraryError("occupancy_d: must be in [1, 64]");
     m.occupancyWords = static_cast<int>(d);
   }
@@ -122,10 +124,12 @@ PyRenderResult renderScene(const py::object& sceneArg, const std::string& method
   {
     py::gil_scoped_release release;
     CpuEngine engine(EngineOptions{ro.threads, ro.tileSize});
+    if (auto fits = engine.preflight(ro.width, ro.height, m, options); !fits)
+      throw LibraryError(echoPath(scene.source) + ": " + fits.error().message);
     auto view = engine.prepare(View{&*scene.scene, cam, ro.width, ro.height});
-    if (!view) throw LibraryError(scene.source + ": " + view.error().message);
+    if (!view) throw LibraryError(echoPath(scene.source) + ": " + view.error().message);
     auto rendered = engine.render(**view, m, options);
-    if (!rendered) throw LibraryError(scene.source + ": " + rendered.error().message);
+    if (!rendered) throw LibraryError(echoPath(scene.source) + ": " + rendered.error().message);
     out = std::move(rendered.value());
     if (wantDepthComplexity && out.depthComplexity.empty())
       out.depthComplexity = unwrap(engine.countFragments(**view));

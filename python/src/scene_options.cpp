@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/scene/camera_spec.hpp"
@@ -14,8 +15,13 @@ namespace {
 
 std::vector<double> numbers(const py::object& value, const char* what) {
   if (py::isinstance<py::str>(value)) throw LibraryError(std::string(what) + ": expected numbers");
+  if (!py::isinstance<py::iterable>(value))
+    throw py::type_error(std::string(what) + ": expected a sequence of numbers, got " +
+                         std::string(py::str(value.get_type().attr("__name__"))));
   std::vector<double> v;
-  for (const py::handle item : value) v.push_back(item.cast<double>());
+  for (const py::handle item : value)
+    v.push_back(
+        castArgument<double>(item, std::string(what) + "[" + std::to_string(v.size()) + "]"));
   for (double x : v)
     if (!std::isfinite(x))
       throw LibraryError(std::string(what) + ": values must be finite numbers");
@@ -26,7 +32,7 @@ std::vector<double> numbers(const py::object& value, const char* what) {
 
 std::optional<float> alphaArgument(const py::object& alpha) {
   if (alpha.is_none()) return std::nullopt;
-  const double a = alpha.cast<double>();
+  const double a = castArgument<double>(alpha, "alpha");
   if (!(a >= 0.0 && a <= 1.0)) throw LibraryError("alpha: must be in [0, 1]");
   return static_cast<float>(a);
 }
@@ -94,8 +100,8 @@ std::optional<uint64_t> memoryLimitArgument(const py::object& limit) {
   if (py::isinstance<py::str>(limit)) {
     auto bytes = parseByteSize(limit.cast<std::string>());
     if (!bytes)
-      throw LibraryError("memory_limit '" + limit.cast<std::string>() +
-                         "': " + bytes.error().message);
+      throw LibraryError("memory_limit " + quoteInput(limit.cast<std::string>()) + ": " +
+                         bytes.error().message);
     return bytes.value();
   }
   if (py::isinstance<py::bool_>(limit) || !py::isinstance<py::int_>(limit))
@@ -108,15 +114,14 @@ std::optional<uint64_t> memoryLimitArgument(const py::object& limit) {
 CaptureMode captureArgument(const std::string& capture) {
   if (capture == "tile") return CaptureMode::TileOwned;
   if (capture == "parallel") return CaptureMode::FragmentParallel;
-  throw LibraryError("capture '" + capture + "': expected tile or parallel");
+  throw LibraryError("capture " + quoteInput(capture) + ": expected tile or parallel");
 }
 
 RasterOptions rasterArgument(int width, int height, int threads) {
   if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize)
     throw LibraryError("width/height " + std::to_string(width) + "x" + std::to_string(height) +
                        ": must be in [1, " + std::to_string(kMaxImageSize) + "]");
-  if (threads < 0 || threads > 1024)
-    throw LibraryError("threads " + std::to_string(threads) + ": must be in [0, 1024]");
+  unwrap(checkThreads(threads, "threads"));
   RasterOptions ro;
   ro.width = width;
   ro.height = height;
@@ -134,12 +139,16 @@ Camera cameraArgument(const Scene& scene, const py::object& camera, const py::ob
     if (py::isinstance<py::str>(camera)) {  // the command line's text, "EX,EY,EZ,TX,TY,TZ,..."
       c = unwrap(parseCameraSpec(camera.cast<std::string>(), "camera"));
     } else {
+      if (!py::isinstance<py::iterable>(camera))
+        throw py::type_error("camera: expected 6, 9 or 10 numbers or a str, got " +
+                             std::string(py::str(camera.get_type().attr("__name__"))));
       std::vector<double> v;
-      for (const py::handle item : camera) v.push_back(item.cast<double>());
+      for (const py::handle item : camera)
+        v.push_back(castArgument<double>(item, "camera[" + std::to_string(v.size()) + "]"));
       c = unwrap(cameraFromNumbers(v, "camera"));
     }
   } else if (!view.is_none()) {
-    const long long i = view.cast<long long>();
+    const long long i = castArgument<long long>(view, "view");
     if (i < 0) throw LibraryError("view: must be a camera index (0-based)");
     if (i >= static_cast<long long>(scene.cameras.size()))
       throw LibraryError(scene.name + ": view " + std::to_string(i) + " but the scene has " +
@@ -176,11 +185,12 @@ ImportanceParams importanceArgument(const py::dict& params) {
   ImportanceParams ip;
   for (const auto& [key, value] : params) {
     const std::string k = py::str(key);
+    const std::string name = "importance[" + quoteInput(k) + "]";
     const auto number = [&](float lo, float hi, bool openLow) {
-      const double v = value.cast<double>();
+      const double v = castArgument<double>(value, name);
       if (!(openLow ? v > lo : v >= lo) || !(v <= hi))
-        throw LibraryError("importance['" + k + "']: must be in " + (openLow ? "(" : "[") +
-                           std::to_string(lo) + ", " + std::to_string(hi) + "]");
+        throw LibraryError(name + ": must be in " + (openLow ? "(" : "[") + std::to_string(lo) +
+                           ", " + std::to_string(hi) + "]");
       return static_cast<float>(v);
     };
     if (k == "alpha") {
@@ -196,16 +206,16 @@ ImportanceParams importanceArgument(const py::dict& params) {
       if (v.size() != 2) throw LibraryError("importance['fovea']: expected two pixel coordinates");
       ip.fovea = glm::vec2(v[0], v[1]);
     } else if (k == "depth_term") {
-      ip.useDepth = value.cast<bool>();
+      ip.useDepth = castArgument<bool>(value, name);
     } else if (k == "periphery_term") {
-      ip.usePeriphery = value.cast<bool>();
+      ip.usePeriphery = castArgument<bool>(value, name);
     } else if (k == "fresnel_term") {
-      ip.useFresnel = value.cast<bool>();
+      ip.useFresnel = castArgument<bool>(value, name);
     } else if (k == "noise_term") {
-      ip.useNoise = value.cast<bool>();
+      ip.useNoise = castArgument<bool>(value, name);
     } else {
-      throw LibraryError("importance: unknown parameter '" + k +
-                         "' (alpha, n_limit, periphery_d, fovea, noise, depth_term, "
+      throw LibraryError("importance: unknown parameter " + quoteInput(k) +
+                         " (alpha, n_limit, periphery_d, fovea, noise, depth_term, "
                          "periphery_term, fresnel_term, noise_term)");
     }
   }
@@ -242,6 +252,7 @@ Image8 image8Argument(const py::array& image, const char* what) {
     const auto pixels = py::array_t<float, py::array::c_style | py::array::forcecast>(image);
     ImageRGB linear(static_cast<int>(w), static_cast<int>(h));
     std::memcpy(linear.pixels.data(), pixels.data(), sizeof(float) * 3 * linear.pixels.size());
+    unwrap(checkFinite(linear, name));
     return encodeSrgb(linear);
   }
   throw py::value_error(name + ": expected uint8 sRGB or floating-point linear values, got dtype " +

@@ -43,7 +43,7 @@ uint64_t budgetArgument(const py::object& budget);
 std::optional<uint64_t> memoryLimitArgument(const py::object& limit);
 /// "tile" or "parallel".
 CaptureMode captureArgument(const std::string& capture);
-/// width, height in [1, kMaxImageSize], threads in [0, 1024].
+/// width, height in [1, kMaxImageSize], threads in [0, 1024] (0 = all cores).
 RasterOptions rasterArgument(int width, int height, int threads);
 /// The camera as `mfr render` picks it: `camera` (6, 9 or 10 numbers: eye, target, [up, [fov]], or
 /// that text, checked by cameraFromNumbers / parseCameraSpec),

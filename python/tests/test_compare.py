@@ -84,9 +84,36 @@ def test_compare_errors(tmp_path):
     blocker.write_text("not a folder")
     with pytest.raises(mfr.Error, match="cannot create the output folder"):
         mfr.compare(SCENE, blocker, "40KB", methods=["fkb"], **kwargs)
+    # the ground truth's buffers at this size do not fit: refused before the frame is set up
+    with pytest.raises(mfr.Error, match=r"^procedural:hairball: ground truth \(abuffer\): "
+                                        r"abuffer at 16384 x 16384 pixels: its per-pixel buffers"):
+        mfr.compare("procedural:hairball", tmp_path / "c", "40KB", methods=["fkb"], width=16384,
+                    height=16384, memory_limit="1GB")
     # a budget too small for a method is recorded, not raised
     r = mfr.compare(SCENE, tmp_path / "b", "2KB", methods=["fkb"], **kwargs)
     assert "error" in r["methods"][0]
+
+
+def test_an_old_folder_is_replaced_whole_and_another_never(tmp_path):
+    out = tmp_path / "out"
+    mfr.compare(SCENE, out, "40KB", methods=["fkb", "vkb"], width=16, height=16)
+    assert (out / "vkb_40KB.png").exists()
+    # a failing compare (here its ground truth does not fit) leaves the old folder as it was
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    with pytest.raises(mfr.Error, match="memory limit"):
+        mfr.compare(SCENE, out, "40KB", methods=["fkb"], width=64, height=64, memory_limit="4KB")
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    # a complete one replaces it whole, as `mfr compare` does: no file of the old one is left
+    mfr.compare(SCENE, out, "40KB", methods=["fkb"], width=24, height=24)
+    assert read_json(out / "results.json")["width"] == 24
+    assert not (out / "vkb_40KB.png").exists()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder left
+    # a folder holding files a comparison does not write is never replaced
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep")
+    with pytest.raises(mfr.Error, match=r"holds 'notes.txt', which a comparison does not write"):
+        mfr.compare(SCENE, tmp_path / "mine", "40KB", methods=["fkb"], width=16, height=16)
+    assert (tmp_path / "mine" / "notes.txt").read_text() == "keep"
 
 
 def test_default_methods_are_the_clis(run_cli):

@@ -82,6 +82,23 @@ def test_metrics_errors(tmp_path, pair, cli_error):
         mfr.metrics(reference.srgb.astype(np.int64), test.srgb.astype(np.int64))
 
 
+def test_non_finite_values_are_an_error_naming_the_image_and_pixel(tmp_path):
+    black = np.zeros((H, W, 3), dtype=np.float32)
+    nan = np.full((H, W, 3), np.nan, dtype=np.float32)
+    # before: MSE 0 and PSNR inf (NaN encoded as black)
+    with pytest.raises(mfr.Error, match=r"^test: pixel \(0, 0\) is not finite \(nan in r\): "
+                                        r"the image must hold finite values$"):
+        mfr.metrics(black, nan)
+    bad = black.copy()
+    bad[2, 5, 1] = np.inf
+    with pytest.raises(mfr.Error, match=r"^reference: pixel \(5, 2\) is not finite \(inf in g\)"):
+        mfr.metrics(bad, black)
+    bad[2, 5, 1] = -np.inf
+    with pytest.raises(mfr.Error, match=r"^image: pixel \(5, 2\) is not finite \(-inf in g\)"):
+        mfr.write_png(tmp_path / "never.png", bad.astype(np.float64))
+    assert not (tmp_path / "never.png").exists()
+
+
 def test_png_and_srgb_helpers(tmp_path):
     rng = np.random.default_rng(1)
     rgba = rng.integers(0, 256, size=(H, W, 4), dtype=np.uint8)

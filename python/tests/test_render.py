@@ -214,6 +214,10 @@ def test_errors_carry_the_librarys_messages(tmp_path, cli_error):
                             memory_limit="1KB"),
          ["render", "procedural:bottles", "-m", "fkb", "--k", 2, "--width", W, "--height", H,
           "--memory-limit", "1KB", "-o", out]),
+        # the image size alone does not fit: refused before the frame is set up (fast)
+        (lambda: mfr.render("procedural:hairball", width=16384, height=16384, memory_limit="1GB"),
+         ["render", "procedural:hairball", "--width", 16384, "--height", 16384,
+          "--memory-limit", "1GB", "-o", out]),
     ]
     for call, args in cases:
         with pytest.raises(mfr.Error) as e:
@@ -238,6 +242,8 @@ def test_errors_carry_the_librarys_messages(tmp_path, cli_error):
     (dict(method="vkb", budget="1MB", importance={"colour": 1}), r"unknown parameter 'colour'"),
     (dict(method="vkb", budget="1MB", importance={"alpha": 2}), r"importance\['alpha'\]"),
     (dict(width=0), r"^width/height 0x32: must be in \[1, 16384\]"),
+    (dict(threads=-1), r"^threads -1: must be in \[0, 1024\], 0 = all cores$"),
+    (dict(threads=1025), r"^threads 1025: must be in \[0, 1024\], 0 = all cores$"),
     (dict(camera=(1, 2, 3)), r"^camera: expected 6, 9 or 10 numbers"),
     (dict(camera=(0, 0, 1, 0, 0, float("nan"))), r"^camera: values must be finite"),
     (dict(camera=(1, 1, 1, 1, 1, 1)), r"^camera: eye and target must differ"),
@@ -256,11 +262,81 @@ def test_bad_options_raise_mfr_error(kwargs, pattern):
         mfr.render("procedural:bottles", **args)
 
 
+def test_echoed_values_are_cut_short(tmp_path):
+    huge = "q" * 5000
+    for kwargs in (dict(capture=huge), dict(memory_limit=huge), dict(method=huge),
+                   dict(method="vkb", budget="1MB", importance={huge: 1})):
+        with pytest.raises(mfr.Error) as e:
+            mfr.render("procedural:bottles", width=W, height=H, **kwargs)
+        assert len(str(e.value)) < 400 and "'qqqq" in str(e.value), str(e.value)[:300]
+    with pytest.raises(mfr.Error) as e:
+        mfr.compare("procedural:bottles", tmp_path / "c", "40KB", methods=[huge, huge],
+                    width=W, height=H)
+    assert len(str(e.value)) < 400, str(e.value)[:300]
+
+
+def test_threads_range_is_the_clis(tmp_path, cli_error):
+    # CLI, viewer (the same options) and Python: [0, 1024], 0 = all cores
+    for threads in (-1, 1025):
+        with pytest.raises(mfr.Error) as e:
+            mfr.render("procedural:bottles", width=W, height=H, threads=threads)
+        assert "--" + str(e.value) == cli_error("render", "procedural:bottles", "--threads",
+                                                threads, "-o", tmp_path / "x.png")
+    assert mfr.render("procedural:bottles", width=W, height=H, threads=0).srgb.shape[:2] == (H, W)
+
+
 def test_wrong_types_raise_type_error():
     with pytest.raises(TypeError):
         mfr.render(42, width=W, height=H)
     with pytest.raises(TypeError):
         mfr.render("procedural:bottles", width="wide")
+
+
+@pytest.mark.parametrize("kwargs,message", [
+    # before: "Unable to cast Python instance to C++ type (#define PYBIND11_DETAILED_ERROR_...)"
+    (dict(method="vkb", budget="1MB", importance={"alpha": "x"}),
+     "importance['alpha']: expected a number, got str"),
+    (dict(method="vkb", budget="1MB", importance={"noise_term": "no"}),
+     "importance['noise_term']: expected True or False, got str"),
+    (dict(method="vkb", budget="1MB", importance={"fovea": [1, "a"]}),
+     "importance['fovea'][1]: expected a number, got str"),
+    (dict(method="vkb", budget="1MB", importance=[("alpha", 1)]),
+     "importance: expected a dict, got list"),
+    (dict(method="fkb", k="4"), "k: expected an integer, got str"),
+    (dict(method="fkb", k=2.5), "k: expected an integer, got float"),
+    (dict(method="fkb+occupancy", budget="1MB", occupancy_d="x"),
+     "occupancy_d: expected an integer, got str"),
+    (dict(camera=[0, 0, 3, 0, 0, "z"]), "camera[5]: expected a number, got str"),
+    (dict(camera=5), "camera: expected 6, 9 or 10 numbers or a str, got int"),
+    (dict(view="first"), "view: expected an integer, got str"),
+    (dict(alpha="half"), "alpha: expected a number, got str"),
+    (dict(background=[0, "r", 0]), "background[1]: expected a number, got str"),
+    (dict(composite=1), "composite: expected a str, got int"),
+    # pybind11's own conversions of typed keywords: "incompatible function arguments" + signature
+    (dict(width="wide"), "width: expected an integer, got str"),
+    (dict(zoom="near"), "zoom: expected a number, got str"),
+    (dict(capture=None), "capture: expected a str, got NoneType"),
+    (dict(threads=1.5), "threads: expected an integer, got float"),
+])
+def test_type_errors_name_the_parameter_and_the_type(kwargs, message):
+    args = dict(width=W, height=H)
+    args.update(kwargs)
+    with pytest.raises(TypeError) as e:
+        mfr.render("procedural:bottles", **args)
+    assert str(e.value) == message
+
+
+def test_type_errors_of_other_functions_name_the_parameter(tmp_path):
+    with pytest.raises(TypeError, match=r"^seed: expected an integer, got str$"):
+        mfr.load_scene("procedural:bottles", seed="one")
+    with pytest.raises(TypeError, match=r"^ppd: expected a number, got str$"):
+        mfr.metrics(np.zeros((2, 2, 3), np.uint8), np.zeros((2, 2, 3), np.uint8), ppd="x")
+    with pytest.raises(TypeError, match=r"^methods: expected a list of str, got list$"):
+        mfr.compare("procedural:bottles", tmp_path / "c", "40KB", methods=["fkb", 3], width=W,
+                    height=H)
+    with pytest.raises(TypeError, match=r"^height: expected an integer, got str$"):
+        mfr.compare("procedural:bottles", tmp_path / "c", "40KB", methods=["fkb"], width=W,
+                    height="tall")
 
 
 def test_gil_is_released_while_rendering():

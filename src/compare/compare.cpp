@@ -103,6 +103,18 @@ double CompareRun::memoryUtilisation() const {
   return slots ? static_cast<double>(stats.captured) / static_cast<double>(slots) : 0.0;
 }
 
+Result<void> checkComparisonFits(const Engine& engine, int width, int height,
+                                 const CompareOptions& options) {
+  auto abuffer = methodPreset("abuffer");
+  if (!abuffer) return abuffer.error();
+  RenderOptions ro;
+  ro.capture = options.capture;
+  ro.memoryLimitBytes = options.memoryLimitBytes;
+  if (auto fits = engine.preflight(width, height, abuffer.value(), ro); !fits)
+    return makeError("ground truth (abuffer): " + fits.error().message);
+  return {};
+}
+
 Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
                                     const CompareOptions& options) {
   if (options.methods.empty()) return makeError("--methods: the method list is empty");

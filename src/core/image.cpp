@@ -1,6 +1,7 @@
 #include "mfr/core/image.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <limits>
@@ -29,6 +30,20 @@ Image8 encodeSrgb(const ImageRGB& image) {
     out.rgba[i * 4 + 3] = 255;
   }
   return out;
+}
+
+Result<void> checkFinite(const ImageRGB& image, const std::string& what) {
+  for (size_t i = 0; i < image.pixels.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const float v = image.pixels[i][c];
+      if (std::isfinite(v)) continue;
+      const size_t w = static_cast<size_t>(std::max(image.width, 1));
+      const char* value = std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf";
+      return makeError(what + ": pixel (" + std::to_string(i % w) + ", " + std::to_string(i / w) +
+                       ") is not finite (" + value + " in " + "rgb"[c] +
+                       "): the image must hold finite values");
+    }
+  return {};
 }
 
 ImageRGB decodeSrgb(const Image8& image) {

@@ -20,6 +20,11 @@ std::map<std::string, std::string> CpuEngine::describe() const {
           {"tile_size", std::to_string(options_.tileSize)}};
 }
 
+Result<void> CpuEngine::preflight(int width, int height, const MethodDesc& method,
+                                  const RenderOptions& options) const {
+  return checkPixelBuffers(width, height, method, options);
+}
+
 Result<std::unique_ptr<PreparedView>> CpuEngine::prepare(const View& view) {
   if (!view.scene) return makeError("engine cpu: a view without a scene");
   RasterOptions ro;

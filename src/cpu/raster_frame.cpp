@@ -13,6 +13,13 @@
 
 namespace mfr {
 
+Result<void> checkThreads(int threads, const std::string& name) {
+  if (threads < 0 || threads > kMaxThreads)
+    return makeError(name + " " + std::to_string(threads) + ": must be in [0, " +
+                     std::to_string(kMaxThreads) + "], 0 = all cores");
+  return {};
+}
+
 int resolveThreads(int threads) {
   if (threads > 0) return threads;
   const unsigned hw = std::thread::hardware_concurrency();
@@ -175,6 +182,7 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
     return makeError("image size " + std::to_string(options.width) + "x" +
                      std::to_string(options.height) + ": width and height must be in [1, " +
                      std::to_string(kMaxImageSize) + "]");
+  MFR_TRY(checkThreads(options.threads, "threads"));
   if (options.tileSize < 8 || options.tileSize > 1024)
     return makeError("tile size " + std::to_string(options.tileSize) + ": must be in [8, 1024]");
   MFR_TRY(validateScene(scene));

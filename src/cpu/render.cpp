@@ -137,9 +137,12 @@ std::vector<uint32_t> countFragments(const RasterFrame& frame) {
 namespace {
 
 /// "abuffer at 1024 x 768 pixels", for memory errors.
+std::string renderWhat(int width, int height, const MethodDesc& method) {
+  return method.name + " at " + std::to_string(width) + " x " + std::to_string(height) + " pixels";
+}
+
 std::string renderWhat(const RasterFrame& frame, const MethodDesc& method) {
-  return method.name + " at " + std::to_string(frame.width()) + " x " +
-         std::to_string(frame.height()) + " pixels";
+  return renderWhat(frame.width(), frame.height(), method);
 }
 
 /// What render() allocates per pixel before any node (README "Memory accounting"): counters, k,
@@ -154,7 +157,24 @@ uint64_t perPixelBytes(const MethodDesc& method, const MemoryModel& memory) {
   return bytes;
 }
 
+/// checkPixelBuffers against `limit`.
+Result<void> checkPixelBytes(int width, int height, const MethodDesc& method, CaptureMode capture,
+                             uint64_t limit) {
+  if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize)
+    return {};  // RasterFrame::build names a bad size
+  const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
+  const MemoryModel memory = MemoryModel::of(method, capture == CaptureMode::FragmentParallel);
+  return checkMemory(saturatingMul(pixels, perPixelBytes(method, memory)), limit,
+                     renderWhat(width, height, method) + ": its per-pixel buffers");
+}
+
 }  // namespace
+
+Result<void> checkPixelBuffers(int width, int height, const MethodDesc& method,
+                               const RenderOptions& options) {
+  return checkPixelBytes(width, height, method, options.capture,
+                         options.memoryLimitBytes.value_or(defaultMemoryLimit()));
+}
 
 static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodDesc& method,
                                          const RenderOptions& options, uint64_t memoryLimit) {
@@ -187,9 +207,9 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
   const size_t pixels = frame.pixelCount();
   const MemoryModel memory =
       MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
-  // memory pre-flight: the per-pixel buffers here, the node pool after allocate
-  MFR_TRY(checkMemory(saturatingMul(pixels, perPixelBytes(method, memory)), memoryLimit,
-                      renderWhat(frame, method) + ": its per-pixel buffers"));
+  // memory pre-flight: the per-pixel buffers here (callers may have checked them before
+  // building the frame), the node pool after allocate
+  MFR_TRY(checkPixelBytes(frame.width(), frame.height(), method, options.capture, memoryLimit));
 
   // count pass
   // (the optimal oracle counts in its own A-buffer pre-pass)

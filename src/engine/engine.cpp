@@ -6,8 +6,13 @@
 
 namespace mfr {
 
+Result<void> Engine::preflight(int, int, const MethodDesc&, const RenderOptions&) const {
+  return {};
+}
+
 Result<RenderOutput> Engine::render(const View& view, const MethodDesc& method,
                                     const RenderOptions& options) {
+  MFR_TRY(preflight(view.width, view.height, method, options));
   auto prepared = prepare(view);
   if (!prepared) return prepared.error();
   return render(**prepared, method, options);

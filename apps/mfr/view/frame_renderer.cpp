@@ -5,6 +5,7 @@
 #include <type_traits>
 
 #include "mfr/core/colormap.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
@@ -113,7 +114,7 @@ Frame FrameRenderer::update(const ViewSettings& s) {
       c = Cached{};
       auto view = engine_.prepare(cli::sceneView(scene_, options_, s.camera.camera()));
       if (!view) {
-        f.error = options_.source + ": " + view.error().message;
+        f.error = echoPath(options_.source) + ": " + view.error().message;
         f.display = blank(w, h);
         return f;
       }

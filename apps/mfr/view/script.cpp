@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/method.hpp"
 
@@ -61,8 +62,8 @@ Result<void> applyStep(const nlohmann::json& step, ViewSettings& s, FrameActions
       MFR_VIEW_GET(name, text(value, key));
       auto mode = parseViewMode(name);
       if (!mode)
-        return makeError("\"mode\": '" + name +
-                         "': expected image, depth, kmap, importance, truth, flip or wiper");
+        return makeError("\"mode\": " + quoteInput(name) +
+                         ": expected image, depth, kmap, importance, truth, flip or wiper");
       s.mode = *mode;
     } else if (key == "wiper") {
       MFR_VIEW_GET(x, number(value, key));
@@ -168,19 +169,19 @@ Result<void> applyStep(const nlohmann::json& step, ViewSettings& s, FrameActions
 
 Result<std::vector<nlohmann::json>> loadScript(const std::string& path) {
   std::ifstream in(path);
-  if (!in) return makeError("--script " + path + ": cannot read the file");
+  if (!in) return makeError("--script " + echoPath(path) + ": cannot read the file");
   std::stringstream buffer;
   buffer << in.rdbuf();
   nlohmann::json doc = nlohmann::json::parse(buffer.str(), nullptr, false);
   if (doc.is_discarded() || !doc.is_array())
-    return makeError("--script " + path + ": expected a JSON array of action objects");
+    return makeError("--script " + echoPath(path) + ": expected a JSON array of action objects");
   std::vector<nlohmann::json> steps(doc.begin(), doc.end());
   // check every step on a scratch copy, so a typo fails before the window opens
   ViewSettings scratch{Camera{}};
   for (size_t i = 0; i < steps.size(); ++i) {
     FrameActions ignored;
     if (auto ok = applyStep(steps[i], scratch, ignored); !ok)
-      return makeError("--script " + path + ": step " + std::to_string(i) + ": " +
+      return makeError("--script " + echoPath(path) + ": step " + std::to_string(i) + ": " +
                        ok.error().message);
   }
   return steps;

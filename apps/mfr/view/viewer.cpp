@@ -22,6 +22,7 @@
 #include "frame_renderer.hpp"
 #include "image_texture.hpp"
 #include "mfr/core/atomic_file.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/method.hpp"
 #include "panel.hpp"
@@ -192,8 +193,8 @@ int runViewer(const ViewerArgs& a) {
   settings.importance.seed = a.scene.seed;  // as render's ImportanceParams
   auto mode = parseViewMode(a.mode);
   if (!mode)
-    return cli::fail("--mode '" + a.mode +
-                     "': expected image, depth, kmap, importance, truth, flip or wiper");
+    return cli::fail("--mode " + quoteInput(a.mode) +
+                     ": expected image, depth, kmap, importance, truth, flip or wiper");
   settings.mode = *mode;
   if (auto method = settingsMethod(settings); !method) return cli::fail(method.error().message);
   std::vector<nlohmann::json> steps;
@@ -276,8 +277,8 @@ int runViewer(const ViewerArgs& a) {
     auto chooseFileCamera = [&](int index) {
       const std::vector<Camera>& cameras = prepared->scene.cameras;
       if (index < 0 || index >= static_cast<int>(cameras.size())) {
-        notice = sceneOptions.source + ": no camera " + std::to_string(index) + ", the scene has " +
-                 std::to_string(cameras.size()) + " camera(s)";
+        notice = echoPath(sceneOptions.source) + ": no camera " + std::to_string(index) +
+                 ", the scene has " + std::to_string(cameras.size()) + " camera(s)";
         return false;
       }
       Camera camera = cameras[index];

@@ -109,6 +109,13 @@ struct CompareResult {
 Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
                                     const CompareOptions& options);
 
+/// The memory pre-flight of runComparison that the image size alone decides: the ground truth's
+/// (the A-buffer's) per-pixel buffers at width x height on `engine` (Engine::preflight), against
+/// options.memoryLimitBytes. Checked before the view is prepared, so that a comparison that
+/// cannot fit fails before the scene is set up.
+Result<void> checkComparisonFits(const Engine& engine, int width, int height,
+                                 const CompareOptions& options);
+
 /// results.json: scene, width, height, compositing, capture, flip_pixels_per_degree,
 /// budget_bytes (the first budget), ground_truth {name, image, depth_complexity_image, ...stats},
 /// methods (the first budget's runs), budgets [{budget_bytes, budget_label, methods}], and each

@@ -33,6 +33,11 @@ struct Image8 {
 
 /// sRGB-encodes a linear image (alpha 255).
 Image8 encodeSrgb(const ImageRGB& image);
+
+/// Checks that every value of a linear image is a finite number (a NaN would encode as black and
+/// measure as no error at all). Error, naming `what` and the first bad pixel in row order:
+/// "test: pixel (3, 0) is not finite (nan in g): the image must hold finite values".
+Result<void> checkFinite(const ImageRGB& image, const std::string& what);
 /// Decodes an sRGB8 image to linear floats (alpha ignored).
 ImageRGB decodeSrgb(const Image8& image);
 

@@ -30,4 +30,11 @@ inline std::string oneLine(std::string_view text, size_t maxLength = std::string
   return out;
 }
 
+/// A path or scene source echoed at the head of an error line ("PATH: ..."), unquoted as the
+/// library's messages name files: control characters as '?', cut at 256 characters with "..."
+/// (a real path is shorter; an argument or a Python string can be any length).
+inline std::string echoPath(std::string_view path) {
+  return oneLine(path, 256);
+}
+
 }  // namespace mfr

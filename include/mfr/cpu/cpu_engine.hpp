@@ -26,6 +26,8 @@ class CpuEngine final : public Engine {
   explicit CpuEngine(const EngineOptions& options = {}) : options_(options) {}
   std::string_view name() const override { return "cpu"; }
   std::map<std::string, std::string> describe() const override;
+  Result<void> preflight(int width, int height, const MethodDesc& method,
+                         const RenderOptions& options) const override;
   Result<std::unique_ptr<PreparedView>> prepare(const View& view) override;
   using Engine::render;
   Result<RenderOutput> render(const PreparedView& view, const MethodDesc& method,

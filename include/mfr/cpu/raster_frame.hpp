@@ -13,6 +13,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -175,6 +176,13 @@ struct CoverageAll {
 };
 template <class F>
 CoverageAll(F) -> CoverageAll<F>;
+
+/// Most worker threads a run may ask for.
+inline constexpr int kMaxThreads = 1024;
+
+/// Checks a requested number of threads: [0, kMaxThreads], 0 meaning all cores. The error names
+/// the parameter as `name` ("--threads 2000: must be in [0, 1024], 0 = all cores").
+Result<void> checkThreads(int threads, const std::string& name);
 
 /// Resolves a number of threads: 0 means all hardware threads.
 int resolveThreads(int threads);

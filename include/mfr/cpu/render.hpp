@@ -31,6 +31,15 @@ namespace mfr {
 Result<RenderOutput> render(const RasterFrame& frame, const MethodDesc& method,
                             const RenderOptions& options);
 
+/// The memory pre-flight that the image size alone decides: the per-pixel buffers `method` needs
+/// at width x height (with options.capture's locks) against options.memoryLimitBytes (default
+/// defaultMemoryLimit()). render() checks it before its first pass; callers check it before
+/// building the frame (RasterFrame::build takes seconds at 16384 x 16384), so that a run that
+/// cannot fit fails at once. A size outside [1, kMaxImageSize] passes (RasterFrame::build names
+/// it).
+Result<void> checkPixelBuffers(int width, int height, const MethodDesc& method,
+                               const RenderOptions& options);
+
 /// Per-pixel fragment counts n(p) (a Coverage count pass), rows top to bottom; what
 /// RenderOutput::depthComplexity holds when the method counts.
 std::vector<uint32_t> countFragments(const RasterFrame& frame);

@@ -57,6 +57,11 @@ class Engine {
   virtual std::string_view name() const = 0;
   /// What the engine runs on, as key/value lines for `mfr info` and the report's set-up table.
   virtual std::map<std::string, std::string> describe() const = 0;
+  /// The memory pre-flight that the size alone decides, checked before prepare() so that a run
+  /// that cannot fit fails before the scene is set up (the CPU engine: checkPixelBuffers; default:
+  /// nothing to check). render() checks it again.
+  virtual Result<void> preflight(int width, int height, const MethodDesc& method,
+                                 const RenderOptions& options) const;
   /// Sets up a view. Errors (one line): the size, the scene or the camera (see RasterFrame::build).
   virtual Result<std::unique_ptr<PreparedView>> prepare(const View& view) = 0;
   /// Renders one method on a prepared view (the passes of the method's description).
