@@ -318,6 +318,17 @@ TEST_F(HostileInputs, EchoedInputsInErrorsAreCutToABoundedLength) {
                                 "property float " +
                                     std::string(1 << 20, 'z') + "\nend_header\n");
   EXPECT_TRUE(refused(mfr::loadScene(ply), ply, {}));
+  // a procedural value of 5,000 characters, a missing file of a 5,000-character name: cut, and
+  // the problem after the echo survives
+  const std::string count(5000, '9');
+  EXPECT_TRUE(refused(mfr::loadScene("procedural:spheres?count=" + count), "procedural:spheres",
+                      {"'count'", "invalid value '9999"}));
+  const std::string missing = (model() / (std::string(5000, 'n') + ".obj")).string();
+  auto result = mfr::loadScene(missing);
+  ASSERT_FALSE(result.ok());
+  EXPECT_LT(result.error().message.size(), 1500u);
+  EXPECT_NE(result.error().message.find("cannot be read"), std::string::npos)
+      << result.error().message;
 }
 
 // ---------------------------------------------------------------------------------------------

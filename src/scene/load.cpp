@@ -80,10 +80,16 @@ Result<Scene> loadScene(const std::string& source, const LoadOptions& options) {
                                                    options.maxProceduralTriangles)
                              : loadFile(source, options);
   if (!loaded) {  // make sure the message names the source (procedural errors may not)
-    const std::string& message = loaded.error().message;
-    // one line whatever the source and the file hold (a name or a key may contain newlines)
+    std::string message = loaded.error().message;
     if (message.find(source) == std::string::npos)
-      return makeError(oneLine(source, 200) + ": " + oneLine(message, kMaxMessage));
+      return makeError(echoPath(source) + ": " + oneLine(message, kMaxMessage));
+    // a source of any length (a Python string, a generated path) is shortened where the loader
+    // echoed it, so that the problem after it survives the cut below
+    if (source.size() > 256)
+      for (size_t at = message.find(source); at != std::string::npos;
+           at = message.find(source, at + 1))
+        message.replace(at, source.size(), echoPath(source));
+    // one line whatever the source and the file hold (a name or a key may contain newlines)
     return makeError(oneLine(message, kMaxMessage));
   }
   Scene scene = std::move(*loaded);

@@ -2,6 +2,7 @@
 // (one file each: procedural_layers/hairball/smoke/bottles/spheres.cpp) and the helpers they share
 // (parameter reader, colours, framing, tube / lathe / sphere mesh builders).
 #include "mfr/scene/procedural.hpp"
+#include "mfr/core/quote.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -17,11 +18,9 @@ namespace mfr {
 namespace procedural {
 namespace {
 
-/// The value quoted for a one-line message (control characters replaced).
+/// The value quoted for a one-line message (control characters replaced, cut at 80 characters).
 std::string quoted(std::string_view text) {
-  std::string out = "'";
-  for (char c : text) out += (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) ? '?' : c;
-  return out + "'";
+  return quoteInput(text, 80);
 }
 
 std::string joined(const std::vector<std::string>& names) {
