@@ -22,6 +22,7 @@
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/scene/load.hpp"
+#include "scratch_folder.hpp"
 
 namespace {
 
@@ -30,22 +31,9 @@ using mfr::test::CliRun;
 using nlohmann::json;
 
 /// A fresh folder per test: `model/` holds the scene files, files beside `model/` are "outside".
-class Confinement : public ::testing::Test {
+class Confinement : public mfr::test::ScratchFolderTest {
  protected:
-  void SetUp() override {
-    static std::atomic<int> counter{0};
-    root_ =
-        fs::temp_directory_path() / ("mfr_confinement_" + std::to_string(std::random_device{}()) +
-                                     "_" + std::to_string(counter++));
-    fs::create_directories(root_ / "model");
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(root_, ec);
-  }
-
-  fs::path root() const { return root_; }
-  fs::path model() const { return root_ / "model"; }
+  Confinement() : ScratchFolderTest("mfr_confinement") {}
   std::string write(const fs::path& path, const std::string& bytes) const {
     fs::create_directories(path.parent_path());
     std::ofstream(path, std::ios::binary) << bytes;
@@ -53,11 +41,8 @@ class Confinement : public ::testing::Test {
   }
   void fifo(const fs::path& path) const { ASSERT_EQ(::mkfifo(path.c_str(), 0600), 0) << path; }
   CliRun cli(const std::string& args, const mfr::test::TimedCliOptions& options = {}) const {
-    return mfr::test::runCliTimed(args, root_, options);
+    return mfr::test::runCliTimed(args, root(), options);
   }
-
- private:
-  fs::path root_;
 };
 
 /// One triangle, three float positions: 36 bytes.

@@ -28,34 +28,21 @@
 #include "gltf_quads.hpp"
 #include "mfr/scene/load.hpp"
 #include "scene/polygon.hpp"
+#include "scratch_folder.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using nlohmann::json;
 
-class HostileInputs : public ::testing::Test {
+class HostileInputs : public mfr::test::ScratchFolderTest {
  protected:
-  void SetUp() override {
-    static std::atomic<int> counter{0};
-    root_ = fs::temp_directory_path() /
-            ("mfr_hostile_" + std::to_string(::getpid()) + "_" + std::to_string(counter++));
-    fs::create_directories(root_ / "model");
-  }
-  void TearDown() override {
-    std::error_code ec;
-    fs::remove_all(root_, ec);
-  }
-  fs::path root() const { return root_; }
-  fs::path model() const { return root_ / "model"; }
+  HostileInputs() : ScratchFolderTest("mfr_hostile") {}
   std::string write(const std::string& name, const std::string& bytes) const {
     const fs::path path = model() / name;
     std::ofstream(path, std::ios::binary) << bytes;
     return path.string();
   }
-
- private:
-  fs::path root_;
 };
 
 bool contains(const std::string& text, const std::string& part) {

@@ -55,22 +55,28 @@ Result<Scene> loadOpenFile(const std::string& path, const OpenFile& file,
   return loadJsonScene(path, file, options);
 }
 
-/// The public loaders open the file, then read it from the descriptor.
-Result<Scene> loadGltf(const std::string& path, const LoadOptions& options) {
+namespace {
+
+/// A public loader: the file opened once, then read from the descriptor by `load`.
+template <Result<Scene> (*load)(const std::string&, const OpenFile&, const LoadOptions&)>
+Result<Scene> openAndLoad(const std::string& path, const LoadOptions& options) {
   auto file = openRegularFile(path, path);
-  return file ? loadGltf(path, *file, options) : Result<Scene>(file.error());
+  return file ? load(path, *file, options) : Result<Scene>(file.error());
+}
+
+}  // namespace
+
+Result<Scene> loadGltf(const std::string& path, const LoadOptions& options) {
+  return openAndLoad<loadGltf>(path, options);
 }
 Result<Scene> loadObj(const std::string& path, const LoadOptions& options) {
-  auto file = openRegularFile(path, path);
-  return file ? loadObj(path, *file, options) : Result<Scene>(file.error());
+  return openAndLoad<loadObj>(path, options);
 }
 Result<Scene> loadPly(const std::string& path, const LoadOptions& options) {
-  auto file = openRegularFile(path, path);
-  return file ? loadPly(path, *file, options) : Result<Scene>(file.error());
+  return openAndLoad<loadPly>(path, options);
 }
 Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options) {
-  auto file = openRegularFile(path, path);
-  return file ? loadJsonScene(path, *file, options) : Result<Scene>(file.error());
+  return openAndLoad<loadJsonScene>(path, options);
 }
 
 Result<Scene> loadScene(const std::string& source, const LoadOptions& options) {
