@@ -85,12 +85,11 @@ void removeStaleStaging(const fs::path& destination) {
   for (const fs::path& p : stale) fs::remove_all(p, ec);
 }
 
-void syncFolder(const fs::path& dir) {  // best effort: makes the renames durable
-  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd >= 0) {
-    ::fsync(fd);
-    ::close(fd);
-  }
+/// "DIR: holds 'NAME', which a comparison does not write: ...": never replaced.
+Error foreignRefusal(const std::string& dir, const std::string& foreign) {
+  return makeError(dir + ": holds " + quoteInput(foreign) +
+                   ", which a comparison does not write: not replacing it (choose another "
+                   "folder)");
 }
 
 /// Swaps two folders in one step; false with errno where the file system cannot.
@@ -131,9 +130,7 @@ Result<OutputFolder> OutputFolder::begin(const std::string& out) {
     if (!fs::is_directory(st))
       return makeError(out + ": cannot create the output folder (not a directory)");
     if (const std::string foreign = foreignEntry(destination); !foreign.empty())
-      return makeError(out + ": holds " + quoteInput(foreign) +
-                       ", which a comparison does not write: not replacing it (choose another "
-                       "folder)");
+      return foreignRefusal(out, foreign);
   } else {
     fs::create_directories(destination.parent_path(), ec);
     if (ec || !fs::is_directory(destination.parent_path()))
@@ -159,31 +156,27 @@ Result<OutputFolder> OutputFolder::begin(const std::string& out) {
 Result<void> OutputFolder::commit() {
   if (staging_.empty()) return makeError(name_ + ": already written");
   const fs::path destination(destination_), staging(staging_);
+  const auto failed = [this](const std::string& why) {
+    return makeError(name_ + ": cannot put the comparison in place (" + why + ")");
+  };
   for (int attempt = 0; attempt < 16; ++attempt) {
     // absent or an empty folder: one rename
     if (::rename(staging.c_str(), destination.c_str()) == 0) break;
-    if (errno != ENOTEMPTY && errno != EEXIST)
-      return makeError(name_ + ": cannot put the comparison in place (" + std::strerror(errno) +
-                       ")");
+    if (errno != ENOTEMPTY && errno != EEXIST) return failed(std::strerror(errno));
     // a previous comparison (or one committed meanwhile): swap, then remove the old one
     if (const std::string foreign = foreignEntry(destination); !foreign.empty())
-      return makeError(name_ + ": holds " + quoteInput(foreign) +
-                       ", which a comparison does not write: not replacing it (choose another "
-                       "folder)");
+      return foreignRefusal(name_, foreign);
     if (exchange(staging, destination)) {
       std::error_code ec;
       fs::remove_all(staging, ec);  // now the old folder
       break;
     }
     if (errno == ENOENT) continue;  // removed meanwhile: rename again
-    if (errno != EINVAL && errno != ENOSYS && errno != ENOTSUP)
-      return makeError(name_ + ": cannot put the comparison in place (" + std::strerror(errno) +
-                       ")");
+    if (errno != EINVAL && errno != ENOSYS && errno != ENOTSUP) return failed(std::strerror(errno));
     // no exchange on this file system: the old folder aside, the new one in, the old one gone
     const fs::path aside = staging.string() + ".old";
     if (::rename(destination.c_str(), aside.c_str()) != 0 && errno != ENOENT)
-      return makeError(name_ + ": cannot put the comparison in place (" + std::strerror(errno) +
-                       ")");
+      return failed(std::strerror(errno));
     const bool placed = ::rename(staging.c_str(), destination.c_str()) == 0;
     std::error_code ec;
     fs::remove_all(aside, ec);
@@ -191,9 +184,9 @@ Result<void> OutputFolder::commit() {
   }
   std::error_code ec;
   if (fs::exists(staging, ec))  // every attempt lost to a concurrent comparison
-    return makeError(name_ + ": cannot put the comparison in place (it keeps changing)");
+    return failed("it keeps changing");
   staging_.clear();
-  syncFolder(destination.parent_path());
+  syncFolder(destination.parent_path().string());
   return {};
 }
 

@@ -65,14 +65,6 @@ fs::path temporaryName(const fs::path& target) {
   return dir / name;
 }
 
-void syncFolder(const fs::path& dir) {  // best effort: makes the rename itself durable
-  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd >= 0) {
-    ::fsync(fd);
-    ::close(fd);
-  }
-}
-
 /// Writes into an already open temporary file, syncs it and gives it the target's permissions.
 Result<void> fillTemporary(int fd, const std::string& path, std::string_view bytes,
                            std::optional<mode_t> mode) {
@@ -88,7 +80,7 @@ Result<void> renameIntoPlace(const fs::path& temporary, const std::string& path)
     ::unlink(temporary.c_str());
     return ioError(path, "cannot replace the file", err);
   }
-  syncFolder(fs::path(path).parent_path());
+  syncFolder(fs::path(path).parent_path().string());
   return {};
 }
 
@@ -163,6 +155,14 @@ Result<void> writeFileAtomically(const std::string& path, std::string_view bytes
   }
   if (auto unnamed = writeUnnamed(dir, path, bytes, mode)) return *unnamed;
   return writeNamed(path, bytes, mode);
+}
+
+void syncFolder(const std::string& dir) {
+  const int fd = ::open(dir.empty() ? "." : dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd >= 0) {
+    ::fsync(fd);
+    ::close(fd);
+  }
 }
 
 void setWriteFailureInjectionForTests(WriteFailureInjection hook) {

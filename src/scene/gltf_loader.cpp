@@ -191,10 +191,7 @@ Result<nlohmann::json> gltfJson(const std::vector<unsigned char>& bytes) {
   try {
     return nlohmann::json::parse(begin, begin + size);
   } catch (const nlohmann::json::exception& e) {
-    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at ..."
-    if (what.rfind("[json.exception.", 0) == 0 && what.find("] ") != std::string::npos)
-      what = what.substr(what.find("] ") + 2);
-    return makeError("JSON error: " + oneLine(what, 200));
+    return makeError(jsonErrorText(e.what()));
   }
 }
 
@@ -284,63 +281,59 @@ Result<void> checkReferences(const nlohmann::json& doc, GltfFiles& files) {
         return makeError("bufferViews[" + std::to_string(i) + "].byteStride " +
                          oneLine(stride.dump(), 40) + ": must be a multiple of 4 in [4, 252]");
     }
-  const auto external = [](const nlohmann::json& item) {
-    return item.is_object() && item.contains("uri") && item["uri"].is_string() &&
-           !tinygltf::IsDataURI(item["uri"].get<std::string>());
+  // an item's uri, when it has one
+  const auto uriOf = [](const nlohmann::json& item) -> const std::string* {
+    if (!item.is_object()) return nullptr;
+    const auto uri = item.find("uri");
+    return uri != item.end() && uri->is_string() ? &uri->get_ref<const std::string&>() : nullptr;
   };
+  // a file named by a uri, read once (a second uri naming it shares the bytes)
   const auto read = [&files](const std::string& uri, const std::string& what,
                              std::optional<uint64_t> declared) -> Result<void> {
     const std::string reference = decodeUri(uri);
-    if (auto known = files.bytes.find(reference); known != files.bytes.end()) {
-      if (declared && known->second.size() != *declared)
-        return makeError(what + ": byteLength " + std::to_string(*declared) +
-                         " differs from the file's size, " + std::to_string(known->second.size()) +
-                         " bytes");
-      ++files.readsLeft[reference];
-      return {};
-    }
-    auto file = openReference(files.path, reference, what, files.allowOutside);
-    if (!file) return file.error();
-    if (declared && file->size() != *declared)
+    const auto sizeDiffers = [&](uint64_t size) {
       return makeError(what + ": byteLength " + std::to_string(*declared) +
-                       " differs from the file's size, " + std::to_string(file->size()) + " bytes");
-    auto bytes = file->read(declared.value_or(files.maxFileBytes));
-    if (!bytes) return bytes.error();
-    if (declared && bytes->size() != *declared)
-      return makeError(what + ": the file shrank while it was read");
-    files.bytes.emplace(reference, std::move(*bytes));
-    files.readsLeft[reference] = 1;
+                       " differs from the file's size, " + std::to_string(size) + " bytes");
+    };
+    auto known = files.bytes.find(reference);
+    if (known == files.bytes.end()) {
+      auto file = openReference(files.path, reference, what, files.allowOutside);
+      if (!file) return file.error();
+      if (declared && file->size() != *declared) return sizeDiffers(file->size());  // unread
+      auto bytes = file->read(declared.value_or(files.maxFileBytes));
+      if (!bytes) return bytes.error();
+      if (declared && bytes->size() != *declared)
+        return makeError(what + ": the file shrank while it was read");
+      known = files.bytes.emplace(reference, std::move(*bytes)).first;
+    } else if (declared && known->second.size() != *declared) {
+      return sizeDiffers(known->second.size());
+    }
+    ++files.readsLeft[reference];
     return {};
   };
   if (auto it = doc.find("buffers"); it != doc.end() && it->is_array())
     for (size_t i = 0; i < it->size(); ++i) {
-      const nlohmann::json& buffer = (*it)[i];
-      const auto length = buffer.is_object() ? buffer.find("byteLength") : buffer.end();
-      const bool hasLength = length != buffer.end() && length->is_number_unsigned();
-      if (buffer.is_object() && buffer.contains("uri") && buffer["uri"].is_string() &&
-          !external(buffer) && hasLength) {
-        const std::string& uri = buffer["uri"].get_ref<const std::string&>();
-        const auto decoded = dataUriBytes(uri);
-        if (decoded && *decoded != length->get<uint64_t>())
-          return makeError("buffer " + std::to_string(i) + ": byteLength " +
-                           std::to_string(length->get<uint64_t>()) +
-                           " differs from the size of its data URI, " + std::to_string(*decoded) +
-                           " bytes");
-      }
-      if (!external(buffer)) continue;
-      const std::string uri = buffer["uri"].get<std::string>();
-      const std::string what = "buffer " + std::to_string(i) + " uri " + quoteInput(uri);
+      const std::string* uri = uriOf((*it)[i]);
+      if (!uri) continue;  // the GLB's own buffer, or invalid (tinygltf reports it)
+      const auto length = (*it)[i].find("byteLength");
       std::optional<uint64_t> declared;
-      if (hasLength) declared = length->get<uint64_t>();
-      MFR_TRY(read(uri, what, declared));
+      if (length != (*it)[i].end() && length->is_number_unsigned())
+        declared = length->get<uint64_t>();
+      if (tinygltf::IsDataURI(*uri)) {
+        const auto decoded = dataUriBytes(*uri);
+        if (declared && decoded && *decoded != *declared)
+          return makeError("buffer " + std::to_string(i) + ": byteLength " +
+                           std::to_string(*declared) + " differs from the size of its data URI, " +
+                           std::to_string(*decoded) + " bytes");
+        continue;
+      }
+      MFR_TRY(read(*uri, "buffer " + std::to_string(i) + " uri " + quoteInput(*uri), declared));
     }
   if (auto it = doc.find("images"); it != doc.end() && it->is_array())
-    for (size_t i = 0; i < it->size(); ++i) {
-      const nlohmann::json& image = (*it)[i];
-      if (!external(image)) continue;
-      const std::string uri = image["uri"].get<std::string>();
-      MFR_TRY(read(uri, "image " + std::to_string(i) + " uri " + quoteInput(uri), std::nullopt));
-    }
+    for (size_t i = 0; i < it->size(); ++i)
+      if (const std::string* uri = uriOf((*it)[i]); uri && !tinygltf::IsDataURI(*uri))
+        MFR_TRY(
+            read(*uri, "image " + std::to_string(i) + " uri " + quoteInput(*uri), std::nullopt));
   return {};
 }
 
@@ -633,8 +626,12 @@ Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int 
     values[a] = std::move(*read);
   }
   if (!count) return addMesh(node.mesh, world);
-  const size_t before = scene_.positions.size() * sizeof(glm::vec3) * 3 +
-                        scene_.indices.size() * sizeof(uint32_t) * 2;
+  // the scene's vertex data (positions, normals, uvs) and index data (indices, materials)
+  const auto sceneBytes = [this] {
+    return scene_.positions.size() * sizeof(glm::vec3) * 3 +
+           scene_.indices.size() * sizeof(uint32_t) * 2;
+  };
+  const size_t before = sceneBytes();
   for (size_t i = 0; i < *count; ++i) {
     glm::dmat4 instance(1.0);
     if (!values[0].empty())
@@ -652,10 +649,9 @@ Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int 
           instance, glm::dvec3(values[2][3 * i], values[2][3 * i + 1], values[2][3 * i + 2]));
     MFR_TRY(addMesh(node.mesh, world * instance));
     if (i == 0) {  // what one instance costs, times the count, against the memory limit
-      const size_t after = scene_.positions.size() * sizeof(glm::vec3) * 3 +
-                           scene_.indices.size() * sizeof(uint32_t) * 2;
-      if (auto fits = checkMemory(saturatingAdd(before, saturatingMul(after - before, *count)),
-                                  memoryLimit_, "its " + std::to_string(*count) + " instances");
+      if (auto fits =
+              checkMemory(saturatingAdd(before, saturatingMul(sceneBytes() - before, *count)),
+                          memoryLimit_, "its " + std::to_string(*count) + " instances");
           !fits)
         return fail(what + ": " + fits.error().message);
     }

@@ -109,10 +109,7 @@ Result<Scene> loadJsonScene(const std::string& path, const OpenFile& file,
   try {
     root = json::parse(*text);
   } catch (const json::exception& e) {
-    std::string what = e.what();  // "[json.exception.parse_error.101] parse error at ..."
-    if (what.rfind("[json.exception.", 0) == 0 && what.find("] ") != std::string::npos)
-      what = what.substr(what.find("] ") + 2);
-    return makeError(path + ": JSON error: " + oneLine(what, 200));
+    return makeError(path + ": " + jsonErrorText(e.what()));
   }
   const Checker check{path};
   if (!root.is_object()) return makeError(path + ": JSON error: top level must be an object");

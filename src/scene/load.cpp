@@ -27,15 +27,6 @@ std::string lowercaseExtension(const std::string& path) {
   return extension;
 }
 
-Result<void> checkExtension(const std::string& path) {
-  const std::string extension = lowercaseExtension(path);
-  for (const char* known : {".gltf", ".glb", ".obj", ".ply", ".json"})
-    if (extension == known) return {};
-  return makeError(path + ": unsupported scene format " +
-                   (extension.empty() ? "(no extension)" : quoteInput(extension, 20)) +
-                   " (expected .gltf, .glb, .obj, .ply, .json)");
-}
-
 Result<Scene> loadFile(const std::string& path, const LoadOptions& options) {
   // opened once, non-blocking: a FIFO or device named as the scene is refused on the descriptor
   auto file = openRegularFile(path, path);
@@ -47,12 +38,14 @@ Result<Scene> loadFile(const std::string& path, const LoadOptions& options) {
 
 Result<Scene> loadOpenFile(const std::string& path, const OpenFile& file,
                            const LoadOptions& options) {
-  MFR_TRY(checkExtension(path));
   const std::string extension = lowercaseExtension(path);
   if (extension == ".gltf" || extension == ".glb") return loadGltf(path, file, options);
   if (extension == ".obj") return loadObj(path, file, options);
   if (extension == ".ply") return loadPly(path, file, options);
-  return loadJsonScene(path, file, options);
+  if (extension == ".json") return loadJsonScene(path, file, options);
+  return makeError(path + ": unsupported scene format " +
+                   (extension.empty() ? "(no extension)" : quoteInput(extension, 20)) +
+                   " (expected .gltf, .glb, .obj, .ply, .json)");
 }
 
 namespace {
@@ -91,10 +84,10 @@ Result<Scene> loadScene(const std::string& source, const LoadOptions& options) {
       return makeError(echoPath(source) + ": " + oneLine(message, kMaxMessage));
     // a source of any length (a Python string, a generated path) is shortened where the loader
     // echoed it, so that the problem after it survives the cut below
-    if (source.size() > 256)
+    if (const std::string shortened = echoPath(source); source.size() > 256)
       for (size_t at = message.find(source); at != std::string::npos;
-           at = message.find(source, at + 1))
-        message.replace(at, source.size(), echoPath(source));
+           at = message.find(source, at + shortened.size()))
+        message.replace(at, source.size(), shortened);
     // one line whatever the source and the file hold (a name or a key may contain newlines)
     return makeError(oneLine(message, kMaxMessage));
   }

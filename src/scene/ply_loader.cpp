@@ -101,7 +101,7 @@ class PlyChecker {
  public:
   static constexpr size_t kMaxHeaderLines = 10000;
 
-  explicit PlyChecker(const std::vector<char>& bytes) : bytes_(bytes) {}
+  explicit PlyChecker(std::string_view bytes) : bytes_(bytes) {}
 
   /// "" when the file is a well-formed PLY file with in-range face indices, else the problem.
   std::string check() {
@@ -236,6 +236,14 @@ class PlyChecker {
     return {};
   }
 
+  /// What is wrong with the indices of a face or strip list ("" for other lists, and valid ones).
+  std::string indexProblem(const PlyElement& element, const PlyProperty& property, int64_t count,
+                           const std::vector<int64_t>& indices) const {
+    if (isFaceIndexList(element, property)) return faceProblem(count, indices);
+    if (isStripIndexList(element, property)) return stripProblem(indices);
+    return {};
+  }
+
   std::string checkBinaryBody() {
     const bool bigEndian = format_ == PlyFormat::BinaryBigEndian;
     const auto* data = reinterpret_cast<const unsigned char*>(bytes_.data());
@@ -261,10 +269,9 @@ class PlyChecker {
             indices.clear();
             for (size_t i = 0; i < static_cast<size_t>(count); ++i)
               indices.push_back(readInteger(data + pos_ + i * itemSize, property.type, bigEndian));
-            const std::string problem = isFaceIndexList(element, property)
-                                            ? faceProblem(count, indices)
-                                            : stripProblem(indices);
-            if (!problem.empty()) return problem;
+            if (std::string problem = indexProblem(element, property, count, indices);
+                !problem.empty())
+              return problem;
           }
           pos_ += static_cast<size_t>(count) * itemSize;
         }
@@ -310,10 +317,9 @@ class PlyChecker {
                                   ? static_cast<int64_t>(value)
                                   : std::numeric_limits<int64_t>::min());  // never valid
           }
-          if (isFaceIndexList(element, property))
-            if (std::string problem = faceProblem(count, indices); !problem.empty()) return problem;
-          if (isStripIndexList(element, property))
-            if (std::string problem = stripProblem(indices); !problem.empty()) return problem;
+          if (std::string problem = indexProblem(element, property, count, indices);
+              !problem.empty())
+            return problem;
         }
         if (line.find_first_not_of(" \t", next) != std::string_view::npos)
           return "bad PLY " + element.name + " line (extra values)";
@@ -322,7 +328,7 @@ class PlyChecker {
     return {};
   }
 
-  const std::vector<char>& bytes_;
+  std::string_view bytes_;
   size_t pos_ = 0;
   PlyFormat format_ = PlyFormat::Ascii;
   std::vector<PlyElement> elements_;
@@ -398,11 +404,9 @@ struct PlyBuilder {
 
 Result<Scene> loadPly(const std::string& path, const OpenFile& file, const LoadOptions& options) {
   try {
-    auto read = file.read(options.memoryLimitBytes.value_or(defaultMemoryLimit()));
+    auto read = file.readText(options.memoryLimitBytes.value_or(defaultMemoryLimit()));
     if (!read) return read.error();
-    const std::vector<char> bytes(read->begin(), read->end());
-    read->clear();
-    read->shrink_to_fit();
+    const std::string& bytes = *read;
     if (bytes.empty()) return makeError(path + ": empty file");
     if (std::string problem = PlyChecker(bytes).check(); !problem.empty())
       return makeError(path + ": " + problem);

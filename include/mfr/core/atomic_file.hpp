@@ -22,6 +22,9 @@ namespace mfr {
 /// `path` is untouched.
 Result<void> writeFileAtomically(const std::string& path, std::string_view bytes);
 
+/// fsync of a folder, so that renames in it are durable; best effort (errors are ignored).
+void syncFolder(const std::string& dir);
+
 /// Test hook (tests only): called after every chunk written to the temporary file with the
 /// destination path and the bytes written so far; returning true makes that write fail there as an
 /// I/O error would. Not thread-safe: set it while no file is being written. Empty: no injection.
