@@ -18,8 +18,9 @@ Errors the library reports (missing files, unknown scenes or methods, budgets to
 that do not apply to a method, ...) raise mfr.Error (a RuntimeError) with the library's one-line
 message, the same text `mfr` prints after "mfr: error: ". Arrays of the wrong shape raise
 ValueError; arguments of the wrong type raise TypeError naming the parameter and the type
-("importance['alpha']: expected a number, got str"). Rendering, loading and comparing release the GIL. Returned arrays own the library's
-buffers (no copies); arrays that view a Scene, Model or dataset are read-only.
+("importance['alpha']: expected a number, got str"). Rendering, loading and comparing release the
+GIL. Returned arrays own the library's buffers (no copies); arrays that view a Scene, Model or
+dataset are read-only.
 """
 
 from __future__ import annotations
@@ -131,8 +132,9 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
         zoom: moves the camera zoom times closer to its target.
     threads: worker threads in [0, 1024] (0: all cores; the output does not depend on it).
         seed: procedural scenes and vkb's noise.
-    memory_limit: refuse runs whose buffers need more (bytes or "8GB"; default 75% of the
-        physical memory, as `mfr --memory-limit`).
+    memory_limit: refuse runs whose buffers need more (bytes or "8GB"; default 75% of the least
+        of the physical memory, the address-space limit and the cgroup limit, as
+        `mfr --memory-limit`).
     depth_complexity: also count the fragments per pixel when the method does not.
 
     Returns an mfr.RenderResult: image (float32 (h, w, 3) linear RGB), srgb (uint8 (h, w, 4), the
