@@ -378,7 +378,7 @@ TEST_F(HostileInputs, NonConvexObjFacesAreEarClippedOrRefusedBeyondTheStatedLimi
   ASSERT_TRUE(scene.ok()) << scene.error().message;
   EXPECT_EQ(scene->triangleCount(), 10u);
   EXPECT_NEAR(summedArea(*scene), 11.0, 1e-9);
-  // a star of 2,000 corners is not convex and beyond the ear-clipping limit
+  // a star of 2,048 corners (twice the limit) is not convex and beyond the ear-clipping limit
   std::string star;
   const size_t corners = 2 * mfr::kMaxNonConvexCorners;
   for (size_t i = 0; i < corners; ++i) {
