@@ -2,10 +2,14 @@
 // target mfr::mfr; or pkg-config mfr). The flow of a frame:
 //
 //   auto scene = mfr::loadScene("procedural:bottles");            // scene/load.hpp
-//   auto frame = mfr::RasterFrame::build(*scene, camera, {});      // raster/raster_frame.hpp
+//   auto engine = mfr::makeEngine("cpu");                          // engine/engine.hpp
+//   auto view = (*engine)->prepare({.scene = &*scene, .camera = camera, .width = w, .height = h});
 //   auto method = mfr::methodPreset("kplus-dynamic");              // method/method.hpp
-//   auto out = mfr::render(*frame, *method, {.budgetBytes = M});   // method/render.hpp
+//   auto out = (*engine)->render(**view, *method, {.budgetBytes = M});
 //   mfr::writePng("out.png", mfr::encodeSrgb(out->image));         // core/image.hpp
+//
+// (The CPU engine's own entry points, mfr::RasterFrame::build in cpu/raster_frame.hpp and
+// mfr::render in cpu/render.hpp, are included too.)
 //
 // Every fallible call returns a Result<T> (core/result.hpp) whose error message is one line naming
 // the input; the library never prints, throws for bad input, or exits. Metrics

@@ -37,7 +37,8 @@ uint64_t GlRenderOutput::totalBufferBytes() const {
 
 namespace {
 
-// Guard band clamp of the CPU set-up (src/raster/raster_frame.cpp: kGuardBand * 1.001).
+// Guard band clamp of the CPU set-up, a copy of setupTriangle's kMaxNdc in src/cpu/raster_frame.cpp
+// (kGuardBand = 8, times 1.001); raster.geom clamps to it as the uniform uMaxNdc.
 constexpr double kMaxNdc = 8.0f * 1.001;
 
 std::string oneLine(std::string text) {

@@ -91,7 +91,7 @@ struct MethodDesc {
 };
 
 /// One row of the preset table (src/method/method.cpp): the name, the paper it follows and a
-/// one-line summary. The CLI help, `mfr info --presets`, the README's table and the compare
+/// one-line summary. The CLI help, `mfr presets`, the README's table and the compare
 /// report's legend are generated from it, so they cannot disagree.
 struct PresetInfo {
   std::string name;
