@@ -56,7 +56,7 @@ enum class ImportanceSource : uint8_t {
 enum class Compositing : uint8_t {
   KBuffer,  // sort the captured fragments, composite front to back, drop the rest
   Hybrid,   // sorted core + order-independent tail (hybrid transparency)
-  // The peer methods' own rules (README "Peer methods"); --composite does not apply to them.
+  // The peer methods' own rules (docs/METHODS.md); --composite does not apply to them.
   WeightedBlended,  // wboit: weighted sums and revealage (McGuire & Bavoil 2013), wboit.hpp
   MomentBased,      // mboit: power moments, reconstructed transmittance (Muenstermann 2018)
   MultiLayerAlpha,  // mlab: front-to-back over of the MultiLayer store's nodes (Salvi 2014)
