@@ -1,6 +1,6 @@
 // Relative budgets (issue 14, sec. 1): "30%" is the method's per-pixel and per-image words plus 30%
 // of the exact A-buffer's node bytes for the frame. The expected bytes are recomputed here from
-// the documented per-pixel layout (README, "Memory accounting") and the A-buffer's own fragment
+// the documented per-pixel layout (docs/MEMORY.md) and the A-buffer's own fragment
 // count, not from MemoryModel; too small a share is a one-line error naming the smallest share
 // that works (checked by rendering at it and just below it); compare accepts mixed lists.
 #include <gtest/gtest.h>

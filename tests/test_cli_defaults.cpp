@@ -1,4 +1,4 @@
-// The command line does what the README says by default: each preset composites with its own
+// The command line does what docs/CLI.md says by default: each preset composites with its own
 // rule unless --composite is given (checked on the recorded compositing and bytes, not the exit
 // code), and an option that would change nothing for the chosen method is a one-line error.
 #include <gtest/gtest.h>

@@ -1,6 +1,6 @@
 // bytes_used is the papers' accounting (MemoryModel: what a GPU would lay out); bytes_allocated
 // is what the CPU engine really allocated for the method's buffers, measured where they are
-// allocated. Both are checked here against the documented layouts (README, "Memory accounting"),
+// allocated. Both are checked here against the documented layouts (docs/MEMORY.md),
 // recomputed from the run's k(p) and n(p).
 #include <gtest/gtest.h>
 
@@ -30,7 +30,7 @@ const RasterFrame& hairball() {
   return f.frame;
 }
 
-// The CPU engine's documented buffers of one run (README, "Memory accounting").
+// The CPU engine's documented buffers of one run (docs/MEMORY.md).
 std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const RenderOutput& out,
                                                      uint64_t pixels, bool parallel,
                                                      uint64_t abufferFragments) {

@@ -145,7 +145,7 @@ std::string renderWhat(const RasterFrame& frame, const MethodDesc& method) {
   return renderWhat(frame.width(), frame.height(), method);
 }
 
-/// What render() allocates per pixel before any node (README "Memory accounting"): counters, k,
+/// What render() allocates per pixel before any node (docs/MEMORY.md): counters, k,
 /// offsets, store kind, the output image, n(p), and the method's locks, occupancy, tail and
 /// accumulators; importance allocation adds its reserved k, scratch and map. A lower bound,
 /// checked before the first pass.
@@ -184,7 +184,7 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
     return makeError(method.name + ": occupancy culling needs a bounded k");
   if (method.store == StoreChoice::Append && method.allocation != AllocationPolicy::Unbounded)
     return makeError(method.name + ": the append store needs exact (unbounded) allocation");
-  // the peer methods' rules go with their own allocation and store (README "Peer methods")
+  // the peer methods' rules go with their own allocation and store (docs/METHODS.md)
   const bool accumulates = method.compositing == Compositing::WeightedBlended ||
                            method.compositing == Compositing::MomentBased;
   if (accumulates != (method.allocation == AllocationPolicy::NoNodes) ||

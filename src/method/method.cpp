@@ -7,7 +7,7 @@ namespace mfr {
 namespace {
 
 // The preset table: every preset's name, paper, one-line summary and fields. presetNames(),
-// methodPreset(), `mfr render --help`, `mfr info --presets` (the README's table, checked by a test)
+// methodPreset(), `mfr render --help`, `mfr presets` (the README's table, checked by a test)
 // and the compare report's legend all read it.
 struct PresetRow {
   PresetInfo info;
@@ -132,7 +132,7 @@ const std::vector<PresetRow>& presetRows() {
          m.compositing = Compositing::Hybrid;
          m.publishedGreedy = true;
        }},
-      // the peer methods (README "Peer methods"): per-pixel accumulators, no fragment nodes
+      // the peer methods (docs/METHODS.md): per-pixel accumulators, no fragment nodes
       {{"wboit", "weighted blended OIT (McGuire & Bavoil 2013)",
         "weighted sums and revealage per pixel, no fragment nodes"},
        [](MethodDesc& m) {

@@ -256,7 +256,7 @@ void expectValid(const Config& c, const RenderOutput& out) {
 /// How two runs of a configuration at different thread counts may differ. Tile-owned capture
 /// delivers each pixel's fragments in primitive order: everything is byte-identical. Fragment-
 /// parallel capture delivers them in any order: hybrid tails and the WBOIT / MBOIT sums differ
-/// by float summation order only (README "Peer methods"; MBOIT's reconstruction amplifies it),
+/// by float summation order only (docs/METHODS.md; MBOIT's reconstruction amplifies it),
 /// MLAB's merges depend on the order by design once a pixel has more than k fragments.
 enum class Sameness { Exact, RoundingOnly, OrderDependent };
 

@@ -119,7 +119,7 @@ Result<void> checkComparisonFits(const Engine& engine, int width, int height,
 /// results.json: scene, width, height, compositing, capture, flip_pixels_per_degree,
 /// budget_bytes (the first budget), ground_truth {name, image, depth_complexity_image, ...stats},
 /// methods (the first budget's runs), budgets [{budget_bytes, budget_label, methods}], and each
-/// run's keys (see README, "mfr compare"). `mfrVersion` is recorded as mfr_version when not empty.
+/// run's keys (see docs/COMPARE.md). `mfrVersion` is recorded as mfr_version when not empty.
 nlohmann::json compareToJson(const CompareResult& result, const std::string& mfrVersion = "");
 
 /// results.csv: a header and one row per run (ground truth first), budgets in order.

@@ -68,7 +68,7 @@ struct RenderStats {
   uint64_t bytesUsed = 0;
   std::map<std::string, uint64_t> bytesByCategory;
   /// What this CPU engine actually allocated for the method's buffers (summed over the frame,
-  /// measured at the allocation sites; see README "Memory accounting"). Not bounded by the budget.
+  /// measured at the allocation sites; see docs/MEMORY.md). Not bounded by the budget.
   uint64_t bytesAllocated = 0;
   std::map<std::string, uint64_t> bytesAllocatedByCategory;
   uint64_t fragmentSlots = 0;  // nodes allocated

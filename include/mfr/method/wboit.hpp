@@ -14,7 +14,7 @@
 //   w(z, a) = a * max(1e-2, 3e3 * (1 - d)^3)          (the upper clamp 3e3 is implied: d >= 0)
 // Sums are accumulated in the order fragments reach the pixel: primitive order in tile-owned
 // capture (the same for any thread count); in another submission order the float sums may differ
-// in the last bits (relative 1e-6 per fragment, see README "Peer methods").
+// in the last bits (relative 1e-6 per fragment, see docs/METHODS.md).
 #pragma once
 
 #include <algorithm>
