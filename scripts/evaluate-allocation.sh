@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# One evaluation of the bounded allocations (issue 14, sec. 6): every real scene in
+# One evaluation of the bounded allocations (docs/ALLOCATION_EVAL.md): every real scene in
 # ../shared/scenes x VIEWS orbit views x relative budgets {25%, 50%, 75%} (each method's own words +
 # that share of the exact A-buffer's node bytes) x both compositing rules, all bounded k-buffer
 # methods and optimal; writes the mfr compare folders and one summary (summary.md, summary.html:

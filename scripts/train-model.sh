@@ -1,14 +1,14 @@
 #!/usr/bin/env bash
 # Reproduces the deep k-buffer's shipped models from the project's procedural scenes only (no real
 # scene is seen in training; ../shared/scenes/ never is), with `mfr dataset` and `mfr train`, one
-# model per compositing rule (issue 14 sec. 3):
+# model per compositing rule (docs/DEEP_KBUFFER.md):
 #
 #   scripts/train-model.sh [OPTIONS] [MFR_BINARY] [WORK_DIR]   (defaults: build/mfr,
 #                                                               build/dkb-training)
 #
 #   models/dkb-default.mfrnn        dkb / dkb-fill, hybrid-compositing optimal targets (the default)
 #   models/dkb-kbuffer.mfrnn        dkb / dkb-fill, kbuffer-compositing targets (--composite kbuffer)
-#   models/dkb-curve.mfrnn          dkb-curve (issue 14 sec. 4): the error curves, hybrid
+#   models/dkb-curve.mfrnn          dkb-curve: the error curves, hybrid
 #   models/dkb-curve-kbuffer.mfrnn  dkb-curve, kbuffer
 #
 # each with its training log (.log.csv) and loss curve (.loss.png) beside it. Deterministic: the
@@ -16,7 +16,7 @@
 # each dataset's file name and FNV-1a 64 hash, not its path). Rebuild afterwards to compile the new
 # models into the library.
 #
-# The corpus (issue 14 sec. 2): every procedural family, the training corpus's (glassware, foliage,
+# The corpus: every procedural family, the training corpus's (glassware, foliage,
 # particles, hair, panels, city) with two parameter sets each, and the older layers, hairball,
 # smoke and spheres; the bottles family is held out for validation (--validation-family: a split
 # by family). Each rule's data come from two passes over the scenes with different resolutions,
