@@ -1,5 +1,5 @@
 // Shared geometry shader of the geometry passes: the CPU engine's primitive set-up, operation for
-// operation (src/raster/raster_frame.cpp): trivial reject and Sutherland-Hodgman clipping against
+// operation (src/cpu/raster_frame.cpp): trivial reject and Sutherland-Hodgman clipping against
 // near, far and the x/y guard band in clip space (float), then per fan triangle the window
 // coordinates in double, snapped to 1/256 pixel with llround, the orientation made positive, the
 // top-left flags and the bounds test. Each fan triangle is emitted at its snapped position (w = 1,

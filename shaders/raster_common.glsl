@@ -1,6 +1,6 @@
 // Shared part of the fragment shaders of the geometry passes (prepended to count.frag,
 // capture_abuffer.frag and capture_kbuffer.frag): the CPU engine's exact coverage test,
-// barycentrics, alpha test, depth and shading (include/mfr/raster/raster_frame_impl.hpp), operation
+// barycentrics, alpha test, depth and shading (include/mfr/cpu/raster_frame_impl.hpp), operation
 // for operation and `precise`, so that both engines produce the same fragments bit for bit.
 flat in ivec3 gX;
 flat in ivec3 gY;

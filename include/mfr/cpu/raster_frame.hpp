@@ -80,7 +80,7 @@ struct ShadingInputs {
   const ColorTables* tables = nullptr;
 };
 
-/// One view of a scene, set up for the tile passes: what render() (method/render.hpp) and
+/// One view of a scene, set up for the tile passes: what render() (cpu/render.hpp) and
 /// runComparison (compare/compare.hpp) take.
 ///
 /// Lifetime: a frame refers to the scene's textures: the Scene must outlive the RasterFrame built

@@ -44,7 +44,7 @@ Result<Model> decodeModel(const uint8_t* bytes, size_t size, const std::string& 
 Result<void> writeModel(const std::string& path, const Model& model);
 /// Reads and decodes a model file; errors as decodeModel's, or the file cannot be opened / read /
 /// is a directory. Whether the deep k-buffer can use the model is checkDkbModel's question
-/// (method/deep_importance.hpp).
+/// (method/dkb_model.hpp).
 Result<Model> readModel(const std::string& path);
 
 }  // namespace mfr::learn
