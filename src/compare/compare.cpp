@@ -115,10 +115,10 @@ Result<void> checkComparisonFits(const Engine& engine, int width, int height,
   return {};
 }
 
-Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
-                                    const CompareOptions& options) {
-  if (options.methods.empty()) return makeError("--methods: the method list is empty");
-  if (options.budgets.empty()) return makeError("--budget: no budget given");
+namespace {
+
+// The presets named in --methods with the comparison's compositing rule, seed and model.
+Result<std::vector<MethodDesc>> comparedMethods(const CompareOptions& options) {
   std::vector<MethodDesc> methods;
   std::set<std::string> seenMethods;
   for (const std::string& name : options.methods) {
@@ -134,26 +134,143 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
     m.model = options.model;
     methods.push_back(m);
   }
-  bool anyRelative = false;
-  for (size_t i = 0; i < options.budgets.size(); ++i) {
-    const BudgetSpec& b = options.budgets[i];
+  return methods;
+}
+
+// Every budget above zero and listed once.
+Result<void> checkBudgetList(const std::vector<BudgetSpec>& budgets) {
+  for (size_t i = 0; i < budgets.size(); ++i) {
+    const BudgetSpec& b = budgets[i];
     if (b.bytes && *b.bytes == 0) return makeError("budget 0 B: must be at least 1 byte");
     if (!b.bytes && !(b.percent > 0.0 && std::isfinite(b.percent)))
       return makeError("budget " + b.label + ": a share must be above 0%");
     for (size_t j = 0; j < i; ++j)
-      if (options.budgets[j] == b) return makeError("budget " + b.label + ": listed twice");
-    anyRelative = anyRelative || b.isRelative();
+      if (budgets[j] == b) return makeError("budget " + b.label + ": listed twice");
   }
+  return {};
+}
+
+// Counts the steps (the ground truth, then one per run) for options.progress.
+struct CompareProgress {
+  const CompareOptions& options;
+  int total;
+  int step = 0;
+
+  void report(const std::string& stage) const {
+    if (options.progress) options.progress(stage, step, total);
+  }
+};
+
+// ground truth: the exact A-buffer, every fragment, sorted and composited
+Result<void> renderGroundTruth(Engine& engine, const PreparedView& view,
+                               const RenderOptions& renderOptions, CompareResult& result) {
+  auto abuffer = methodPreset("abuffer");
+  if (!abuffer) return abuffer.error();
+  auto truth = engine.render(view, abuffer.value(), renderOptions);
+  if (!truth) return makeError("ground truth (abuffer): " + truth.error().message);
+  CompareRun& gt = result.groundTruth;
+  gt.method = "abuffer";
+  gt.stats = std::move(truth->stats);
+  gt.image = encodeSrgb(truth->image);
+  gt.imageFile = "ground_truth.png";
+  gt.metrics.psnrLinear = gt.metrics.psnrSrgb = psnrFromMse(0.0);
+  result.depthComplexityMap =
+      colourMap(std::vector<float>(truth->depthComplexity.begin(), truth->depthComplexity.end()),
+                view.width(), view.height(), std::max(1.0f, maxOf(truth->depthComplexity)), "n(p)");
+  result.depthComplexityFile = "ground_truth_depth_complexity.png";
+  return {};
+}
+
+// What every run reads besides its method and budget.
+struct RunSetting {
+  Engine& engine;
+  const PreparedView& view;
+  const CompareOptions& options;
+  const RenderOptions& renderOptions;
+  const FrameCounts& counts;
+  const std::string& sizeName;
+  const Image8& truth;  // the ground truth, sRGB8
+};
+
+// One method at one budget: resolve the budget, render, measure against the ground truth and name
+// the files. A budget or render failure is the run's error (an empty k map comes back); a failure
+// to measure is the comparison's.
+Result<std::vector<uint32_t>> compareOneRun(const RunSetting& s, const BudgetSpec& spec,
+                                            const std::string& budgetLabel,
+                                            const MethodDesc& method,
+                                            const CompareProgress& progress, CompareRun& run) {
+  run.method = method.name;
+  run.compositing = method.compositing;
+  const MemoryModel memory =
+      MemoryModel::of(method, s.options.capture == CaptureMode::FragmentParallel);
+  auto budget = resolveBudget(spec, method, memory, s.counts, s.sizeName);
+  if (!budget) {
+    run.error = budget.error().message;
+    return std::vector<uint32_t>{};
+  }
+  run.budgetBytes = budget.value();
+  run.budgetSlots = memory.fragmentSlots(budget.value(), s.view.pixelCount());
+  progress.report("rendering " + method.name + " at " + budgetLabel);
+  RenderOptions ro = s.renderOptions;
+  ro.budgetBytes = budget.value();
+  auto out = s.engine.render(s.view, method, ro);
+  if (!out) {
+    run.error = out.error().message;
+    return std::vector<uint32_t>{};
+  }
+  run.stats = std::move(out->stats);
+  run.image = encodeSrgb(out->image);
+  progress.report("measuring " + method.name + " at " + budgetLabel);
+  auto errors = compareImages(s.truth, run.image);
+  if (!errors) return errors.error();
+  auto flip = computeFlip(s.truth, run.image, s.options.flipPixelsPerDegree);
+  if (!flip) return flip.error();
+  run.metrics.mseLinear = errors->mseLinear;
+  run.metrics.mseSrgb = errors->mseSrgb;
+  run.metrics.psnrLinear = errors->psnrLinear;
+  run.metrics.psnrSrgb = errors->psnrSrgb;
+  run.metrics.flipMean = flip->mean;
+  run.flipMap = flipErrorImage(*flip);
+  const std::string stem = fileStem(method.name) + "_" + spec.fileLabel();
+  run.imageFile = stem + ".png";
+  run.flipFile = stem + "_flip.png";
+  run.kMapFile = stem + "_kmap.png";
+  if (!out->importance.importance.empty()) {
+    run.importanceMap = colourMap(out->importance.importance, s.view.width(), s.view.height(),
+                                  maxOf(out->importance.importance), "I(p)");
+    run.importanceFile = stem + "_importance.png";
+  }
+  return std::move(out->kMap);
+}
+
+// the k maps of the successful runs, colour-mapped on one shared scale
+void colourKMaps(const std::vector<std::vector<uint32_t>>& kMaps, int w, int h,
+                 CompareResult& result) {
+  size_t index = 0;
+  for (CompareBudget& cb : result.budgets)
+    for (CompareRun& run : cb.runs) {
+      const std::vector<uint32_t>& k = kMaps[index++];
+      if (!run.ok()) continue;
+      run.kMap = colourMap(std::vector<float>(k.begin(), k.end()), w, h, result.kMapScale, "k(p)");
+    }
+}
+
+}  // namespace
+
+Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
+                                    const CompareOptions& options) {
+  if (options.methods.empty()) return makeError("--methods: the method list is empty");
+  if (options.budgets.empty()) return makeError("--budget: no budget given");
+  auto methods = comparedMethods(options);
+  if (!methods) return methods.error();
+  MFR_TRY(checkBudgetList(options.budgets));
+  const bool anyRelative = std::any_of(options.budgets.begin(), options.budgets.end(),
+                                       [](const BudgetSpec& b) { return b.isRelative(); });
   if (!(options.flipPixelsPerDegree > 0.0 && std::isfinite(options.flipPixelsPerDegree)))
     return makeError("FLIP pixels per degree: must be finite and positive");
 
   const int w = view.width(), h = view.height();
-  const uint64_t pixels = view.pixelCount();
-  const int totalSteps = 1 + static_cast<int>(methods.size() * options.budgets.size());
-  int step = 0;
-  const auto progress = [&](const std::string& stage) {
-    if (options.progress) options.progress(stage, step, totalSteps);
-  };
+  CompareProgress progress{options, 1 + static_cast<int>(methods->size() * options.budgets.size())};
 
   CompareResult result;
   result.scene = options.scene;
@@ -171,33 +288,20 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   if (!options.previousNearestCosine.empty())
     renderOptions.previousNearestCosine = &options.previousNearestCosine;
 
-  // ground truth: the exact A-buffer, every fragment, sorted and composited
-  progress("rendering the ground truth (abuffer)");
-  auto abuffer = methodPreset("abuffer");
-  if (!abuffer) return abuffer.error();
-  auto truth = engine.render(view, abuffer.value(), renderOptions);
-  if (!truth) return makeError("ground truth (abuffer): " + truth.error().message);
-  ++step;
-  CompareRun& gt = result.groundTruth;
-  gt.method = "abuffer";
-  gt.stats = std::move(truth->stats);
-  gt.image = encodeSrgb(truth->image);
-  gt.imageFile = "ground_truth.png";
-  gt.metrics.psnrLinear = gt.metrics.psnrSrgb = psnrFromMse(0.0);
-  result.depthComplexityMap =
-      colourMap(std::vector<float>(truth->depthComplexity.begin(), truth->depthComplexity.end()), w,
-                h, std::max(1.0f, maxOf(truth->depthComplexity)), "n(p)");
-  result.depthComplexityFile = "ground_truth_depth_complexity.png";
-  truth = Error{};  // release the frame-sized buffers
+  progress.report("rendering the ground truth (abuffer)");
+  MFR_TRY(renderGroundTruth(engine, view, renderOptions, result));
+  ++progress.step;
   // relative budgets: the A-buffer's node bytes of this frame (a count pass)
   FrameCounts counts;
-  counts.pixels = pixels;
+  counts.pixels = view.pixelCount();
   if (anyRelative) {
     auto n = engine.countFragments(view);
     if (!n) return makeError("count pass: " + n.error().message);
     counts = FrameCounts::of(n.value());
   }
   const std::string sizeName = std::to_string(w) + "x" + std::to_string(h);
+  const RunSetting setting{
+      engine, view, options, renderOptions, counts, sizeName, result.groundTruth.image};
 
   std::vector<std::vector<uint32_t>> kMaps;  // per run, colour-mapped at the end (shared scale)
   float kScale = 1.0f;
@@ -206,67 +310,18 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
     cb.budgetBytes = spec.bytes ? *spec.bytes : relativeNodeBytes(spec.percent, counts);
     if (spec.isRelative()) cb.percent = spec.percent;
     cb.label = spec.label;
-    for (const MethodDesc& method : methods) {
+    for (const MethodDesc& method : *methods) {
       CompareRun& run = cb.runs.emplace_back();
-      run.method = method.name;
-      run.compositing = method.compositing;
-      const MemoryModel memory =
-          MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
-      auto budget = resolveBudget(spec, method, memory, counts, sizeName);
-      if (!budget) {
-        run.error = budget.error().message;
-        kMaps.emplace_back();
-        ++step;
-        continue;
-      }
-      run.budgetBytes = budget.value();
-      run.budgetSlots = memory.fragmentSlots(budget.value(), pixels);
-      progress("rendering " + method.name + " at " + cb.label);
-      RenderOptions ro = renderOptions;
-      ro.budgetBytes = budget.value();
-      auto out = engine.render(view, method, ro);
-      if (!out) {
-        run.error = out.error().message;
-        kMaps.emplace_back();
-        ++step;
-        continue;
-      }
-      run.stats = std::move(out->stats);
-      run.image = encodeSrgb(out->image);
-      progress("measuring " + method.name + " at " + cb.label);
-      auto errors = compareImages(gt.image, run.image);
-      if (!errors) return errors.error();
-      auto flip = computeFlip(gt.image, run.image, options.flipPixelsPerDegree);
-      if (!flip) return flip.error();
-      run.metrics.mseLinear = errors->mseLinear;
-      run.metrics.mseSrgb = errors->mseSrgb;
-      run.metrics.psnrLinear = errors->psnrLinear;
-      run.metrics.psnrSrgb = errors->psnrSrgb;
-      run.metrics.flipMean = flip->mean;
-      run.flipMap = flipErrorImage(*flip);
-      const std::string stem = fileStem(method.name) + "_" + spec.fileLabel();
-      run.imageFile = stem + ".png";
-      run.flipFile = stem + "_flip.png";
-      run.kMapFile = stem + "_kmap.png";
-      if (!out->importance.importance.empty()) {
-        run.importanceMap =
-            colourMap(out->importance.importance, w, h, maxOf(out->importance.importance), "I(p)");
-        run.importanceFile = stem + "_importance.png";
-      }
-      kScale = std::max(kScale, static_cast<float>(run.stats.kMax));
-      kMaps.push_back(std::move(out->kMap));
-      ++step;
+      auto kMap = compareOneRun(setting, spec, cb.label, method, progress, run);
+      if (!kMap) return kMap.error();
+      if (run.ok()) kScale = std::max(kScale, static_cast<float>(run.stats.kMax));
+      kMaps.push_back(std::move(*kMap));
+      ++progress.step;
     }
   }
   result.kMapScale = kScale;
-  size_t index = 0;
-  for (CompareBudget& cb : result.budgets)
-    for (CompareRun& run : cb.runs) {
-      const std::vector<uint32_t>& k = kMaps[index++];
-      if (!run.ok()) continue;
-      run.kMap = colourMap(std::vector<float>(k.begin(), k.end()), w, h, kScale, "k(p)");
-    }
-  if (options.progress) options.progress("done", totalSteps, totalSteps);
+  colourKMaps(kMaps, w, h, result);
+  if (options.progress) options.progress("done", progress.total, progress.total);
   return result;
 }
 

@@ -547,28 +547,22 @@ std::string imageGrid(const CompareResult& r, const CompareBudget& cb) {
   return g;
 }
 
-}  // namespace
-
-std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
-  const CompareRun& gt = r.groundTruth;
-  const RenderStats& gs = gt.stats;
+// the method names, in the order of the first budget's runs
+std::vector<std::string> methodNamesOf(const CompareResult& r) {
   std::vector<std::string> methodNames;
   if (!r.budgets.empty())
     for (const CompareRun& run : r.budgets[0].runs) methodNames.push_back(run.method);
+  return methodNames;
+}
+
+// the document head and the page title with its subtitle
+std::string reportHead(const CompareResult& r, const std::string& size) {
   std::string budgetsText;
   for (const CompareBudget& cb : r.budgets) {
     if (!budgetsText.empty()) budgetsText += ", ";
     budgetsText += cb.percent ? escape(cb.label) : escape(formatBytes(cb.budgetBytes));
   }
-  std::string methodsText;
-  for (const std::string& m : methodNames) {
-    if (!methodsText.empty()) methodsText += ", ";
-    methodsText += "<code>" + escape(m) + "</code>";
-  }
-  const std::string size = format("%d&#8201;&times;&#8201;%d", r.width, r.height);
-
   std::string h;
-  h.reserve(1 << 16);
   h += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n";
   h += "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n";
   h += "<link rel=\"icon\" href=\"data:,\">\n";
@@ -582,8 +576,19 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
        (r.compositing ? escape(toString(*r.compositing)) + " compositing"
                       : std::string("each method's own compositing")) +
        "</p>\n";
+  return h;
+}
 
-  // set-up
+// 1 Set-up: the scene, the budgets, the methods, the ground truth and the command
+std::string setupSection(const CompareResult& r, const ReportInfo& info,
+                         const std::vector<std::string>& methodNames, const std::string& size) {
+  const RenderStats& gs = r.groundTruth.stats;
+  std::string methodsText;
+  for (const std::string& m : methodNames) {
+    if (!methodsText.empty()) methodsText += ", ";
+    methodsText += "<code>" + escape(m) + "</code>";
+  }
+  std::string h;
   h += "<h2 id=\"setup\">1&ensp;Set-up</h2>\n<table class=\"meta\">\n";
   h += "<tr><th>Scene</th><td><code>" + escape(r.scene) + "</code></td></tr>\n";
   h += "<tr><th>Image</th><td>" + size + " = " +
@@ -628,8 +633,12 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
   h += "<tr><th>Data</th><td><a href=\"results.json\">results.json</a> &middot; "
        "<a href=\"results.csv\">results.csv</a></td></tr>\n";
   h += "</table>\n";
+  return h;
+}
 
-  // results tables
+// 2 Results: one table per budget
+std::string resultsSection(const CompareResult& r) {
+  std::string h;
   h += "<h2 id=\"results\">2&ensp;Results</h2>\n";
   h += "<p class=\"caption\">Error of each method against the ground truth (lower MSE and FLIP, "
        "higher PSNR are better; the best value of each budget is in bold). MSE and PSNR are over "
@@ -646,101 +655,114 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
     h += "<h3>M = " + budgetTitle(cb) + "</h3>\n";
     h += resultsTable(r, cb) + "\n";
   }
+  return h;
+}
 
-  // plots
-  int section = 3;
-  if (r.budgets.size() > 1) {
-    std::vector<uint64_t> budgets;
-    std::vector<std::string> labels;
-    std::vector<size_t> order(r.budgets.size());
-    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-      return r.budgets[a].budgetBytes < r.budgets[b].budgetBytes;
-    });
+// every method's error against the bytes per pixel it was charged (bytes_used / pixels):
+// methods that do not spend the whole budget (wboit, mboit, vkb) sit where they really are; byBytes
+// holds the mean FLIP over the budgets in `order`. Empty when no run succeeded.
+std::string bytesPerPixelFigure(const CompareResult& r, const std::vector<size_t>& order,
+                                std::vector<Series> byBytes) {
+  std::string h;
+  const double pixels = static_cast<double>(r.width) * static_cast<double>(r.height);
+  double lo = INFINITY, hi = 0.0;
+  for (size_t m = 0; m < byBytes.size(); ++m) {
+    size_t j = 0;
     for (size_t i : order) {
-      budgets.push_back(r.budgets[i].budgetBytes);
-      labels.push_back(r.budgets[i].label);
+      const CompareRun& run = r.budgets[i].runs[m];
+      if (!run.ok()) continue;
+      const double bpp = static_cast<double>(run.stats.bytesUsed) / pixels;
+      byBytes[m].points[j++].first = bpp;
+      lo = std::min(lo, bpp);
+      hi = std::max(hi, bpp);
     }
-    const auto seriesOf = [&](auto value) {
-      std::vector<Series> out;
-      for (size_t m = 0; m < methodNames.size(); ++m) {
-        Series s;
-        s.name = methodNames[m];
-        s.colour = kPalette[m % (sizeof kPalette / sizeof kPalette[0])];
-        s.marker = static_cast<int>(m);
-        for (size_t i : order) {
-          const CompareRun& run = r.budgets[i].runs[m];
-          if (run.ok())
-            s.points.emplace_back(static_cast<double>(r.budgets[i].budgetBytes), value(run));
-        }
-        out.push_back(std::move(s));
+    std::sort(byBytes[m].points.begin(), byBytes[m].points.end());
+  }
+  if (std::isfinite(lo)) {
+    std::vector<uint64_t> ticks;
+    std::vector<std::string> tickLabels;
+    // ticks: the data's range (whole bytes) and nice values between
+    const double a = std::max(1.0, std::floor(lo)), b = std::max(std::ceil(hi), a + 1.0);
+    ticks.push_back(static_cast<uint64_t>(a));
+    tickLabels.push_back(format("%g B", a));
+    for (double t : niceTicks(a, b, 4))
+      if (t > a + 0.5 && t < b - 0.5) {
+        ticks.push_back(static_cast<uint64_t>(std::llround(t)));
+        tickLabels.push_back(format("%g B", std::round(t)));
       }
-      return out;
-    };
-    h += format("<h2 id=\"plots\">%d&ensp;Error vs memory budget</h2>\n", section++);
-    h += "<div class=\"plots\">\n<figure>" +
-         svgPlot("Mean FLIP vs budget", "mean FLIP", false, true,
-                 seriesOf([](const CompareRun& run) { return run.metrics.flipMean; }), budgets,
-                 labels) +
-         "<figcaption>Mean LDR-FLIP error against the exact A-buffer (lower is better). "
-         "Missing points: the method failed at that budget.</figcaption></figure>\n";
+    ticks.push_back(static_cast<uint64_t>(b));
+    tickLabels.push_back(format("%g B", b));
     h += "<figure>" +
-         svgPlot("MSE (linear) vs budget", "MSE, linear", true, true,
-                 seriesOf([](const CompareRun& run) { return run.metrics.mseLinear; }), budgets,
-                 labels) +
-         "<figcaption>Mean squared error on linear-light values (lower is better).</figcaption>"
+         svgPlot("Mean FLIP vs bytes per pixel", "mean FLIP", false, true, byBytes, ticks,
+                 tickLabels, "bytes per pixel charged (bytes_used / pixels)") +
+         "<figcaption>Every method's error against the memory it was charged per pixel, "
+         "across all budgets: which method buys the most quality per byte.</figcaption>"
          "</figure>\n";
-    h += "<figure>" +
-         svgPlot("Fragments lost vs budget", "fragments lost, %", false, false,
-                 seriesOf([](const CompareRun& run) { return run.stats.lostPercent(); }), budgets,
-                 labels) +
-         "<figcaption>Share of the generated fragments not in the final per-pixel "
-         "cores.</figcaption>"
-         "</figure>\n";
-    // every method's error against the bytes per pixel it was charged (bytes_used / pixels):
-    // methods that do not spend the whole budget (wboit, mboit, vkb) sit where they really are
-    const double pixels = static_cast<double>(r.width) * static_cast<double>(r.height);
-    double lo = INFINITY, hi = 0.0;
-    std::vector<Series> byBytes =
-        seriesOf([](const CompareRun& run) { return run.metrics.flipMean; });
-    for (size_t m = 0; m < byBytes.size(); ++m) {
-      size_t j = 0;
+  }
+  return h;
+}
+
+// 3 Error vs memory budget: the plots over the budgets, smallest first (two budgets or more)
+std::string budgetPlots(const CompareResult& r, const std::vector<std::string>& methodNames,
+                        int section) {
+  std::string h;
+  std::vector<uint64_t> budgets;
+  std::vector<std::string> labels;
+  std::vector<size_t> order(r.budgets.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return r.budgets[a].budgetBytes < r.budgets[b].budgetBytes;
+  });
+  for (size_t i : order) {
+    budgets.push_back(r.budgets[i].budgetBytes);
+    labels.push_back(r.budgets[i].label);
+  }
+  const auto seriesOf = [&](auto value) {
+    std::vector<Series> out;
+    for (size_t m = 0; m < methodNames.size(); ++m) {
+      Series s;
+      s.name = methodNames[m];
+      s.colour = kPalette[m % (sizeof kPalette / sizeof kPalette[0])];
+      s.marker = static_cast<int>(m);
       for (size_t i : order) {
         const CompareRun& run = r.budgets[i].runs[m];
-        if (!run.ok()) continue;
-        const double bpp = static_cast<double>(run.stats.bytesUsed) / pixels;
-        byBytes[m].points[j++].first = bpp;
-        lo = std::min(lo, bpp);
-        hi = std::max(hi, bpp);
+        if (run.ok())
+          s.points.emplace_back(static_cast<double>(r.budgets[i].budgetBytes), value(run));
       }
-      std::sort(byBytes[m].points.begin(), byBytes[m].points.end());
+      out.push_back(std::move(s));
     }
-    if (std::isfinite(lo)) {
-      std::vector<uint64_t> ticks;
-      std::vector<std::string> tickLabels;
-      // ticks: the data's range (whole bytes) and nice values between
-      const double a = std::max(1.0, std::floor(lo)), b = std::max(std::ceil(hi), a + 1.0);
-      ticks.push_back(static_cast<uint64_t>(a));
-      tickLabels.push_back(format("%g B", a));
-      for (double t : niceTicks(a, b, 4))
-        if (t > a + 0.5 && t < b - 0.5) {
-          ticks.push_back(static_cast<uint64_t>(std::llround(t)));
-          tickLabels.push_back(format("%g B", std::round(t)));
-        }
-      ticks.push_back(static_cast<uint64_t>(b));
-      tickLabels.push_back(format("%g B", b));
-      h += "<figure>" +
-           svgPlot("Mean FLIP vs bytes per pixel", "mean FLIP", false, true, byBytes, ticks,
-                   tickLabels, "bytes per pixel charged (bytes_used / pixels)") +
-           "<figcaption>Every method's error against the memory it was charged per pixel, "
-           "across all budgets: which method buys the most quality per byte.</figcaption>"
-           "</figure>\n";
-    }
-    h += "</div>\n";
-  }
+    return out;
+  };
+  h += format("<h2 id=\"plots\">%d&ensp;Error vs memory budget</h2>\n", section);
+  h += "<div class=\"plots\">\n<figure>" +
+       svgPlot("Mean FLIP vs budget", "mean FLIP", false, true,
+               seriesOf([](const CompareRun& run) { return run.metrics.flipMean; }), budgets,
+               labels) +
+       "<figcaption>Mean LDR-FLIP error against the exact A-buffer (lower is better). "
+       "Missing points: the method failed at that budget.</figcaption></figure>\n";
+  h += "<figure>" +
+       svgPlot("MSE (linear) vs budget", "MSE, linear", true, true,
+               seriesOf([](const CompareRun& run) { return run.metrics.mseLinear; }), budgets,
+               labels) +
+       "<figcaption>Mean squared error on linear-light values (lower is better).</figcaption>"
+       "</figure>\n";
+  h += "<figure>" +
+       svgPlot("Fragments lost vs budget", "fragments lost, %", false, false,
+               seriesOf([](const CompareRun& run) { return run.stats.lostPercent(); }), budgets,
+               labels) +
+       "<figcaption>Share of the generated fragments not in the final per-pixel "
+       "cores.</figcaption>"
+       "</figure>\n";
+  h += bytesPerPixelFigure(r, order,
+                           seriesOf([](const CompareRun& run) { return run.metrics.flipMean; }));
+  h += "</div>\n";
+  return h;
+}
 
-  // images
-  h += format("<h2 id=\"images\">%d&ensp;Images</h2>\n", section++);
+// Images: per budget, the image, FLIP, k(p) and importance grid
+std::string imagesSection(const CompareResult& r, int section) {
+  std::string h;
+  h += format("<h2 id=\"images\">%d&ensp;Images</h2>\n", section);
   h += format(
       "<p class=\"caption\">Columns: the ground truth, then each method. Rows: the image "
       "(sRGB), the FLIP error map (magma, 0&ndash;1), the slots per pixel k(p) (viridis, "
@@ -753,9 +775,33 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
     h += "<h3>M = " + budgetTitle(cb) + "</h3>\n";
     h += imageGrid(r, cb) + "\n";
   }
+  return h;
+}
 
-  // notes
-  h += format("<h2 id=\"notes\">%d&ensp;Notes</h2>\n<dl class=\"notes\">\n", section++);
+// the legend of the methods in this run, from the preset table (method.hpp)
+std::string methodLegend(const CompareResult& r) {
+  std::string h;
+  std::vector<std::string> listed;
+  auto describe = [&](const std::string& method) {
+    const size_t plus = method.find("+occupancy");
+    const std::string base = plus == std::string::npos ? method : method.substr(0, plus);
+    if (std::find(listed.begin(), listed.end(), base) != listed.end()) return;
+    listed.push_back(base);
+    for (const PresetInfo& p : presetTable())
+      if (p.name == base)
+        h += "<dt><code>" + escape(p.name) + "</code></dt><dd>" + escape(p.summary) + " (" +
+             escape(p.paper) + ")</dd>";
+  };
+  describe(r.groundTruth.method);
+  for (const CompareBudget& cb : r.budgets)
+    for (const CompareRun& run : cb.runs) describe(run.method);
+  return h;
+}
+
+// Notes: memory, fragments and the methods' legend
+std::string notesSection(const CompareResult& r, int section) {
+  std::string h;
+  h += format("<h2 id=\"notes\">%d&ensp;Notes</h2>\n<dl class=\"notes\">\n", section);
   h += "<dt>Memory</dt><dd>Every store holds 8-byte fragment nodes (float32 depth + RGBA8) plus "
        "the method's per-pixel words over all pixels (counter 4&#8201;B; offset 4&#8201;B for "
        "count-pass methods; lock 4&#8201;B for the k<sup>+</sup>-buffer family; hybrid tail "
@@ -765,27 +811,28 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
   h += "<dt>Fragments</dt><dd>Captured: fragments in the final per-pixel cores. Lost: generated "
        "minus captured (with hybrid compositing they still contribute to the order-independent "
        "tail).</dd>\n";
-  // the legend of the methods in this run, from the preset table (method.hpp)
   h += "<dt>Methods</dt><dd><dl class=\"legend\">";
-  {
-    std::vector<std::string> listed;
-    auto describe = [&](const std::string& method) {
-      const size_t plus = method.find("+occupancy");
-      const std::string base = plus == std::string::npos ? method : method.substr(0, plus);
-      if (std::find(listed.begin(), listed.end(), base) != listed.end()) return;
-      listed.push_back(base);
-      for (const PresetInfo& p : presetTable())
-        if (p.name == base)
-          h += "<dt><code>" + escape(p.name) + "</code></dt><dd>" + escape(p.summary) + " (" +
-               escape(p.paper) + ")</dd>";
-    };
-    describe(r.groundTruth.method);
-    for (const CompareBudget& cb : r.budgets)
-      for (const CompareRun& run : cb.runs) describe(run.method);
-  }
+  h += methodLegend(r);
   h += "</dl><code>+occupancy</code> adds occupancy-map culling (Vasilakis &amp; Papaioannou). "
        "Each run names the compositing rule it used.</dd>\n";
   h += "</dl>\n";
+  return h;
+}
+
+}  // namespace
+
+std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
+  const std::vector<std::string> methodNames = methodNamesOf(r);
+  const std::string size = format("%d&#8201;&times;&#8201;%d", r.width, r.height);
+  std::string h;
+  h.reserve(1 << 16);
+  h += reportHead(r, size);
+  h += setupSection(r, info, methodNames, size);
+  h += resultsSection(r);
+  int section = 3;
+  if (r.budgets.size() > 1) h += budgetPlots(r, methodNames, section++);
+  h += imagesSection(r, section++);
+  h += notesSection(r, section);
   h += "<footer>Generated by " + escape(info.mfrVersion.empty() ? "mfr" : info.mfrVersion) +
        " <code>compare</code>. All images are files next to this page.</footer>\n";
   h += "</main>\n</body>\n</html>\n";

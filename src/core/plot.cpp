@@ -123,20 +123,17 @@ void drawTextUp(Image8& img, int x, int cy, const std::string& text, int s, glm:
         putPixel(img, x + ty, cy + tmp.width / 2 - tx, c);
 }
 
-}  // namespace
+// A point is drawable when both coordinates are finite and, on a log axis, y is positive.
+bool drawable(double x, double y, bool logY) {
+  return std::isfinite(x) && std::isfinite(y) && (!logY || y > 0.0);
+}
 
-Result<Image8> plotLines(const std::vector<PlotSeries>& series, const PlotOptions& options) {
-  const int W = options.width, H = options.height;
-  if (W < 100 || H < 100 || W > 8192 || H > 8192) {
-    std::string m = "plot size ";
-    m += std::to_string(W) + "x" + std::to_string(H) + " is outside [100, 8192]";
-    return makeError(m);
-  }
-  // data ranges over the drawable points
-  const bool logY = options.logY;
-  auto valid = [&](double x, double y) {
-    return std::isfinite(x) && std::isfinite(y) && (!logY || y > 0.0);
-  };
+// The axes over the drawable points' range (y in log10 on a log axis), or why there is none.
+struct Axes {
+  Axis x, y;
+};
+
+Result<Axes> dataAxes(const std::vector<PlotSeries>& series, bool logY) {
   double xMin = INFINITY, xMax = -INFINITY, yMin = INFINITY, yMax = -INFINITY;
   bool anyFinite = false;
   for (const PlotSeries& s : series) {
@@ -148,7 +145,7 @@ Result<Image8> plotLines(const std::vector<PlotSeries>& series, const PlotOption
     }
     for (size_t i = 0; i < s.x.size(); ++i) {
       anyFinite = anyFinite || (std::isfinite(s.x[i]) && std::isfinite(s.y[i]));
-      if (!valid(s.x[i], s.y[i])) continue;
+      if (!drawable(s.x[i], s.y[i], logY)) continue;
       const double y = logY ? std::log10(s.y[i]) : s.y[i];
       xMin = std::min(xMin, s.x[i]);
       xMax = std::max(xMax, s.x[i]);
@@ -160,81 +157,116 @@ Result<Image8> plotLines(const std::vector<PlotSeries>& series, const PlotOption
   if (xMin > xMax) return makeError("log-scale plot has no positive y value");
   if (!std::isfinite(xMax - xMin) || !std::isfinite(yMax - yMin))
     return makeError("plot data range is too large");
-  const Axis ax = linearAxis(xMin, xMax), ay = logY ? logAxis(yMin, yMax) : linearAxis(yMin, yMax);
+  return Axes{linearAxis(xMin, xMax), logY ? logAxis(yMin, yMax) : linearAxis(yMin, yMax)};
+}
 
-  // layout
+// Where everything goes: the text scale, the spacings and the plot area inside the margins.
+struct Layout {
+  int W, H;
+  int s, charH, pad, tick, gap;
+  Axes axes;
+  bool logY;
+  Rect plot;
+
+  double px(double v) const {
+    return plot.x0 + (v - axes.x.lo) / (axes.x.hi - axes.x.lo) * (plot.x1 - plot.x0);
+  }
+  double py(double v) const {
+    return plot.y1 - (v - axes.y.lo) / (axes.y.hi - axes.y.lo) * (plot.y1 - plot.y0);
+  }
+  // a data point in pixel coordinates
+  glm::dvec2 at(const PlotSeries& se, size_t k) const {
+    return glm::dvec2(px(se.x[k]), py(logY ? std::log10(se.y[k]) : se.y[k]));
+  }
+};
+
+Result<Layout> layOut(const PlotOptions& options, Axes axes) {
+  const int W = options.width, H = options.height;
   const int s = std::max(1, std::min(W / 400, H / 250));
   const int charH = 7 * s, pad = 8 * s, tick = 4 * s, gap = 3 * s;
   int yTickW = 0;
-  for (const std::string& l : ay.labels) yTickW = std::max(yTickW, textWidth(l, s));
+  for (const std::string& l : axes.y.labels) yTickW = std::max(yTickW, textWidth(l, s));
   const int top = pad + (options.title.empty() ? 0 : charH + pad);
   const int left = pad + (options.yLabel.empty() ? 0 : charH + pad) + yTickW + gap + tick;
   const int bottom = tick + gap + charH + (options.xLabel.empty() ? 0 : pad + charH) + pad;
-  const int right = pad + textWidth(ax.labels.back(), s) / 2;
+  const int right = pad + textWidth(axes.x.labels.back(), s) / 2;
   const Rect plot{left, top, W - 1 - right, H - 1 - bottom};
   if (plot.x1 - plot.x0 < 20 || plot.y1 - plot.y0 < 20)
     return makeError("plot size is too small for its labels");
-  auto px = [&](double v) { return plot.x0 + (v - ax.lo) / (ax.hi - ax.lo) * (plot.x1 - plot.x0); };
-  auto py = [&](double v) { return plot.y1 - (v - ay.lo) / (ay.hi - ay.lo) * (plot.y1 - plot.y0); };
+  return Layout{W, H, s, charH, pad, tick, gap, std::move(axes), options.logY, plot};
+}
 
-  Image8 img;
-  img.width = W;
-  img.height = H;
-  img.rgba.assign(static_cast<size_t>(W) * H * 4, 255);
-  // grid, frame, ticks and their labels
-  for (double t : ax.ticks) {
-    const int x = static_cast<int>(std::lround(px(t)));
-    fill(img, {x, plot.y0, x, plot.y1 + tick}, kGrid);
-    fill(img, {x, plot.y1, x, plot.y1 + tick}, kInk);
+// grid lines, the frame and the tick marks
+void drawGrid(Image8& img, const Layout& L) {
+  const Rect& plot = L.plot;
+  for (double t : L.axes.x.ticks) {
+    const int x = static_cast<int>(std::lround(L.px(t)));
+    fill(img, {x, plot.y0, x, plot.y1 + L.tick}, kGrid);
+    fill(img, {x, plot.y1, x, plot.y1 + L.tick}, kInk);
   }
-  for (double t : ay.ticks) {
-    const int y = static_cast<int>(std::lround(py(t)));
-    fill(img, {plot.x0 - tick, y, plot.x1, y}, kGrid);
-    fill(img, {plot.x0 - tick, y, plot.x0, y}, kInk);
+  for (double t : L.axes.y.ticks) {
+    const int y = static_cast<int>(std::lround(L.py(t)));
+    fill(img, {plot.x0 - L.tick, y, plot.x1, y}, kGrid);
+    fill(img, {plot.x0 - L.tick, y, plot.x0, y}, kInk);
   }
-  for (double t : ay.minor) {
-    const int y = static_cast<int>(std::lround(py(t)));
-    fill(img, {plot.x0 - tick / 2, y, plot.x0, y}, kInk);
+  for (double t : L.axes.y.minor) {
+    const int y = static_cast<int>(std::lround(L.py(t)));
+    fill(img, {plot.x0 - L.tick / 2, y, plot.x0, y}, kInk);
   }
   fill(img, {plot.x0, plot.y0, plot.x1, plot.y0}, kFrame);
   fill(img, {plot.x0, plot.y1, plot.x1, plot.y1}, kInk);
   fill(img, {plot.x0, plot.y0, plot.x0, plot.y1}, kInk);
   fill(img, {plot.x1, plot.y0, plot.x1, plot.y1}, kFrame);
-  // tick labels, every n-th one when they would collide
+}
+
+// tick labels, every n-th one when they would collide
+void drawTickLabels(Image8& img, const Layout& L) {
+  const Axis &ax = L.axes.x, &ay = L.axes.y;
+  const int s = L.s, gap = L.gap;
   auto stride = [](double spacing, int size) {
     return std::max(1, static_cast<int>(std::ceil(size / std::max(1.0, std::fabs(spacing)))));
   };
   int xLabelW = 0;
   for (const std::string& l : ax.labels) xLabelW = std::max(xLabelW, textWidth(l, s));
-  const int xEvery = stride(px(ax.ticks[1]) - px(ax.ticks[0]), xLabelW + 2 * gap);
+  const int xEvery = stride(L.px(ax.ticks[1]) - L.px(ax.ticks[0]), xLabelW + 2 * gap);
   const int yEvery =
-      ay.ticks.size() < 2 ? 1 : stride(py(ay.ticks[1]) - py(ay.ticks[0]), charH + gap);
+      ay.ticks.size() < 2 ? 1 : stride(L.py(ay.ticks[1]) - L.py(ay.ticks[0]), L.charH + gap);
   for (size_t i = 0; i < ax.ticks.size(); i += xEvery) {
     const int w = textWidth(ax.labels[i], s);
-    const int x = std::clamp(static_cast<int>(std::lround(px(ax.ticks[i]))) - w / 2, 0, W - w);
-    drawText(img, x, plot.y1 + tick + gap, ax.labels[i], s, kInk);
+    const int x = std::clamp(static_cast<int>(std::lround(L.px(ax.ticks[i]))) - w / 2, 0, L.W - w);
+    drawText(img, x, L.plot.y1 + L.tick + gap, ax.labels[i], s, kInk);
   }
   for (size_t i = 0; i < ay.ticks.size(); i += yEvery) {
-    const int y = static_cast<int>(std::lround(py(ay.ticks[i])));
-    const int x = plot.x0 - tick - gap - textWidth(ay.labels[i], s);
-    drawText(img, x, y - charH / 2, ay.labels[i], s, kInk);
+    const int y = static_cast<int>(std::lround(L.py(ay.ticks[i])));
+    const int x = L.plot.x0 - L.tick - gap - textWidth(ay.labels[i], s);
+    drawText(img, x, y - L.charH / 2, ay.labels[i], s, kInk);
   }
-  // series: runs of drawable points become polylines, lone points dots
-  const double r = 0.5 * s + 0.5;
+}
+
+// the half-width of a series' line
+double lineRadius(const Layout& L) {
+  return 0.5 * L.s + 0.5;
+}
+
+// series: runs of drawable points become polylines, lone points dots
+void drawSeries(Image8& img, const Layout& L, const std::vector<PlotSeries>& series) {
+  const double r = lineRadius(L);
   for (const PlotSeries& se : series) {
     const glm::vec3 c = glm::clamp(se.color, glm::vec3(0.0f), glm::vec3(1.0f));
     for (size_t i = 0; i < se.x.size();) {
       size_t j = i;
-      while (j < se.x.size() && valid(se.x[j], se.y[j])) ++j;
-      auto at = [&](size_t k) {
-        return glm::dvec2(px(se.x[k]), py(logY ? std::log10(se.y[k]) : se.y[k]));
-      };
-      if (j == i + 1) disc(img, plot, at(i).x, at(i).y, 2.0 * r + 1.0, c);
-      for (size_t k = i; k + 1 < j; ++k) segment(img, plot, at(k), at(k + 1), r, c);
+      while (j < se.x.size() && drawable(se.x[j], se.y[j], L.logY)) ++j;
+      if (j == i + 1) disc(img, L.plot, L.at(se, i).x, L.at(se, i).y, 2.0 * r + 1.0, c);
+      for (size_t k = i; k + 1 < j; ++k) segment(img, L.plot, L.at(se, k), L.at(se, k + 1), r, c);
       i = std::max(j, i + 1);
     }
   }
-  // legend in the plot corner covering the fewest drawn pixels (top right first); none if too big
+}
+
+// legend in the plot corner covering the fewest drawn pixels (top right first); none if too big
+void drawLegend(Image8& img, const Layout& L, const std::vector<PlotSeries>& series) {
+  const int s = L.s, pad = L.pad;
+  const Rect& plot = L.plot;
   int rows = 0, labelW = 0;
   for (const PlotSeries& se : series)
     if (!se.label.empty()) {
@@ -243,41 +275,70 @@ Result<Image8> plotLines(const std::vector<PlotSeries>& series, const PlotOption
     }
   const int rowH = 12 * s, swatch = 20 * s, boxW = 3 * pad + swatch + labelW;
   const int boxH = rows * rowH + pad;
-  if (rows > 0 && boxW + 2 * pad <= plot.x1 - plot.x0 && boxH + 2 * pad <= plot.y1 - plot.y0) {
-    Rect box{};
-    size_t best = SIZE_MAX;
-    for (int corner = 0; corner < 4; ++corner) {
-      const int x0 = corner % 2 == 0 ? plot.x1 - pad - boxW : plot.x0 + pad;
-      const int y0 = corner < 2 ? plot.y0 + pad : plot.y1 - pad - boxH;
-      size_t drawn = 0;
-      for (int y = y0; y <= y0 + boxH; ++y)
-        for (int x = x0; x <= x0 + boxW; ++x) {
-          const uint8_t* p = &img.rgba[(static_cast<size_t>(y) * W + x) * 4];
-          const bool grey = p[0] == p[1] && p[1] == p[2];  // white or grid
-          drawn +=
-              !(grey && (p[0] == 255 || p[0] == static_cast<uint8_t>(kGrid.r * 255.0f + 0.5f)));
-        }
-      if (drawn < best) best = drawn, box = {x0, y0, x0 + boxW, y0 + boxH};
-    }
-    fill(img, box, kFrame);
-    fill(img, {box.x0 + 1, box.y0 + 1, box.x1 - 1, box.y1 - 1}, kWhite);
-    int y = box.y0 + pad / 2 + rowH / 2;
-    for (const PlotSeries& se : series) {
-      if (se.label.empty()) continue;
-      const glm::vec3 c = glm::clamp(se.color, glm::vec3(0.0f), glm::vec3(1.0f));
-      segment(img, box, {box.x0 + pad, y}, {box.x0 + pad + swatch, y}, r, c);
-      drawText(img, box.x0 + 2 * pad + swatch, y - charH / 2, se.label, s, kInk);
-      y += rowH;
-    }
+  if (rows == 0 || boxW + 2 * pad > plot.x1 - plot.x0 || boxH + 2 * pad > plot.y1 - plot.y0) return;
+  Rect box{};
+  size_t best = SIZE_MAX;
+  for (int corner = 0; corner < 4; ++corner) {
+    const int x0 = corner % 2 == 0 ? plot.x1 - pad - boxW : plot.x0 + pad;
+    const int y0 = corner < 2 ? plot.y0 + pad : plot.y1 - pad - boxH;
+    size_t drawn = 0;
+    for (int y = y0; y <= y0 + boxH; ++y)
+      for (int x = x0; x <= x0 + boxW; ++x) {
+        const uint8_t* p = &img.rgba[(static_cast<size_t>(y) * L.W + x) * 4];
+        const bool grey = p[0] == p[1] && p[1] == p[2];  // white or grid
+        drawn += !(grey && (p[0] == 255 || p[0] == static_cast<uint8_t>(kGrid.r * 255.0f + 0.5f)));
+      }
+    if (drawn < best) best = drawn, box = {x0, y0, x0 + boxW, y0 + boxH};
   }
-  // title and axis labels
-  const int cx = (plot.x0 + plot.x1) / 2;
+  fill(img, box, kFrame);
+  fill(img, {box.x0 + 1, box.y0 + 1, box.x1 - 1, box.y1 - 1}, kWhite);
+  const double r = lineRadius(L);
+  int y = box.y0 + pad / 2 + rowH / 2;
+  for (const PlotSeries& se : series) {
+    if (se.label.empty()) continue;
+    const glm::vec3 c = glm::clamp(se.color, glm::vec3(0.0f), glm::vec3(1.0f));
+    segment(img, box, {box.x0 + pad, y}, {box.x0 + pad + swatch, y}, r, c);
+    drawText(img, box.x0 + 2 * pad + swatch, y - L.charH / 2, se.label, s, kInk);
+    y += rowH;
+  }
+}
+
+// title and axis labels
+void drawTitles(Image8& img, const Layout& L, const PlotOptions& options) {
+  const int s = L.s, pad = L.pad;
+  const int cx = (L.plot.x0 + L.plot.x1) / 2;
   if (!options.title.empty())
     drawText(img, cx - textWidth(options.title, s) / 2, pad, options.title, s, kInk);
   if (!options.xLabel.empty())
-    drawText(img, cx - textWidth(options.xLabel, s) / 2, H - pad - charH, options.xLabel, s, kInk);
+    drawText(img, cx - textWidth(options.xLabel, s) / 2, L.H - pad - L.charH, options.xLabel, s,
+             kInk);
   if (!options.yLabel.empty())
-    drawTextUp(img, pad, (plot.y0 + plot.y1) / 2, options.yLabel, s, kInk);
+    drawTextUp(img, pad, (L.plot.y0 + L.plot.y1) / 2, options.yLabel, s, kInk);
+}
+
+}  // namespace
+
+Result<Image8> plotLines(const std::vector<PlotSeries>& series, const PlotOptions& options) {
+  const int W = options.width, H = options.height;
+  if (W < 100 || H < 100 || W > 8192 || H > 8192) {
+    std::string m = "plot size ";
+    m += std::to_string(W) + "x" + std::to_string(H) + " is outside [100, 8192]";
+    return makeError(m);
+  }
+  auto axes = dataAxes(series, options.logY);
+  if (!axes) return axes.error();
+  auto layout = layOut(options, std::move(*axes));
+  if (!layout) return layout.error();
+
+  Image8 img;
+  img.width = W;
+  img.height = H;
+  img.rgba.assign(static_cast<size_t>(W) * H * 4, 255);
+  drawGrid(img, *layout);
+  drawTickLabels(img, *layout);
+  drawSeries(img, *layout, series);
+  drawLegend(img, *layout, series);
+  drawTitles(img, *layout, options);
   return img;
 }
 

@@ -222,6 +222,27 @@ Result<unsigned> compileShaderSource(unsigned stage, const std::string& name,
   return shader;
 }
 
+namespace {
+
+// What render() makes of a method and its options: which capture and resolve run, with which
+// allocation and k.
+struct RenderPlan {
+  const MethodDesc& method;
+  const GlRenderOptions& options;
+  const Allocation* alloc;  // the host's per-pixel allocation, or none
+  uint32_t pixels;
+  bool device;    // the allocation the compute shaders left in the engine's buffers
+  bool perPixel;  // a per-pixel allocation (host or device)
+  uint64_t allocSlots;
+  bool isABuffer, isKBuffer, hybrid;
+  bool accumulates, isWboit;  // wboit or mboit: accumulators, no nodes
+  uint32_t accumWords;
+  bool isMlab;
+  uint32_t k;  // the fixed k (0 with a per-pixel allocation)
+};
+
+}  // namespace
+
 struct GlEngine::State {
   int width = 0, height = 0;
   Camera camera;
@@ -307,6 +328,220 @@ struct GlEngine::State {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTexels, texels);
     glDrawElements(GL_TRIANGLES, indexCount, GL_UNSIGNED_INT, nullptr);
   }
+
+  // the CPU engine's camera, matrices and view rays (RasterFrame::build)
+  void placeCamera(const Camera& cameraIn, const Scene& scene) {
+    camera = fitClipPlanes(cameraIn, sceneBounds(scene));
+    const glm::mat4 view = viewMatrix(camera);
+    viewProj = projectionMatrix(camera, width, height) * view;
+    viewRot = glm::mat3(view);
+    const float tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5f);
+    const float aspect = static_cast<float>(width) / static_cast<float>(height);
+    ray.x = 2.0f * tanHalf * aspect / static_cast<float>(width);
+    ray.y = (1.0f / static_cast<float>(width) - 1.0f) * tanHalf * aspect;
+    ray.z = -2.0f * tanHalf / static_cast<float>(height);
+    ray.w = (1.0f - 1.0f / static_cast<float>(height)) * tanHalf;
+  }
+
+  // every program, in this order (the first that fails is the error); the raster programs'
+  // uniforms set
+  Result<void> linkPrograms(const GlContext& context, const std::string& kbufferPrelude) {
+    auto raster = [&](const std::string& frag, const std::string& prelude = "") {
+      return linkProgram(frag,
+                         {{GL_VERTEX_SHADER, "raster.vert"},
+                          {GL_GEOMETRY_SHADER, "raster.geom"},
+                          {GL_FRAGMENT_SHADER, frag}},
+                         prelude);
+    };
+    auto count = raster("count.frag");
+    if (!count) return count.error();
+    progCount = *count;
+    auto abuffer = raster("capture_abuffer.frag");
+    if (!abuffer) return abuffer.error();
+    progABuffer = *abuffer;
+    auto kbuffer = raster("capture_kbuffer.frag", kbufferPrelude);
+    if (!kbuffer) return kbuffer.error();
+    progKBuffer = *kbuffer;
+    if (hasAtomic64(context)) {
+      auto atomic64 = raster("capture_kbuffer_atomic64.frag",
+                             "#extension GL_ARB_gpu_shader_int64 : require\n"
+                             "#extension GL_NV_shader_atomic_int64 : require\n");
+      auto swap =
+          linkProgram("swap_node_words.comp", {{GL_COMPUTE_SHADER, "swap_node_words.comp"}});
+      // never verified on a driver that offers the extension (llvmpipe does not): a driver that
+      // announces it but does not compile the shaders keeps the lock (engine_counters.atomic64
+      // says per frame which capture ran) instead of losing the whole engine
+      if (atomic64 && swap) {
+        progKBufferAtomic64 = *atomic64;
+        progSwapWords = *swap;
+      } else {
+        if (atomic64) glDeleteProgram(*atomic64);
+        if (swap) glDeleteProgram(*swap);
+      }
+    }
+    auto depthRange = raster("depth_range.frag");
+    if (!depthRange) return depthRange.error();
+    progDepthRange = *depthRange;
+    auto occFill = raster("occupancy_fill.frag");
+    if (!occFill) return occFill.error();
+    progOccFill = *occFill;
+    auto nearest = raster("nearest_cosine.frag");
+    if (!nearest) return nearest.error();
+    progNearest = *nearest;
+    auto wboit = raster("wboit.frag");
+    if (!wboit) return wboit.error();
+    progWboit = *wboit;
+    auto wboitResolve =
+        linkProgram("wboit_resolve.comp", {{GL_COMPUTE_SHADER, "wboit_resolve.comp"}});
+    if (!wboitResolve) return wboitResolve.error();
+    progWboitResolve = *wboitResolve;
+    auto mboitMoments = raster("mboit_moments.frag");
+    if (!mboitMoments) return mboitMoments.error();
+    progMboitMoments = *mboitMoments;
+    auto mboitColor = raster("mboit_color.frag");
+    if (!mboitColor) return mboitColor.error();
+    progMboitColor = *mboitColor;
+    auto mboitResolve =
+        linkProgram("mboit_resolve.comp", {{GL_COMPUTE_SHADER, "mboit_resolve.comp"}});
+    if (!mboitResolve) return mboitResolve.error();
+    progMboitResolve = *mboitResolve;
+    auto mlab = raster("mlab.frag");
+    if (!mlab) return mlab.error();
+    progMlab = *mlab;
+    auto mlabResolve = linkProgram("mlab_resolve.comp", {{GL_COMPUTE_SHADER, "mlab_resolve.comp"}});
+    if (!mlabResolve) return mlabResolve.error();
+    progMlabResolve = *mlabResolve;
+    auto dkbFeatures = raster("dkb_features.frag");
+    if (!dkbFeatures) return dkbFeatures.error();
+    progDkbFeatures = *dkbFeatures;
+    auto dkbInfer = linkProgram("dkb_infer.comp", {{GL_COMPUTE_SHADER, "dkb_infer.comp"}});
+    if (!dkbInfer) return dkbInfer.error();
+    progDkbInfer = *dkbInfer;
+    auto occCount =
+        linkProgram("occupancy_count.comp", {{GL_COMPUTE_SHADER, "occupancy_count.comp"}});
+    if (!occCount) return occCount.error();
+    progOccCount = *occCount;
+    auto scanProgram = linkProgram("prefix_sum.comp", {{GL_COMPUTE_SHADER, "prefix_sum.comp"}});
+    if (!scanProgram) return scanProgram.error();
+    progScan = *scanProgram;
+    auto scanAdd = linkProgram("prefix_sum_add.comp", {{GL_COMPUTE_SHADER, "prefix_sum_add.comp"}});
+    if (!scanAdd) return scanAdd.error();
+    progScanAdd = *scanAdd;
+    auto resolve = linkProgram("resolve.comp", {{GL_COMPUTE_SHADER, "resolve.comp"}});
+    if (!resolve) return resolve.error();
+    progResolve = *resolve;
+    for (const auto& [file, program] :
+         {std::pair<const char*, GLuint*>{"alloc_histogram.comp", &progAllocHistogram},
+          {"importance.comp", &progImportance},
+          {"importance_total.comp", &progImportanceTotal},
+          {"alloc_k.comp", &progAllocK},
+          {"alloc_pack.comp", &progAllocPack}}) {
+      auto linked = linkProgram(file, {{GL_COMPUTE_SHADER, file}});
+      if (!linked) return linked.error();
+      *program = *linked;
+    }
+    if (progKBufferAtomic64) setRasterUniforms(progKBufferAtomic64);
+    for (GLuint p : {progCount, progABuffer, progKBuffer, progDepthRange, progOccFill, progNearest,
+                     progWboit, progMboitMoments, progMboitColor, progMlab, progDkbFeatures})
+      setRasterUniforms(p);
+    return {};
+  }
+
+  // positions, normals, uvs (zeros when the scene has none), indices, the vertex array and the
+  // triangles' materials
+  void uploadGeometry(const Scene& scene) {
+    const size_t vertices = scene.positions.size();
+    const GLuint positions =
+        upload("positions", vertices * sizeof(glm::vec3), scene.positions.data());
+    const GLuint normals = upload("normals", vertices * sizeof(glm::vec3), scene.normals.data());
+    std::vector<glm::vec2> zeroUvs;
+    if (scene.uvs.empty()) zeroUvs.assign(vertices, glm::vec2(0.0f));
+    const GLuint uvs = upload("uvs", vertices * sizeof(glm::vec2),
+                              scene.uvs.empty() ? zeroUvs.data() : scene.uvs.data());
+    const GLuint indices =
+        upload("indices", scene.indices.size() * sizeof(uint32_t), scene.indices.data());
+    indexCount = static_cast<GLsizei>(scene.indices.size());
+    glCreateVertexArrays(1, &vao);
+    const GLuint vbos[3] = {positions, normals, uvs};
+    const GLint sizes[3] = {3, 3, 2};
+    for (GLuint i = 0; i < 3; ++i) {
+      glVertexArrayVertexBuffer(vao, i, vbos[i], 0, static_cast<GLsizei>(sizes[i] * sizeof(float)));
+      glVertexArrayAttribFormat(vao, i, sizes[i], GL_FLOAT, GL_FALSE, 0);
+      glVertexArrayAttribBinding(vao, i, i);
+      glEnableVertexArrayAttrib(vao, i);
+    }
+    glVertexArrayElementBuffer(vao, indices);
+    triMaterial = upload("triangle materials", scene.triangleMaterial.size() * 4,
+                         scene.triangleMaterial.data());
+  }
+
+  // the textures' texels and the material words, each within one shader storage block
+  Result<void> uploadMaterials(const Scene& scene) {
+    std::vector<uint32_t> texelWords;
+    std::vector<uint32_t> textureFirst;
+    for (const Texture& t : scene.textures) {
+      textureFirst.push_back(static_cast<uint32_t>(texelWords.size()));
+      const size_t n = static_cast<size_t>(t.width) * t.height;
+      const size_t at = texelWords.size();
+      texelWords.resize(at + n);
+      std::memcpy(texelWords.data() + at, t.rgba.data(), n * 4);  // R | G << 8 | B << 16 | A << 24
+    }
+    std::vector<uint32_t> materialWords;
+    auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+    for (const Material& m : scene.materials) {
+      const bool textured = m.baseColorTexture >= 0;
+      const Texture* t = textured ? &scene.textures[m.baseColorTexture] : nullptr;
+      const uint32_t words[kMaterialWords] = {
+          bits(m.baseColor.r),
+          bits(m.baseColor.g),
+          bits(m.baseColor.b),
+          bits(m.baseColor.a),
+          textured ? textureFirst[m.baseColorTexture] : kNoTexture,
+          t ? static_cast<uint32_t>(t->width) : 0u,
+          t ? static_cast<uint32_t>(t->height) : 0u,
+          static_cast<uint32_t>(m.alphaMode),
+          bits(m.alphaCutoff),
+          scene.alphaOverride ? 1u : 0u,
+          bits(scene.alphaOverride ? *scene.alphaOverride : 1.0f),
+          0u};
+      materialWords.insert(materialWords.end(), words, words + kMaterialWords);
+    }
+    for (const auto& [name, bytes] :
+         {std::pair<const char*, uint64_t>{"texels", texelWords.size() * 4},
+          {"triangle materials", scene.triangleMaterial.size() * 4}})
+      if (bytes > maxBlockBytes)
+        return makeError("--engine gl: the scene's " + std::string(name) + " need " +
+                         std::to_string(bytes) + " B, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
+                         std::to_string(maxBlockBytes) + " B)");
+    materials = upload("materials", materialWords.size() * 4, materialWords.data());
+    texels = upload("texels", texelWords.size() * 4, texelWords.data());
+    return {};
+  }
+
+  // the sRGB8 decode and encode tables of the resolve
+  void uploadColorTables() {
+    auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+    const ColorTables& tables = ColorTables::get();
+    std::vector<uint32_t> tableWords(kTableWords);
+    for (int i = 0; i < 256; ++i) tableWords[kTableLinearBase + i] = bits(tables.srgb8ToLinear[i]);
+    for (int i = 0; i < 4096; ++i) tableWords[kTableCoarseBase + i] = tables.coarseSrgb8[i];
+    for (int i = 0; i < 257; ++i) tableWords[kTableBoundBase + i] = bits(tables.lowerBound[i]);
+    colorTables = upload("colour tables", tableWords.size() * 4, tableWords.data());
+  }
+
+  // the attachment-less framebuffer of the raster passes and the timer query
+  void createFramebufferAndQuery() {
+    glCreateFramebuffers(1, &fbo);
+    glNamedFramebufferParameteri(fbo, GL_FRAMEBUFFER_DEFAULT_WIDTH, width);
+    glNamedFramebufferParameteri(fbo, GL_FRAMEBUFFER_DEFAULT_HEIGHT, height);
+    glCreateQueries(GL_TIME_ELAPSED, 1, &query);
+  }
+
+  // the method's kind and allocation, checked against what the GL engine runs and the block size
+  Result<RenderPlan> planRender(const MethodDesc& method, const GlRenderOptions& options) const;
+  // every storage buffer must fit one shader storage block (GL clamps the accessible range)
+  Error tooLarge(const MethodDesc& method, const std::string& what, uint64_t bytes) const;
+  struct FrameRun;
 
   // exclusive prefix sum of `count` uints of `in` into `out`
   void scan(FrameBuffers& fb, GLuint in, GLuint out, uint32_t count) const {
@@ -413,8 +648,10 @@ const Camera& GlEngine::camera() const {
   return state_->camera;
 }
 
-Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
-                                  const Camera& cameraIn, int width, int height, bool interlock) {
+namespace {
+
+// the image size, the scene and the camera, before any GL call
+Result<void> checkCreateArgs(const Scene& scene, const Camera& cameraIn, int width, int height) {
   if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize)
     return makeError("image size " + std::to_string(width) + "x" + std::to_string(height) +
                      ": width and height must be in [1, " + std::to_string(kMaxImageSize) + "]");
@@ -426,7 +663,11 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
     return makeError(
         "camera: eye != target, up not parallel to the view direction and a field "
         "of view in (0, 180) degrees needed");
-  context.makeCurrent();
+  return {};
+}
+
+// the image within this GL's framebuffer and texel-buffer limits (the context current)
+Result<void> checkGlLimits(int width, int height) {
   GLint maxFbWidth = 0, maxFbHeight = 0, maxTexelBuffer = 0;
   glGetIntegerv(GL_MAX_FRAMEBUFFER_WIDTH, &maxFbWidth);
   glGetIntegerv(GL_MAX_FRAMEBUFFER_HEIGHT, &maxFbHeight);
@@ -437,33 +678,12 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
                      std::to_string(height) + " above this GL's limits (framebuffer " +
                      std::to_string(maxFbWidth) + "x" + std::to_string(maxFbHeight) +
                      ", texel buffer " + std::to_string(maxTexelBuffer) + ")");
+  return {};
+}
 
-  auto s = std::make_unique<State>();
-  GLint64 maxBlock = 0;
-  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
-  s->maxBlockBytes = static_cast<uint64_t>(maxBlock);
-  s->width = width;
-  s->height = height;
-  // the CPU engine's camera, matrices and view rays (RasterFrame::build)
-  s->camera = fitClipPlanes(cameraIn, sceneBounds(scene));
-  const glm::mat4 view = viewMatrix(s->camera);
-  s->viewProj = projectionMatrix(s->camera, width, height) * view;
-  s->viewRot = glm::mat3(view);
-  const float tanHalf = std::tan(glm::radians(s->camera.fovYDegrees) * 0.5f);
-  const float aspect = static_cast<float>(width) / static_cast<float>(height);
-  s->ray.x = 2.0f * tanHalf * aspect / static_cast<float>(width);
-  s->ray.y = (1.0f / static_cast<float>(width) - 1.0f) * tanHalf * aspect;
-  s->ray.z = -2.0f * tanHalf / static_cast<float>(height);
-  s->ray.w = (1.0f - 1.0f / static_cast<float>(height)) * tanHalf;
-
-  // programs
-  auto raster = [&](const std::string& frag, const std::string& prelude = "") {
-    return linkProgram(frag,
-                       {{GL_VERTEX_SHADER, "raster.vert"},
-                        {GL_GEOMETRY_SHADER, "raster.geom"},
-                        {GL_FRAGMENT_SHADER, frag}},
-                       prelude);
-  };
+// the capture_kbuffer.frag prelude: with --gl-sync interlock, the driver's interlock extension
+// and its begin / end macros; empty without
+Result<std::string> kbufferInterlockPrelude(const GlContext& context, bool interlock) {
   std::string kbufferPrelude;
   if (interlock) {
     const std::string ext = interlockExtension(context);
@@ -488,174 +708,31 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
     if (ext != "GL_INTEL_fragment_shader_ordering")
       kbufferPrelude += "layout(pixel_interlock_ordered) in;\n";
   }
-  auto count = raster("count.frag");
-  if (!count) return count.error();
-  s->progCount = *count;
-  auto abuffer = raster("capture_abuffer.frag");
-  if (!abuffer) return abuffer.error();
-  s->progABuffer = *abuffer;
-  auto kbuffer = raster("capture_kbuffer.frag", kbufferPrelude);
-  if (!kbuffer) return kbuffer.error();
-  s->progKBuffer = *kbuffer;
-  if (hasAtomic64(context)) {
-    auto atomic64 = raster("capture_kbuffer_atomic64.frag",
-                           "#extension GL_ARB_gpu_shader_int64 : require\n"
-                           "#extension GL_NV_shader_atomic_int64 : require\n");
-    auto swap = linkProgram("swap_node_words.comp", {{GL_COMPUTE_SHADER, "swap_node_words.comp"}});
-    // never verified on a driver that offers the extension (llvmpipe does not): a driver that
-    // announces it but does not compile the shaders keeps the lock (engine_counters.atomic64
-    // says per frame which capture ran) instead of losing the whole engine
-    if (atomic64 && swap) {
-      s->progKBufferAtomic64 = *atomic64;
-      s->progSwapWords = *swap;
-    } else {
-      if (atomic64) glDeleteProgram(*atomic64);
-      if (swap) glDeleteProgram(*swap);
-    }
-  }
-  auto depthRange = raster("depth_range.frag");
-  if (!depthRange) return depthRange.error();
-  s->progDepthRange = *depthRange;
-  auto occFill = raster("occupancy_fill.frag");
-  if (!occFill) return occFill.error();
-  s->progOccFill = *occFill;
-  auto nearest = raster("nearest_cosine.frag");
-  if (!nearest) return nearest.error();
-  s->progNearest = *nearest;
-  auto wboit = raster("wboit.frag");
-  if (!wboit) return wboit.error();
-  s->progWboit = *wboit;
-  auto wboitResolve =
-      linkProgram("wboit_resolve.comp", {{GL_COMPUTE_SHADER, "wboit_resolve.comp"}});
-  if (!wboitResolve) return wboitResolve.error();
-  s->progWboitResolve = *wboitResolve;
-  auto mboitMoments = raster("mboit_moments.frag");
-  if (!mboitMoments) return mboitMoments.error();
-  s->progMboitMoments = *mboitMoments;
-  auto mboitColor = raster("mboit_color.frag");
-  if (!mboitColor) return mboitColor.error();
-  s->progMboitColor = *mboitColor;
-  auto mboitResolve =
-      linkProgram("mboit_resolve.comp", {{GL_COMPUTE_SHADER, "mboit_resolve.comp"}});
-  if (!mboitResolve) return mboitResolve.error();
-  s->progMboitResolve = *mboitResolve;
-  auto mlab = raster("mlab.frag");
-  if (!mlab) return mlab.error();
-  s->progMlab = *mlab;
-  auto mlabResolve = linkProgram("mlab_resolve.comp", {{GL_COMPUTE_SHADER, "mlab_resolve.comp"}});
-  if (!mlabResolve) return mlabResolve.error();
-  s->progMlabResolve = *mlabResolve;
-  auto dkbFeatures = raster("dkb_features.frag");
-  if (!dkbFeatures) return dkbFeatures.error();
-  s->progDkbFeatures = *dkbFeatures;
-  auto dkbInfer = linkProgram("dkb_infer.comp", {{GL_COMPUTE_SHADER, "dkb_infer.comp"}});
-  if (!dkbInfer) return dkbInfer.error();
-  s->progDkbInfer = *dkbInfer;
-  auto occCount =
-      linkProgram("occupancy_count.comp", {{GL_COMPUTE_SHADER, "occupancy_count.comp"}});
-  if (!occCount) return occCount.error();
-  s->progOccCount = *occCount;
-  auto scanProgram = linkProgram("prefix_sum.comp", {{GL_COMPUTE_SHADER, "prefix_sum.comp"}});
-  if (!scanProgram) return scanProgram.error();
-  s->progScan = *scanProgram;
-  auto scanAdd = linkProgram("prefix_sum_add.comp", {{GL_COMPUTE_SHADER, "prefix_sum_add.comp"}});
-  if (!scanAdd) return scanAdd.error();
-  s->progScanAdd = *scanAdd;
-  auto resolve = linkProgram("resolve.comp", {{GL_COMPUTE_SHADER, "resolve.comp"}});
-  if (!resolve) return resolve.error();
-  s->progResolve = *resolve;
-  for (const auto& [file, program] :
-       {std::pair<const char*, GLuint*>{"alloc_histogram.comp", &s->progAllocHistogram},
-        {"importance.comp", &s->progImportance},
-        {"importance_total.comp", &s->progImportanceTotal},
-        {"alloc_k.comp", &s->progAllocK},
-        {"alloc_pack.comp", &s->progAllocPack}}) {
-    auto linked = linkProgram(file, {{GL_COMPUTE_SHADER, file}});
-    if (!linked) return linked.error();
-    *program = *linked;
-  }
-  if (s->progKBufferAtomic64) s->setRasterUniforms(s->progKBufferAtomic64);
-  for (GLuint p : {s->progCount, s->progABuffer, s->progKBuffer, s->progDepthRange, s->progOccFill,
-                   s->progNearest, s->progWboit, s->progMboitMoments, s->progMboitColor,
-                   s->progMlab, s->progDkbFeatures})
-    s->setRasterUniforms(p);
+  return kbufferPrelude;
+}
 
-  // geometry, once
-  const size_t vertices = scene.positions.size();
-  const GLuint positions =
-      s->upload("positions", vertices * sizeof(glm::vec3), scene.positions.data());
-  const GLuint normals = s->upload("normals", vertices * sizeof(glm::vec3), scene.normals.data());
-  std::vector<glm::vec2> zeroUvs;
-  if (scene.uvs.empty()) zeroUvs.assign(vertices, glm::vec2(0.0f));
-  const GLuint uvs = s->upload("uvs", vertices * sizeof(glm::vec2),
-                               scene.uvs.empty() ? zeroUvs.data() : scene.uvs.data());
-  const GLuint indices =
-      s->upload("indices", scene.indices.size() * sizeof(uint32_t), scene.indices.data());
-  s->indexCount = static_cast<GLsizei>(scene.indices.size());
-  glCreateVertexArrays(1, &s->vao);
-  const GLuint vbos[3] = {positions, normals, uvs};
-  const GLint sizes[3] = {3, 3, 2};
-  for (GLuint i = 0; i < 3; ++i) {
-    glVertexArrayVertexBuffer(s->vao, i, vbos[i], 0,
-                              static_cast<GLsizei>(sizes[i] * sizeof(float)));
-    glVertexArrayAttribFormat(s->vao, i, sizes[i], GL_FLOAT, GL_FALSE, 0);
-    glVertexArrayAttribBinding(s->vao, i, i);
-    glEnableVertexArrayAttrib(s->vao, i);
-  }
-  glVertexArrayElementBuffer(s->vao, indices);
-  s->triMaterial = s->upload("triangle materials", scene.triangleMaterial.size() * 4,
-                             scene.triangleMaterial.data());
+}  // namespace
 
-  // materials and textures
-  std::vector<uint32_t> texelWords;
-  std::vector<uint32_t> textureFirst;
-  for (const Texture& t : scene.textures) {
-    textureFirst.push_back(static_cast<uint32_t>(texelWords.size()));
-    const size_t n = static_cast<size_t>(t.width) * t.height;
-    const size_t at = texelWords.size();
-    texelWords.resize(at + n);
-    std::memcpy(texelWords.data() + at, t.rgba.data(), n * 4);  // R | G << 8 | B << 16 | A << 24
-  }
-  std::vector<uint32_t> materialWords;
-  auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
-  for (const Material& m : scene.materials) {
-    const bool textured = m.baseColorTexture >= 0;
-    const Texture* t = textured ? &scene.textures[m.baseColorTexture] : nullptr;
-    const uint32_t words[kMaterialWords] = {
-        bits(m.baseColor.r),
-        bits(m.baseColor.g),
-        bits(m.baseColor.b),
-        bits(m.baseColor.a),
-        textured ? textureFirst[m.baseColorTexture] : kNoTexture,
-        t ? static_cast<uint32_t>(t->width) : 0u,
-        t ? static_cast<uint32_t>(t->height) : 0u,
-        static_cast<uint32_t>(m.alphaMode),
-        bits(m.alphaCutoff),
-        scene.alphaOverride ? 1u : 0u,
-        bits(scene.alphaOverride ? *scene.alphaOverride : 1.0f),
-        0u};
-    materialWords.insert(materialWords.end(), words, words + kMaterialWords);
-  }
-  for (const auto& [name, bytes] :
-       {std::pair<const char*, uint64_t>{"texels", texelWords.size() * 4},
-        {"triangle materials", scene.triangleMaterial.size() * 4}})
-    if (bytes > s->maxBlockBytes)
-      return makeError("--engine gl: the scene's " + std::string(name) + " need " +
-                       std::to_string(bytes) + " B, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
-                       std::to_string(s->maxBlockBytes) + " B)");
-  s->materials = s->upload("materials", materialWords.size() * 4, materialWords.data());
-  s->texels = s->upload("texels", texelWords.size() * 4, texelWords.data());
-  const ColorTables& tables = ColorTables::get();
-  std::vector<uint32_t> tableWords(kTableWords);
-  for (int i = 0; i < 256; ++i) tableWords[kTableLinearBase + i] = bits(tables.srgb8ToLinear[i]);
-  for (int i = 0; i < 4096; ++i) tableWords[kTableCoarseBase + i] = tables.coarseSrgb8[i];
-  for (int i = 0; i < 257; ++i) tableWords[kTableBoundBase + i] = bits(tables.lowerBound[i]);
-  s->colorTables = s->upload("colour tables", tableWords.size() * 4, tableWords.data());
+Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
+                                  const Camera& cameraIn, int width, int height, bool interlock) {
+  MFR_TRY(checkCreateArgs(scene, cameraIn, width, height));
+  context.makeCurrent();
+  MFR_TRY(checkGlLimits(width, height));
 
-  glCreateFramebuffers(1, &s->fbo);
-  glNamedFramebufferParameteri(s->fbo, GL_FRAMEBUFFER_DEFAULT_WIDTH, width);
-  glNamedFramebufferParameteri(s->fbo, GL_FRAMEBUFFER_DEFAULT_HEIGHT, height);
-  glCreateQueries(GL_TIME_ELAPSED, 1, &s->query);
+  auto s = std::make_unique<State>();
+  GLint64 maxBlock = 0;
+  glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
+  s->maxBlockBytes = static_cast<uint64_t>(maxBlock);
+  s->width = width;
+  s->height = height;
+  s->placeCamera(cameraIn, scene);
+  auto kbufferPrelude = kbufferInterlockPrelude(context, interlock);
+  if (!kbufferPrelude) return kbufferPrelude.error();
+  MFR_TRY(s->linkPrograms(context, *kbufferPrelude));
+  s->uploadGeometry(scene);
+  MFR_TRY(s->uploadMaterials(scene));
+  s->uploadColorTables();
+  s->createFramebufferAndQuery();
   if (s->uploadFailure) return *s->uploadFailure;
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
     return makeError("GL engine: scene upload failed (GL error 0x" + [&] {
@@ -666,91 +743,42 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   return GlEngine(std::move(s));
 }
 
-Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRenderOptions& options) {
-  State& s = *state_;
-  const bool isABuffer =
-      method.allocation == AllocationPolicy::Unbounded && method.store == StoreChoice::Append;
-  const Allocation* alloc = options.allocation;
-  const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
-  // the allocation the compute shaders left in the engine's buffers (allocateCapped,
-  // allocateByImportance), else the host's
-  const bool device = options.deviceAllocation;
-  if (device && !s.device)
-    return makeError("--engine gl: " + method.name + ": no allocation on the device");
-  const bool perPixel = alloc != nullptr || device;
-  const uint64_t allocSlots = device ? s.deviceSlots : alloc ? alloc->slots : 0;
-  if (alloc && (alloc->capacity.size() != pixels || alloc->offsets.size() != pixels ||
-                alloc->kind.size() != pixels))
-    return makeError("--engine gl: " + method.name + ": an allocation of another size");
-  const bool isKBuffer =
-      (perPixel && method.allocation != AllocationPolicy::Unbounded &&
-       method.allocation != AllocationPolicy::NoNodes &&
-       (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap ||
-        method.store == StoreChoice::PerPixel)) ||
-      (!perPixel && method.allocation == AllocationPolicy::FixedK &&
-       (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap) &&
-       method.k && *method.k > 0);
-  const bool hybrid = isKBuffer && method.compositing == Compositing::Hybrid;
-  const bool accumulates = (method.compositing == Compositing::WeightedBlended ||
-                            method.compositing == Compositing::MomentBased) &&
-                           method.allocation == AllocationPolicy::NoNodes &&
-                           method.store == StoreChoice::None && method.occupancyWords == 0;
-  const bool isWboit = accumulates && method.compositing == Compositing::WeightedBlended;
-  const uint32_t accumWords = !accumulates ? 0u : isWboit ? kWboitWords : kMboitWords;
-  const bool isMlab = !perPixel && method.allocation == AllocationPolicy::FixedK &&
-                      method.store == StoreChoice::MultiLayer &&
-                      method.compositing == Compositing::MultiLayerAlpha && method.k &&
-                      *method.k > 0 && method.occupancyWords == 0;
-  if (accumulates || isMlab) {
-    // weighted blended or moment-based OIT: no nodes, the accumulators; mlab: its own nodes
-  } else if ((!isABuffer && !isKBuffer) || (isABuffer && method.occupancyWords != 0) ||
-             method.occupancyWords < 0 || method.occupancyWords > 64 ||
-             (method.compositing != Compositing::KBuffer && !hybrid))
-    return makeError("--engine gl: method " + method.name +
-                     " is not in the GL engine yet (abuffer, fixed-k max-array or max-heap "
-                     "k-buffers with an explicit k, k-buffers with a per-pixel allocation, "
-                     "wboit, mboit, mlab)");
-  const uint32_t k = (isKBuffer && !perPixel) || isMlab ? *method.k : 0u;
-  // every storage buffer must fit one shader storage block (GL clamps the accessible range)
-  auto tooLarge = [&](const std::string& what, uint64_t bytes) {
-    return makeError("--engine gl: " + method.name + " at " + std::to_string(s.width) + "x" +
-                     std::to_string(s.height) + ": the " + what + " buffer needs " +
-                     std::to_string(bytes) + " B, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
-                     std::to_string(s.maxBlockBytes) + " B)");
-  };
-  {
-    const uint64_t perPixelBytes =
-        std::max<uint64_t>({accumulates ? accumWords * 4 : 12, hybrid ? kTailWords * 4 : 0,
-                            perPixel ? 8 : uint64_t{k} * (isMlab ? kMlabWords * 4 : kNodeBytes),
-                            static_cast<uint64_t>(std::max(method.occupancyWords, 0)) * 4});
-    if (uint64_t{pixels} * perPixelBytes > s.maxBlockBytes)
-      return tooLarge("per-pixel", uint64_t{pixels} * perPixelBytes);
-    if (perPixel && allocSlots * kNodeBytes > s.maxBlockBytes)  // (keeps the uint offsets exact)
-      return tooLarge("node", allocSlots * kNodeBytes);
+// One run of render(): the frame's buffers (freed with it), the passes in order and the read-back.
+struct GlEngine::State::FrameRun {
+  State& s;
+  const RenderPlan& plan;
+  GlRenderOutput& out;
+  FrameBuffers fb;
+  GLuint counts = 0, offsets = 0, nodes = 0, tails = 0, accum = 0, image = 0;
+  uint64_t nodeCount = 0;
+
+  FrameRun(State& state, const RenderPlan& p, GlRenderOutput& output)
+      : s(state), plan(p), out(output) {
+    fb.ledger = &out.bufferBytes;
   }
 
-  GlRenderOutput out;
-  for (int run = options.warmUp ? 0 : 1; run < 2; ++run) {
-    const bool timed = run == 1;
-    out.bufferBytes = s.sceneBytes;
-    out.passes.clear();
-    FrameBuffers fb;
-    fb.ledger = &out.bufferBytes;
-    auto pass = [&](const char* name, auto&& body) {
-      if (fb.failure) return;  // a buffer GL could not allocate: reported below
-      const auto t0 = std::chrono::steady_clock::now();
-      glBeginQuery(GL_TIME_ELAPSED, s.query);
-      body();
-      glEndQuery(GL_TIME_ELAPSED);
-      glFinish();
-      const auto t1 = std::chrono::steady_clock::now();
-      GLuint64 ns = 0;
-      glGetQueryObjectui64v(s.query, GL_QUERY_RESULT, &ns);
-      out.passes.push_back({name, static_cast<double>(ns) * 1e-6,
-                            std::chrono::duration<double, std::milli>(t1 - t0).count()});
-    };
+  // one timed pass: GL's elapsed time and the wall time around it
+  template <class Body>
+  void pass(const char* name, Body&& body) {
+    if (fb.failure) return;  // a buffer GL could not allocate: reported below
+    const auto t0 = std::chrono::steady_clock::now();
+    glBeginQuery(GL_TIME_ELAPSED, s.query);
+    body();
+    glEndQuery(GL_TIME_ELAPSED);
+    glFinish();
+    const auto t1 = std::chrono::steady_clock::now();
+    GLuint64 ns = 0;
+    glGetQueryObjectui64v(s.query, GL_QUERY_RESULT, &ns);
+    out.passes.push_back({name, static_cast<double>(ns) * 1e-6,
+                          std::chrono::duration<double, std::milli>(t1 - t0).count()});
+  }
 
-    // the per-pixel allocation: (first slot, k(p) | heap bit), a texel buffer
+  // the per-pixel allocation: (first slot, k(p) | heap bit), a texel buffer
+  void bindAllocation() {
+    const Allocation* alloc = plan.alloc;
+    const uint32_t pixels = plan.pixels;
+    const bool device = plan.device;
+    const bool perPixel = plan.perPixel;
     if (device) {
       out.bufferBytes["allocation"] += uint64_t{pixels} * 8;
       GLuint t = 0;
@@ -772,11 +800,16 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       fb.textures.push_back(t);
       glBindTextureUnit(kBindAllocation, t);
     }
+  }
 
-    // count: n(p) by imageAtomicAdd
+  // count: n(p) by imageAtomicAdd (or the counts given, or those on the device)
+  void countFragments() {
+    const GlRenderOptions& options = plan.options;
+    const uint32_t pixels = plan.pixels;
+    const bool device = plan.device;
     const bool counted = device || (options.counts && options.counts->size() == pixels);
-    const GLuint counts = fb.make("counts", uint64_t{pixels} * 4,
-                                  counted && !device ? options.counts->data() : nullptr);
+    counts = fb.make("counts", uint64_t{pixels} * 4,
+                     counted && !device ? options.counts->data() : nullptr);
     if (device)  // n(p) of countOnDevice, copied on the GPU
       glCopyNamedBufferSubData(s.deviceCounts, counts, 0, 0, uint64_t{pixels} * 4);
     if (!counted) {
@@ -789,156 +822,195 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
                         GL_BUFFER_UPDATE_BARRIER_BIT);
       });
     }
+  }
 
-    GLuint offsets = 0, nodes = 0, tails = 0, accum = 0;
-    uint64_t nodeCount = 0;
-    if (accumulates) {
-      accum = fb.make("accumulators", uint64_t{pixels} * accumWords * 4);
-      {  // wboit: revealage 1, the rest 0
-        std::vector<float> init(uint64_t{pixels} * accumWords, 0.0f);
-        if (isWboit)
-          for (uint32_t p = 0; p < pixels; ++p) init[uint64_t{p} * accumWords + 4] = 1.0f;
-        glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
-      }
-      const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
-      clearUint(locks, kLockFree);
-      auto accumulate = [&](GLuint program) {
-        glUseProgram(program);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
-        fb.bindImage(locks, kBindLocks);
-        s.drawScene();
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-      };
-      if (!isWboit) pass("moments", [&] { accumulate(s.progMboitMoments); });
-      pass("capture", [&] { accumulate(isWboit ? s.progWboit : s.progMboitColor); });
-    } else if (isMlab) {
-      nodes = fb.make("nodes", uint64_t{pixels} * k * kMlabWords * 4);
-      accum = fb.make("counters", uint64_t{pixels} * 4);  // nodes in use per pixel
-      clearUint(accum, 0);
-      const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
-      clearUint(locks, kLockFree);
-      pass("capture", [&] {
-        const GLuint p = s.progMlab;
-        glUseProgram(p);
-        glProgramUniform1ui(p, loc(p, "uK"), k);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, accum);
-        fb.bindImage(locks, kBindLocks);
-        s.drawScene();
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-      });
-    } else if (isABuffer) {
-      offsets = fb.make("offsets", uint64_t{pixels} * 4);
-      pass("prefix sum", [&] { s.scan(fb, counts, offsets, pixels); });
-      // the total in 64 bits from n(p) itself (the 32-bit scan would wrap silently)
-      std::vector<uint32_t> n(pixels);
-      glGetNamedBufferSubData(counts, 0, uint64_t{pixels} * 4ll, n.data());
-      nodeCount = 0;
-      for (uint32_t c : n) nodeCount += c;
-      if (nodeCount * kNodeBytes > s.maxBlockBytes)  // (also keeps the uint offsets exact)
-        return tooLarge("A-buffer node", nodeCount * kNodeBytes);
-      nodes = fb.make("nodes", nodeCount * kNodeBytes);
-      const GLuint fill = fb.make("fill counters", uint64_t{pixels} * 4);
-      clearUint(fill, 0);
-      pass("capture", [&] {
-        glUseProgram(s.progABuffer);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, offsets);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, fill);
-        s.drawScene();
-        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-      });
-    } else {
-      nodeCount = perPixel ? allocSlots : uint64_t{pixels} * k;
-      const uint32_t words = static_cast<uint32_t>(method.occupancyWords);
-      const GLuint stats = fb.make("capture counters", 8);
-      clearUint(stats, 0);
-      if (hybrid) {
-        tails = fb.make("tails", uint64_t{pixels} * kTailWords * 4);
-        clearUint(tails, 0);
-      } else {
-        tails = stats;  // not read
-      }
-      GLuint range = stats;
-      if (words > 0) {
-        // occupancy culling: depth range, bitmap fill, k-th occupied bucket
-        range = fb.make("occupancy", uint64_t{pixels} * kOccupancyWords * 4);
-        static_assert(kOccupancyWords == 3);
-        const uint32_t init[3] = {kFarDepthBits, 0u, kOccupancyNoCulling};
-        glClearNamedBufferData(range, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
-        const GLuint bitmap = fb.make("occupancy", uint64_t{pixels} * words * 4);
-        clearUint(bitmap, 0);
-        pass("depth range", [&] {
-          glUseProgram(s.progDepthRange);
-          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
-          s.drawScene();
-          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        });
-        pass("occupancy fill", [&] {
-          glUseProgram(s.progOccFill);
-          glProgramUniform1ui(s.progOccFill, loc(s.progOccFill, "uWords"), words);
-          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
-          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
-          s.drawScene();
-          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        });
-        pass("occupancy count", [&] {
-          const GLuint p = s.progOccCount;
-          glUseProgram(p);
-          glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
-          glProgramUniform1ui(p, loc(p, "uWords"), words);
-          glProgramUniform1ui(p, loc(p, "uK"), k);
-          glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
-          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
-          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
-          dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
-          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
-        });
-      }
-      // a fixed k without tail or occupancy takes 64-bit atomicMin where the driver has them
-      const bool atomic = s.progKBufferAtomic64 != 0 && !perPixel && !hybrid && words == 0;
-      out.atomic64 = atomic;
-      nodes = fb.make("nodes", nodeCount * kNodeBytes);
-      // the far node; as uint64 words (colour, depth) for the atomic capture
-      const uint32_t far[2] = {atomic ? 0u : kFarDepthBits, atomic ? kFarDepthBits : 0u};
-      glClearNamedBufferData(nodes, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT, far);
-      // (the lock words stay allocated and charged with the atomics: bytes_used does not depend
-      // on the capture's synchronisation)
-      const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
-      clearUint(locks, kLockFree);
-      const GLuint p = atomic ? s.progKBufferAtomic64 : s.progKBuffer;
+  // wboit, mboit: the per-pixel accumulators (mboit: its moments first)
+  void captureAccumulators() {
+    const uint32_t pixels = plan.pixels;
+    const bool isWboit = plan.isWboit;
+    const uint32_t accumWords = plan.accumWords;
+    accum = fb.make("accumulators", uint64_t{pixels} * accumWords * 4);
+    {  // wboit: revealage 1, the rest 0
+      std::vector<float> init(uint64_t{pixels} * accumWords, 0.0f);
+      if (isWboit)
+        for (uint32_t p = 0; p < pixels; ++p) init[uint64_t{p} * accumWords + 4] = 1.0f;
+      glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
+    }
+    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+    clearUint(locks, kLockFree);
+    auto accumulate = [&](GLuint program) {
+      glUseProgram(program);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+      fb.bindImage(locks, kBindLocks);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    };
+    if (!isWboit) pass("moments", [&] { accumulate(s.progMboitMoments); });
+    pass("capture", [&] { accumulate(isWboit ? s.progWboit : s.progMboitColor); });
+  }
+
+  // mlab: k nodes per pixel merged in place, their count per pixel
+  void captureMlab() {
+    const uint32_t pixels = plan.pixels;
+    const uint32_t k = plan.k;
+    nodes = fb.make("nodes", uint64_t{pixels} * k * kMlabWords * 4);
+    accum = fb.make("counters", uint64_t{pixels} * 4);  // nodes in use per pixel
+    clearUint(accum, 0);
+    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+    clearUint(locks, kLockFree);
+    pass("capture", [&] {
+      const GLuint p = s.progMlab;
+      glUseProgram(p);
       glProgramUniform1ui(p, loc(p, "uK"), k);
-      glProgramUniform1ui(p, loc(p, "uStore"),
-                          method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
-      glProgramUniform1ui(p, loc(p, "uOccupancyWords"), words);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, accum);
+      fb.bindImage(locks, kBindLocks);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    });
+  }
+
+  // the A-buffer: the prefix sum of n(p), then every fragment into its slot
+  Result<void> captureABuffer() {
+    const MethodDesc& method = plan.method;
+    const uint32_t pixels = plan.pixels;
+    offsets = fb.make("offsets", uint64_t{pixels} * 4);
+    pass("prefix sum", [&] { s.scan(fb, counts, offsets, pixels); });
+    // the total in 64 bits from n(p) itself (the 32-bit scan would wrap silently)
+    std::vector<uint32_t> n(pixels);
+    glGetNamedBufferSubData(counts, 0, uint64_t{pixels} * 4ll, n.data());
+    nodeCount = 0;
+    for (uint32_t c : n) nodeCount += c;
+    if (nodeCount * kNodeBytes > s.maxBlockBytes)  // (also keeps the uint offsets exact)
+      return s.tooLarge(method, "A-buffer node", nodeCount * kNodeBytes);
+    nodes = fb.make("nodes", nodeCount * kNodeBytes);
+    const GLuint fill = fb.make("fill counters", uint64_t{pixels} * 4);
+    clearUint(fill, 0);
+    pass("capture", [&] {
+      glUseProgram(s.progABuffer);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, offsets);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, fill);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    });
+    return {};
+  }
+
+  // occupancy culling: depth range, bitmap fill, k-th occupied bucket; the range buffer
+  GLuint occupancyCulling(uint32_t words) {
+    const uint32_t pixels = plan.pixels;
+    const uint32_t k = plan.k;
+    const bool perPixel = plan.perPixel;
+    const GLuint range = fb.make("occupancy", uint64_t{pixels} * kOccupancyWords * 4);
+    static_assert(kOccupancyWords == 3);
+    const uint32_t init[3] = {kFarDepthBits, 0u, kOccupancyNoCulling};
+    glClearNamedBufferData(range, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
+    const GLuint bitmap = fb.make("occupancy", uint64_t{pixels} * words * 4);
+    clearUint(bitmap, 0);
+    pass("depth range", [&] {
+      glUseProgram(s.progDepthRange);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    });
+    pass("occupancy fill", [&] {
+      glUseProgram(s.progOccFill);
+      glProgramUniform1ui(s.progOccFill, loc(s.progOccFill, "uWords"), words);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    });
+    pass("occupancy count", [&] {
+      const GLuint p = s.progOccCount;
+      glUseProgram(p);
+      glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+      glProgramUniform1ui(p, loc(p, "uWords"), words);
+      glProgramUniform1ui(p, loc(p, "uK"), k);
       glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
-      glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
-      pass("capture", [&] {
-        glUseProgram(p);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+      dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    });
+    return range;
+  }
+
+  // the k-buffer family: fixed or per-pixel k, max-array or max-heap, optional tail and occupancy
+  void captureKBuffer() {
+    const MethodDesc& method = plan.method;
+    const uint32_t pixels = plan.pixels;
+    const uint32_t k = plan.k;
+    const bool perPixel = plan.perPixel;
+    const bool hybrid = plan.hybrid;
+    const uint64_t allocSlots = plan.allocSlots;
+    nodeCount = perPixel ? allocSlots : uint64_t{pixels} * k;
+    const uint32_t words = static_cast<uint32_t>(method.occupancyWords);
+    const GLuint stats = fb.make("capture counters", 8);
+    clearUint(stats, 0);
+    if (hybrid) {
+      tails = fb.make("tails", uint64_t{pixels} * kTailWords * 4);
+      clearUint(tails, 0);
+    } else {
+      tails = stats;  // not read
+    }
+    GLuint range = stats;
+    if (words > 0) range = occupancyCulling(words);
+    // a fixed k without tail or occupancy takes 64-bit atomicMin where the driver has them
+    const bool atomic = s.progKBufferAtomic64 != 0 && !perPixel && !hybrid && words == 0;
+    out.atomic64 = atomic;
+    nodes = fb.make("nodes", nodeCount * kNodeBytes);
+    // the far node; as uint64 words (colour, depth) for the atomic capture
+    const uint32_t far[2] = {atomic ? 0u : kFarDepthBits, atomic ? kFarDepthBits : 0u};
+    glClearNamedBufferData(nodes, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT, far);
+    // (the lock words stay allocated and charged with the atomics: bytes_used does not depend
+    // on the capture's synchronisation)
+    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+    clearUint(locks, kLockFree);
+    const GLuint p = atomic ? s.progKBufferAtomic64 : s.progKBuffer;
+    glProgramUniform1ui(p, loc(p, "uK"), k);
+    glProgramUniform1ui(p, loc(p, "uStore"),
+                        method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
+    glProgramUniform1ui(p, loc(p, "uOccupancyWords"), words);
+    glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
+    glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
+    pass("capture", [&] {
+      glUseProgram(p);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTails, tails);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCaptureStats, stats);
+      fb.bindImage(locks, kBindLocks);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    });
+    if (atomic)
+      pass("node words", [&] {
+        const GLuint q = s.progSwapWords;
+        glUseProgram(q);
+        glProgramUniform1ui(q, loc(q, "uCount"), static_cast<GLuint>(nodeCount));
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTails, tails);
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCaptureStats, stats);
-        fb.bindImage(locks, kBindLocks);
-        s.drawScene();
+        dispatchGroups((nodeCount + kResolveGroupSize - 1) / kResolveGroupSize);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
       });
-      if (atomic)
-        pass("node words", [&] {
-          const GLuint q = s.progSwapWords;
-          glUseProgram(q);
-          glProgramUniform1ui(q, loc(q, "uCount"), static_cast<GLuint>(nodeCount));
-          glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
-          dispatchGroups((nodeCount + kResolveGroupSize - 1) / kResolveGroupSize);
-          glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-        });
-      uint32_t culled[2] = {0, 0};
-      glGetNamedBufferSubData(stats, 0, 8, culled);
-      out.culledOccupancy = culled[0];
-      out.culledKPlus = culled[1];
-    }
+    uint32_t culled[2] = {0, 0};
+    glGetNamedBufferSubData(stats, 0, 8, culled);
+    out.culledOccupancy = culled[0];
+    out.culledKPlus = culled[1];
+  }
 
-    const GLuint image = fb.make("image", uint64_t{pixels} * 12);
+  // the image: each kind's resolve pass
+  void resolve() {
+    const GlRenderOptions& options = plan.options;
+    const uint32_t pixels = plan.pixels;
+    const uint32_t k = plan.k;
+    const bool perPixel = plan.perPixel;
+    const bool hybrid = plan.hybrid;
+    const bool isWboit = plan.isWboit;
+    const bool isMlab = plan.isMlab;
+    const bool accumulates = plan.accumulates;
+    image = fb.make("image", uint64_t{pixels} * 12);
     if (isMlab) {
       pass("resolve", [&] {
         const GLuint p = s.progMlabResolve;
@@ -986,6 +1058,11 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
       });
     }
+  }
+
+  // a GL error or a buffer GL could not allocate
+  Result<void> checkErrors() {
+    const MethodDesc& method = plan.method;
     if (const GLenum e = glGetError(); e != GL_NO_ERROR) {
       char buf[16];
       std::snprintf(buf, sizeof buf, "%x", e);
@@ -993,50 +1070,155 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       return makeError("--engine gl: " + method.name + " failed (GL error 0x" + buf + ")");
     }
     if (fb.failure) return *fb.failure;
-    if (!timed) continue;
+    return {};
+  }
 
-    // read back
+  // n(p), the image and, with readNodes, the nodes with their per-pixel ranges
+  void readBack() {
+    const GlRenderOptions& options = plan.options;
+    const uint32_t pixels = plan.pixels;
+    const bool isMlab = plan.isMlab;
     out.counts.resize(pixels);
     glGetNamedBufferSubData(counts, 0, uint64_t{pixels} * 4ll, out.counts.data());
     for (uint32_t n : out.counts) out.fragments += n;
     out.image = ImageRGB(s.width, s.height);
     glGetNamedBufferSubData(image, 0, uint64_t{pixels} * 12ll, out.image.pixels.data());
-    if (options.readNodes && !isMlab) {  // (mlab's nodes are not fragment nodes)
-      std::vector<uint32_t> words(nodeCount * 2);
-      if (nodeCount > 0)
-        glGetNamedBufferSubData(nodes, 0, static_cast<GLsizeiptr>(nodeCount * kNodeBytes),
-                                words.data());
-      out.nodes.resize(nodeCount);
-      for (uint64_t i = 0; i < nodeCount; ++i)
-        out.nodes[i] = (static_cast<uint64_t>(words[2 * i + kNodeHiIndex]) << 32) |
-                       words[2 * i + 1 - kNodeHiIndex];
-      out.nodeOffsets.resize(pixels);
-      out.nodeCounts.resize(pixels);
-      if (isABuffer) {
-        std::vector<uint32_t> off(pixels);
-        glGetNamedBufferSubData(offsets, 0, uint64_t{pixels} * 4ll, off.data());
-        for (uint32_t p = 0; p < pixels; ++p) {
-          out.nodeOffsets[p] = off[p];
-          out.nodeCounts[p] = out.counts[p];
-        }
-      } else {
-        std::vector<uint32_t> words;
-        if (device) {
-          words.resize(uint64_t{pixels} * 2);
-          glGetNamedBufferSubData(s.deviceWords, 0, uint64_t{pixels} * 8ll, words.data());
-        }
-        for (uint32_t p = 0; p < pixels; ++p) {
-          const uint64_t first = device  ? words[2 * p]
-                                 : alloc ? alloc->offsets[p]
-                                         : uint64_t{p} * k;
-          const uint32_t capacity = device  ? words[2 * p + 1] & ~kAllocHeapBit
-                                    : alloc ? alloc->capacity[p]
-                                            : k;
-          out.nodeOffsets[p] = first;
-          out.nodeCounts[p] = std::min(out.counts[p], capacity);
-        }
+    if (options.readNodes && !isMlab) readNodes();  // (mlab's nodes are not fragment nodes)
+  }
+
+  // the nodes, and each pixel's first node and count
+  void readNodes() {
+    const Allocation* alloc = plan.alloc;
+    const uint32_t pixels = plan.pixels;
+    const uint32_t k = plan.k;
+    const bool device = plan.device;
+    const bool isABuffer = plan.isABuffer;
+    std::vector<uint32_t> words(nodeCount * 2);
+    if (nodeCount > 0)
+      glGetNamedBufferSubData(nodes, 0, static_cast<GLsizeiptr>(nodeCount * kNodeBytes),
+                              words.data());
+    out.nodes.resize(nodeCount);
+    for (uint64_t i = 0; i < nodeCount; ++i)
+      out.nodes[i] = (static_cast<uint64_t>(words[2 * i + kNodeHiIndex]) << 32) |
+                     words[2 * i + 1 - kNodeHiIndex];
+    out.nodeOffsets.resize(pixels);
+    out.nodeCounts.resize(pixels);
+    if (isABuffer) {
+      std::vector<uint32_t> off(pixels);
+      glGetNamedBufferSubData(offsets, 0, uint64_t{pixels} * 4ll, off.data());
+      for (uint32_t p = 0; p < pixels; ++p) {
+        out.nodeOffsets[p] = off[p];
+        out.nodeCounts[p] = out.counts[p];
+      }
+    } else {
+      std::vector<uint32_t> words;
+      if (device) {
+        words.resize(uint64_t{pixels} * 2);
+        glGetNamedBufferSubData(s.deviceWords, 0, uint64_t{pixels} * 8ll, words.data());
+      }
+      for (uint32_t p = 0; p < pixels; ++p) {
+        const uint64_t first = device ? words[2 * p] : alloc ? alloc->offsets[p] : uint64_t{p} * k;
+        const uint32_t capacity = device  ? words[2 * p + 1] & ~kAllocHeapBit
+                                  : alloc ? alloc->capacity[p]
+                                          : k;
+        out.nodeOffsets[p] = first;
+        out.nodeCounts[p] = std::min(out.counts[p], capacity);
       }
     }
+  }
+};
+
+Result<RenderPlan> GlEngine::State::planRender(const MethodDesc& method,
+                                               const GlRenderOptions& options) const {
+  const State& s = *this;
+  const bool isABuffer =
+      method.allocation == AllocationPolicy::Unbounded && method.store == StoreChoice::Append;
+  const Allocation* alloc = options.allocation;
+  const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
+  // the allocation the compute shaders left in the engine's buffers (allocateCapped,
+  // allocateByImportance), else the host's
+  const bool device = options.deviceAllocation;
+  if (device && !s.device)
+    return makeError("--engine gl: " + method.name + ": no allocation on the device");
+  const bool perPixel = alloc != nullptr || device;
+  const uint64_t allocSlots = device ? s.deviceSlots : alloc ? alloc->slots : 0;
+  if (alloc && (alloc->capacity.size() != pixels || alloc->offsets.size() != pixels ||
+                alloc->kind.size() != pixels))
+    return makeError("--engine gl: " + method.name + ": an allocation of another size");
+  const bool isKBuffer =
+      (perPixel && method.allocation != AllocationPolicy::Unbounded &&
+       method.allocation != AllocationPolicy::NoNodes &&
+       (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap ||
+        method.store == StoreChoice::PerPixel)) ||
+      (!perPixel && method.allocation == AllocationPolicy::FixedK &&
+       (method.store == StoreChoice::MaxArray || method.store == StoreChoice::MaxHeap) &&
+       method.k && *method.k > 0);
+  const bool hybrid = isKBuffer && method.compositing == Compositing::Hybrid;
+  const bool accumulates = (method.compositing == Compositing::WeightedBlended ||
+                            method.compositing == Compositing::MomentBased) &&
+                           method.allocation == AllocationPolicy::NoNodes &&
+                           method.store == StoreChoice::None && method.occupancyWords == 0;
+  const bool isWboit = accumulates && method.compositing == Compositing::WeightedBlended;
+  const uint32_t accumWords = !accumulates ? 0u : isWboit ? kWboitWords : kMboitWords;
+  const bool isMlab = !perPixel && method.allocation == AllocationPolicy::FixedK &&
+                      method.store == StoreChoice::MultiLayer &&
+                      method.compositing == Compositing::MultiLayerAlpha && method.k &&
+                      *method.k > 0 && method.occupancyWords == 0;
+  if (accumulates || isMlab) {
+    // weighted blended or moment-based OIT: no nodes, the accumulators; mlab: its own nodes
+  } else if ((!isABuffer && !isKBuffer) || (isABuffer && method.occupancyWords != 0) ||
+             method.occupancyWords < 0 || method.occupancyWords > 64 ||
+             (method.compositing != Compositing::KBuffer && !hybrid))
+    return makeError("--engine gl: method " + method.name +
+                     " is not in the GL engine yet (abuffer, fixed-k max-array or max-heap "
+                     "k-buffers with an explicit k, k-buffers with a per-pixel allocation, "
+                     "wboit, mboit, mlab)");
+  const uint32_t k = (isKBuffer && !perPixel) || isMlab ? *method.k : 0u;
+  const uint64_t perPixelBytes =
+      std::max<uint64_t>({accumulates ? accumWords * 4 : 12, hybrid ? kTailWords * 4 : 0,
+                          perPixel ? 8 : uint64_t{k} * (isMlab ? kMlabWords * 4 : kNodeBytes),
+                          static_cast<uint64_t>(std::max(method.occupancyWords, 0)) * 4});
+  if (uint64_t{pixels} * perPixelBytes > s.maxBlockBytes)
+    return tooLarge(method, "per-pixel", uint64_t{pixels} * perPixelBytes);
+  if (perPixel && allocSlots * kNodeBytes > s.maxBlockBytes)  // (keeps the uint offsets exact)
+    return tooLarge(method, "node", allocSlots * kNodeBytes);
+  return RenderPlan{method,      options,    alloc,      pixels,    device,
+                    perPixel,    allocSlots, isABuffer,  isKBuffer, hybrid,
+                    accumulates, isWboit,    accumWords, isMlab,    k};
+}
+
+Error GlEngine::State::tooLarge(const MethodDesc& method, const std::string& what,
+                                uint64_t bytes) const {
+  return makeError("--engine gl: " + method.name + " at " + std::to_string(width) + "x" +
+                   std::to_string(height) + ": the " + what + " buffer needs " +
+                   std::to_string(bytes) + " B, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
+                   std::to_string(maxBlockBytes) + " B)");
+}
+
+Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRenderOptions& options) {
+  State& s = *state_;
+  auto plan = s.planRender(method, options);
+  if (!plan) return plan.error();
+  GlRenderOutput out;
+  for (int run = options.warmUp ? 0 : 1; run < 2; ++run) {
+    const bool timed = run == 1;
+    out.bufferBytes = s.sceneBytes;
+    out.passes.clear();
+    State::FrameRun frame(s, *plan, out);
+    frame.bindAllocation();
+    frame.countFragments();
+    if (plan->accumulates) {
+      frame.captureAccumulators();
+    } else if (plan->isMlab) {
+      frame.captureMlab();
+    } else if (plan->isABuffer) {
+      MFR_TRY(frame.captureABuffer());
+    } else {
+      frame.captureKBuffer();
+    }
+    frame.resolve();
+    MFR_TRY(frame.checkErrors());
+    if (timed) frame.readBack();
   }
   return out;
 }

@@ -197,144 +197,149 @@ CountSummary summarizeCounts(const std::vector<uint32_t>& n) {
   return s;
 }
 
-Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
-                            const MemoryModel& memory, std::optional<uint64_t> budget,
-                            const std::vector<uint32_t>& n, const std::vector<float>& importanceIn,
-                            const std::vector<uint32_t>& oracleK) {
-  // I(p) comes from hand-set parameters or a model file (deep k-buffer): a NaN, infinite or
-  // negative value counts as 0, so that no float-to-integer conversion below ever sees it.
-  const auto usable = [](float i) { return std::isfinite(i) && i >= 0.0f; };
-  std::vector<float> sanitized;
-  const bool clean = std::all_of(importanceIn.begin(), importanceIn.end(), usable);
-  if (!clean) {
-    sanitized = importanceIn;
-    for (float& i : sanitized)
-      if (!usable(i)) i = 0.0f;
-  }
-  const std::vector<float>& importance = clean ? importanceIn : sanitized;
-  const uint64_t pixels = frame.pixels();
-  const uint64_t overhead = memory.overhead(pixels);
-  const std::string& name = method.name;
-  Allocation a;
-  a.capacity.assign(pixels, 0);
-  a.kind.assign(pixels, StoreKind::MaxArray);
+namespace {
 
-  const uint64_t nodeBytes = memory.node;
-  auto inBudget = budgetSlots(frame, method, memory, budget);
-  if (!inBudget) return inBudget.error();
-  if (method.allocation == AllocationPolicy::NoNodes) {  // wboit, mboit: accumulators only
-    a.offsets.assign(pixels, 0);
-    return a;
-  }
-  const uint64_t slotsInBudget = *inBudget;
+// What every policy step reads: the frame, the method, the counts n(p) and the slots F(M) the
+// budget leaves for nodes.
+struct AllocationInputs {
+  const PixelLayout& frame;
+  const MethodDesc& method;
+  const MemoryModel& memory;
+  std::optional<uint64_t> budget;
+  const std::vector<uint32_t>& n;
+  uint64_t slotsInBudget;
+  uint64_t covered;  // pixels with n(p) > 0
 
-  auto sumCapped = [&](uint64_t k) {
-    uint64_t s = 0;
-    for (uint32_t c : n) s += std::min<uint64_t>(c, k);
-    return s;
-  };
-  uint64_t covered = 0;
-  for (uint32_t c : n) covered += c > 0;
-  auto tooSmall = [&](const char* which, uint64_t count) {
+  Error tooSmall(const char* which, uint64_t count) const {
     return tooSmallFor(frame, method, memory, *budget, which, count);
-  };
-
-  switch (method.allocation) {
-    case AllocationPolicy::Unbounded: {
-      a.slots = sumCapped(UINT32_MAX);
-      if (a.slots > slotsInBudget)
-        return makeError("budget " + bytesText(*budget) + ": " + name + " needs " +
-                         bytesText(overhead + a.slots * nodeBytes) + " for all " +
-                         std::to_string(a.slots) + " fragments at " + sizeText(frame));
-      for (size_t p = 0; p < pixels; ++p) a.capacity[p] = n[p];
-      break;
-    }
-    case AllocationPolicy::FixedK: {
-      uint64_t k = method.k.value_or(0);
-      if (!method.k) {
-        if (!budget) return makeError(name + ": needs a budget or an explicit k");
-        k = std::min<uint64_t>(slotsInBudget / pixels, 1u << 20);
-        if (k == 0) return tooSmall("pixel", pixels);
-      }
-      if (k == 0) return makeError(name + ": k must be at least 1");
-      if (k * pixels > slotsInBudget)
-        return makeError("budget " + bytesText(*budget) + ": " + name +
-                         " with k = " + std::to_string(k) + " needs " +
-                         bytesText(overhead + k * pixels * nodeBytes) + " at " + sizeText(frame));
-      a.globalK = static_cast<uint32_t>(k);
-      a.slots = k * pixels;
-      std::fill(a.capacity.begin(), a.capacity.end(), static_cast<uint32_t>(k));
-      break;
-    }
-    case AllocationPolicy::CountedK:
-    case AllocationPolicy::DynamicK: {
-      const CountSummary summary = method.allocation == AllocationPolicy::DynamicK
-                                       ? summarizeCounts(n)
-                                       : CountSummary{{}, 0, covered};
-      if (method.allocation == AllocationPolicy::DynamicK)
-        a.scratchBytes += summary.histogram.capacity() * sizeof(uint64_t);
-      auto k = boundedK(frame, method, memory, budget, summary);
-      if (!k) return k.error();
-      a.slots = sumCapped(*k);
-      MFR_TRY(checkBoundedSlots(frame, method, memory, budget, *k, a.slots));
-      a.globalK = *k;
-      for (size_t p = 0; p < pixels; ++p) a.capacity[p] = std::min(n[p], *k);
-      break;
-    }
-    case AllocationPolicy::Importance: {
-      if (!budget) return makeError(name + ": needs a budget");
-      if (slotsInBudget < covered) return tooSmall("covered pixel", covered);
-      double total = 0.0;
-      for (float i : importance) total += i;
-      std::vector<uint64_t> k(pixels, 0);
-      if (!method.fillUnusedSlots) {  // the paper's rule, Eq. 1
-        if (total > 0.0)
-          for (size_t p = 0; p < pixels; ++p)
-            k[p] = static_cast<uint64_t>(
-                std::floor(importance[p] / total * static_cast<double>(slotsInBudget)));
-      } else {
-        // fill: one slot for every covered pixel first (like DHOIT's allocation), the rest by
-        // importance, capped at n(p), then the freed and remainder slots to the unmet pixels
-        const double share = static_cast<double>(slotsInBudget - covered);
-        for (size_t p = 0; p < pixels; ++p) {
-          if (n[p] == 0) continue;
-          const uint64_t byImportance =
-              total > 0.0 ? static_cast<uint64_t>(std::floor(importance[p] / total * share)) : 0;
-          k[p] = 1 + std::min<uint64_t>(n[p] - 1, byImportance);
-        }
-        fillByImportance(n, importance, slotsInBudget, k);
-      }
-      a.scratchBytes += k.capacity() * sizeof(uint64_t);
-      a.reservedK.resize(pixels);
-      for (size_t p = 0; p < pixels; ++p) {
-        a.reservedSlots += k[p];
-        a.reservedK[p] = static_cast<uint32_t>(std::min<uint64_t>(k[p], UINT32_MAX));
-        a.capacity[p] = static_cast<uint32_t>(std::min<uint64_t>(k[p], n[p]));
-        a.slots += a.capacity[p];
-      }
-      MFR_CHECK(a.reservedSlots <= slotsInBudget);
-      break;
-    }
-    case AllocationPolicy::NoNodes:  // returned above
-      break;
-    case AllocationPolicy::Optimal: {  // k(p) chosen by the oracle (render.cpp) within F(M)
-      if (!budget) return makeError(name + ": needs a budget");
-      if (slotsInBudget < covered) return tooSmall("covered pixel", covered);
-      for (size_t p = 0; p < pixels; ++p) {
-        a.capacity[p] = oracleK[p];
-        a.slots += oracleK[p];
-      }
-      MFR_CHECK(a.slots <= slotsInBudget);
-      break;
-    }
   }
-  if (a.reservedK.empty()) a.reservedSlots = a.slots;
+};
 
-  for (size_t p = 0; p < pixels; ++p)
-    a.kind[p] = pickStore(method.store, n.empty() ? a.capacity[p] + 1 : n[p], a.capacity[p]);
+// sum over p of min(n(p), k)
+uint64_t cappedSum(const std::vector<uint32_t>& n, uint64_t k) {
+  uint64_t s = 0;
+  for (uint32_t c : n) s += std::min<uint64_t>(c, k);
+  return s;
+}
 
-  // exclusive prefix sum in tile-major order (row-major: one tile as wide and high as the frame)
-  a.offsets.assign(pixels, 0);
+// I(p) comes from hand-set parameters or a model file (deep k-buffer): a NaN, infinite or
+// negative value counts as 0, so that no float-to-integer conversion below ever sees it. Returns
+// importanceIn itself when it is clean, else the copy made in scratch.
+const std::vector<float>& usableImportance(const std::vector<float>& importanceIn,
+                                           std::vector<float>& scratch) {
+  const auto usable = [](float i) { return std::isfinite(i) && i >= 0.0f; };
+  if (std::all_of(importanceIn.begin(), importanceIn.end(), usable)) return importanceIn;
+  scratch = importanceIn;
+  for (float& i : scratch)
+    if (!usable(i)) i = 0.0f;
+  return scratch;
+}
+
+// unbounded: k(p) = n(p), all fragments or an error
+Result<void> allocateUnbounded(const AllocationInputs& in, Allocation& a) {
+  a.slots = cappedSum(in.n, UINT32_MAX);
+  if (a.slots > in.slotsInBudget)
+    return makeError("budget " + bytesText(*in.budget) + ": " + in.method.name + " needs " +
+                     bytesText(in.memory.overhead(in.frame.pixels()) + a.slots * in.memory.node) +
+                     " for all " + std::to_string(a.slots) + " fragments at " + sizeText(in.frame));
+  for (size_t p = 0; p < in.frame.pixels(); ++p) a.capacity[p] = in.n[p];
+  return {};
+}
+
+// fixed k: the explicit k, or floor(F(M) / |P|), for every pixel
+Result<void> allocateFixedK(const AllocationInputs& in, Allocation& a) {
+  const std::string& name = in.method.name;
+  const uint64_t pixels = in.frame.pixels();
+  uint64_t k = in.method.k.value_or(0);
+  if (!in.method.k) {
+    if (!in.budget) return makeError(name + ": needs a budget or an explicit k");
+    k = std::min<uint64_t>(in.slotsInBudget / pixels, 1u << 20);
+    if (k == 0) return in.tooSmall("pixel", pixels);
+  }
+  if (k == 0) return makeError(name + ": k must be at least 1");
+  if (k * pixels > in.slotsInBudget)
+    return makeError("budget " + bytesText(*in.budget) + ": " + name +
+                     " with k = " + std::to_string(k) + " needs " +
+                     bytesText(in.memory.overhead(pixels) + k * pixels * in.memory.node) + " at " +
+                     sizeText(in.frame));
+  a.globalK = static_cast<uint32_t>(k);
+  a.slots = k * pixels;
+  std::fill(a.capacity.begin(), a.capacity.end(), static_cast<uint32_t>(k));
+  return {};
+}
+
+// counted k and dynamic k: one global k (boundedK), k(p) = min(n(p), k)
+Result<void> allocateBoundedK(const AllocationInputs& in, Allocation& a) {
+  const bool dynamic = in.method.allocation == AllocationPolicy::DynamicK;
+  const CountSummary summary = dynamic ? summarizeCounts(in.n) : CountSummary{{}, 0, in.covered};
+  if (dynamic) a.scratchBytes += summary.histogram.capacity() * sizeof(uint64_t);
+  auto k = boundedK(in.frame, in.method, in.memory, in.budget, summary);
+  if (!k) return k.error();
+  a.slots = cappedSum(in.n, *k);
+  MFR_TRY(checkBoundedSlots(in.frame, in.method, in.memory, in.budget, *k, a.slots));
+  a.globalK = *k;
+  for (size_t p = 0; p < in.frame.pixels(); ++p) a.capacity[p] = std::min(in.n[p], *k);
+  return {};
+}
+
+// importance: k(p) = floor(I(p) / sum I * F(M)) (Eq. 1), or the fill variant; the reserved k(p)
+// may exceed n(p), the capacity never does
+Result<void> allocateByImportance(const AllocationInputs& in, const std::vector<float>& importance,
+                                  Allocation& a) {
+  const std::vector<uint32_t>& n = in.n;
+  const uint64_t pixels = in.frame.pixels();
+  const uint64_t slotsInBudget = in.slotsInBudget;
+  if (!in.budget) return makeError(in.method.name + ": needs a budget");
+  if (slotsInBudget < in.covered) return in.tooSmall("covered pixel", in.covered);
+  double total = 0.0;
+  for (float i : importance) total += i;
+  std::vector<uint64_t> k(pixels, 0);
+  if (!in.method.fillUnusedSlots) {  // the paper's rule, Eq. 1
+    if (total > 0.0)
+      for (size_t p = 0; p < pixels; ++p)
+        k[p] = static_cast<uint64_t>(
+            std::floor(importance[p] / total * static_cast<double>(slotsInBudget)));
+  } else {
+    // fill: one slot for every covered pixel first (like DHOIT's allocation), the rest by
+    // importance, capped at n(p), then the freed and remainder slots to the unmet pixels
+    const double share = static_cast<double>(slotsInBudget - in.covered);
+    for (size_t p = 0; p < pixels; ++p) {
+      if (n[p] == 0) continue;
+      const uint64_t byImportance =
+          total > 0.0 ? static_cast<uint64_t>(std::floor(importance[p] / total * share)) : 0;
+      k[p] = 1 + std::min<uint64_t>(n[p] - 1, byImportance);
+    }
+    fillByImportance(n, importance, slotsInBudget, k);
+  }
+  a.scratchBytes += k.capacity() * sizeof(uint64_t);
+  a.reservedK.resize(pixels);
+  for (size_t p = 0; p < pixels; ++p) {
+    a.reservedSlots += k[p];
+    a.reservedK[p] = static_cast<uint32_t>(std::min<uint64_t>(k[p], UINT32_MAX));
+    a.capacity[p] = static_cast<uint32_t>(std::min<uint64_t>(k[p], n[p]));
+    a.slots += a.capacity[p];
+  }
+  MFR_CHECK(a.reservedSlots <= slotsInBudget);
+  return {};
+}
+
+// optimal: k(p) chosen by the oracle (render.cpp) within F(M)
+Result<void> allocateOptimal(const AllocationInputs& in, const std::vector<uint32_t>& oracleK,
+                             Allocation& a) {
+  if (!in.budget) return makeError(in.method.name + ": needs a budget");
+  if (in.slotsInBudget < in.covered) return in.tooSmall("covered pixel", in.covered);
+  for (size_t p = 0; p < in.frame.pixels(); ++p) {
+    a.capacity[p] = oracleK[p];
+    a.slots += oracleK[p];
+  }
+  MFR_CHECK(a.slots <= in.slotsInBudget);
+  return {};
+}
+
+// exclusive prefix sum of the capacities in tile-major order (row-major: one tile as wide and
+// high as the frame)
+void tileMajorOffsets(const PixelLayout& frame, Allocation& a) {
+  a.offsets.assign(frame.pixels(), 0);
   uint64_t running = 0;
   const int tw = frame.tileSize > 0 ? frame.tileSize : std::max(frame.width, 1);
   const int th = frame.tileSize > 0 ? frame.tileSize : std::max(frame.height, 1);
@@ -347,6 +352,56 @@ Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
           running += a.capacity[p];
         }
   MFR_CHECK(running == a.slots);
+}
+
+}  // namespace
+
+Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
+                            const MemoryModel& memory, std::optional<uint64_t> budget,
+                            const std::vector<uint32_t>& n, const std::vector<float>& importanceIn,
+                            const std::vector<uint32_t>& oracleK) {
+  std::vector<float> sanitized;
+  const std::vector<float>& importance = usableImportance(importanceIn, sanitized);
+  const uint64_t pixels = frame.pixels();
+  Allocation a;
+  a.capacity.assign(pixels, 0);
+  a.kind.assign(pixels, StoreKind::MaxArray);
+
+  auto inBudget = budgetSlots(frame, method, memory, budget);
+  if (!inBudget) return inBudget.error();
+  if (method.allocation == AllocationPolicy::NoNodes) {  // wboit, mboit: accumulators only
+    a.offsets.assign(pixels, 0);
+    return a;
+  }
+  uint64_t covered = 0;
+  for (uint32_t c : n) covered += c > 0;
+  const AllocationInputs in{frame, method, memory, budget, n, *inBudget, covered};
+
+  switch (method.allocation) {
+    case AllocationPolicy::Unbounded:
+      MFR_TRY(allocateUnbounded(in, a));
+      break;
+    case AllocationPolicy::FixedK:
+      MFR_TRY(allocateFixedK(in, a));
+      break;
+    case AllocationPolicy::CountedK:
+    case AllocationPolicy::DynamicK:
+      MFR_TRY(allocateBoundedK(in, a));
+      break;
+    case AllocationPolicy::Importance:
+      MFR_TRY(allocateByImportance(in, importance, a));
+      break;
+    case AllocationPolicy::NoNodes:  // returned above
+      break;
+    case AllocationPolicy::Optimal:
+      MFR_TRY(allocateOptimal(in, oracleK, a));
+      break;
+  }
+  if (a.reservedK.empty()) a.reservedSlots = a.slots;
+
+  for (size_t p = 0; p < pixels; ++p)
+    a.kind[p] = pickStore(method.store, n.empty() ? a.capacity[p] + 1 : n[p], a.capacity[p]);
+  tileMajorOffsets(frame, a);
   return a;
 }
 

@@ -301,10 +301,11 @@ std::string sizeText(const Image8& image) {
   return s;
 }
 
-}  // namespace
+// The eight planes the filter passes write along rows and read along columns: the reference's
+// four, then the test's.
+using RowPlanes = std::array<Plane, 8>;
 
-Result<FlipResult> computeFlip(const Image8& reference, const Image8& test,
-                               double pixelsPerDegree) {
+Result<void> checkFlipInputs(const Image8& reference, const Image8& test, double pixelsPerDegree) {
   if (reference.width != test.width || reference.height != test.height) {
     std::string message = "FLIP needs images of the same size: reference is ";
     message += sizeText(reference);
@@ -318,25 +319,18 @@ Result<FlipResult> computeFlip(const Image8& reference, const Image8& test,
     message += ")";
     return makeError(message);
   }
-  const int w = reference.width, h = reference.height;
-  const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
+  const size_t n = static_cast<size_t>(reference.width) * static_cast<size_t>(reference.height);
   if (reference.rgba.size() != n * 4 || test.rgba.size() != n * 4)
     return makeError("FLIP: image pixel data does not match its size");
   if (!std::isfinite(pixelsPerDegree) || pixelsPerDegree <= 0.0)
     return makeError("FLIP: pixels per degree must be finite and positive");
-  const float ppd = static_cast<float>(pixelsPerDegree);
+  return {};
+}
 
-  std::array<float, 256> decode;
-  for (int c = 0; c < 256; ++c) decode[c] = srgbToLinear(static_cast<float>(c) / 255.0f);
-
-  // Stage 1: both images to YCxCz.
-  const YCxCzPlanes ref = toYCxCz(reference, decode);
-  const YCxCzPlanes tst = toYCxCz(test, decode);
-
-  // Stage 2a: spatial (CSF) filtering along rows: Y, Cx and the two Cz terms of both images.
-  const SpatialFilters sf = makeSpatialFilters(ppd);
-  std::array<Plane, 8> rows;  // ref Y, Cx, Cz1, Cz2, then the test's
-  for (Plane& p : rows) p.resize(n);
+// Stage 2a: spatial (CSF) filtering along rows: Y, Cx and the two Cz terms of both images
+// (rows: ref Y, Cx, Cz1, Cz2, then the test's).
+void spatialFilterRows(const YCxCzPlanes& ref, const YCxCzPlanes& tst, const SpatialFilters& sf,
+                       int w, int h, RowPlanes& rows) {
   forRows(h, [&](int y) {
     std::vector<float> padded(static_cast<size_t>(w) + 2 * sf.radius);
     const size_t o = static_cast<size_t>(y) * w;
@@ -352,11 +346,13 @@ Result<FlipResult> computeFlip(const Image8& reference, const Image8& test,
       convolveRow(padded.data(), sf.cz2, w, rows[4 * i + 3].data() + o);
     }
   });
+}
 
-  // Stage 2b: along columns, then the colour difference per pixel.
+// Stage 2b: along columns, then the colour difference per pixel.
+Plane colorDifference(const RowPlanes& rows, const SpatialFilters& sf, int w, int h) {
   const float cmax = maxColorDifference();
   const float pccmax = kPc * cmax;
-  Plane colorDiff(n);
+  Plane colorDiff(static_cast<size_t>(w) * static_cast<size_t>(h));
   forRows(h, [&](int y) {
     std::vector<float> acc(static_cast<size_t>(w) * 8);
     for (int c = 0; c < 8; ++c) {
@@ -386,12 +382,15 @@ Result<FlipResult> computeFlip(const Image8& reference, const Image8& test,
       colorDiff[static_cast<size_t>(y) * w + x] = d;
     }
   });
+  return colorDiff;
+}
 
-  // Stage 3a: feature filters along rows on normalised luminance: derivatives in x (dg, ddg) and
-  // the Gaussian (for the y derivatives of the next pass).
-  const FeatureFilters ff = makeFeatureFilters(ppd);
+// Stage 3a: feature filters along rows on normalised luminance: derivatives in x (dg, ddg) and
+// the Gaussian (for the y derivatives of the next pass). Reuses the colour pass's planes: ref dx,
+// ddx, g in rows[0..2], test's in rows[4..6].
+void featureFilterRows(const YCxCzPlanes& ref, const YCxCzPlanes& tst, const FeatureFilters& ff,
+                       int w, int h, RowPlanes& rows) {
   const float oneOver116 = 1.0f / 116.0f, sixteenOver116 = 16.0f / 116.0f;
-  // reuse the colour pass's planes: ref dx, ddx, g in rows[0..2], test's in rows[4..6]
   forRows(h, [&](int y) {
     std::vector<float> lum(static_cast<size_t>(w));
     std::vector<float> padded(static_cast<size_t>(w) + 2 * ff.radius);
@@ -405,11 +404,13 @@ Result<FlipResult> computeFlip(const Image8& reference, const Image8& test,
       convolveRow(padded.data(), ff.g, w, rows[4 * i + 2].data() + o);
     }
   });
+}
 
-  // Stage 3b + 4: along columns, edge and point strengths, feature difference, final error.
-  FlipResult result;
-  result.width = w;
-  result.height = h;
+// Stage 3b + 4: along columns, edge and point strengths, feature difference, final error per
+// pixel into result.errorMap and its mean into result.mean.
+void featureErrors(const RowPlanes& rows, const FeatureFilters& ff, const Plane& colorDiff, int w,
+                   int h, FlipResult& result) {
+  const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
   result.errorMap.resize(n);
   std::vector<double> rowSums(static_cast<size_t>(h));
   const float invSqrt2 = 1.0f / std::sqrt(2.0f);
@@ -443,6 +444,37 @@ Result<FlipResult> computeFlip(const Image8& reference, const Image8& test,
   double total = 0.0;
   for (double s : rowSums) total += s;
   result.mean = total / static_cast<double>(n);
+}
+
+}  // namespace
+
+Result<FlipResult> computeFlip(const Image8& reference, const Image8& test,
+                               double pixelsPerDegree) {
+  MFR_TRY(checkFlipInputs(reference, test, pixelsPerDegree));
+  const int w = reference.width, h = reference.height;
+  const size_t n = static_cast<size_t>(w) * static_cast<size_t>(h);
+  const float ppd = static_cast<float>(pixelsPerDegree);
+
+  std::array<float, 256> decode;
+  for (int c = 0; c < 256; ++c) decode[c] = srgbToLinear(static_cast<float>(c) / 255.0f);
+
+  // Stage 1: both images to YCxCz.
+  const YCxCzPlanes ref = toYCxCz(reference, decode);
+  const YCxCzPlanes tst = toYCxCz(test, decode);
+
+  const SpatialFilters sf = makeSpatialFilters(ppd);
+  RowPlanes rows;
+  for (Plane& p : rows) p.resize(n);
+  spatialFilterRows(ref, tst, sf, w, h, rows);
+  const Plane colorDiff = colorDifference(rows, sf, w, h);
+
+  const FeatureFilters ff = makeFeatureFilters(ppd);
+  featureFilterRows(ref, tst, ff, w, h, rows);
+
+  FlipResult result;
+  result.width = w;
+  result.height = h;
+  featureErrors(rows, ff, colorDiff, w, h, result);
   return result;
 }
 

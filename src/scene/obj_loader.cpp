@@ -218,20 +218,24 @@ Result<std::vector<uint32_t>> scanFaces(const std::string& text) {
   return faces;
 }
 
-Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
-                            const LoadOptions& options) {
-  const uint64_t memoryLimit = options.memoryLimitBytes.value_or(defaultMemoryLimit());
-  auto text = file.readText(memoryLimit);
-  if (!text) return text.error();
-  auto faceCorners = scanFaces(*text);
-  if (!faceCorners) return makeError(path + ": " + faceCorners.error().message);
-  std::istringstream stream(*text);
+// What tinyobjloader read: vertex attributes, shapes, materials and each material's MTL file.
+struct ObjData {
   tinyobj::attrib_t attrib;
   std::vector<tinyobj::shape_t> shapes;
-  std::vector<tinyobj::material_t> objMaterials;
+  std::vector<tinyobj::material_t> materials;
+  std::vector<fs::path> mtlFiles;  // the MTL file of each material, by material index
+};
+
+// The OBJ text through tinyobjloader (polygons kept whole), its MTL files confined as the
+// options say; its warnings about out-of-range indices are errors.
+Result<ObjData> parseObj(const std::string& path, const std::string& text,
+                         const LoadOptions& options) {
+  std::istringstream stream(text);
+  ObjData obj;
+  tinyobj::attrib_t& attrib = obj.attrib;
   std::string warn, err;
   MtlReader mtlReader(path, options.allowOutsideReferences);
-  const bool loaded = tinyobj::LoadObj(&attrib, &shapes, &objMaterials, &warn, &err, &stream,
+  const bool loaded = tinyobj::LoadObj(&attrib, &obj.shapes, &obj.materials, &warn, &err, &stream,
                                        &mtlReader, /*triangulate=*/false);  // polygon.hpp
   if (!mtlReader.refusal.empty()) return makeError(path + ": " + mtlReader.refusal);
   if (!loaded) {
@@ -242,16 +246,19 @@ Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
   if (const std::string bad = lineContaining(warn, {"out of bounds", "invalid vertex index"});
       !bad.empty())
     return makeError(path + ": " + bad);
-  restoreNonFiniteCoordinates(*text, attrib.vertices);
+  obj.mtlFiles = std::move(mtlReader.files);
+  return obj;
+}
 
-  Scene scene;
-  scene.name = path;
-
-  // Materials (plus a default one, appended when some face needs it).
+// Materials with their map_Kd textures (each file loaded once).
+Result<void> addObjMaterials(const std::string& path,
+                             const std::vector<tinyobj::material_t>& materials,
+                             const std::vector<fs::path>& mtlFiles, const LoadOptions& options,
+                             uint64_t memoryLimit, Scene& scene) {
   std::map<std::string, int> textureByPath;
   uint64_t textureBytes = 0;
-  for (size_t m = 0; m < objMaterials.size(); ++m) {
-    const tinyobj::material_t& src = objMaterials[m];
+  for (size_t m = 0; m < materials.size(); ++m) {
+    const tinyobj::material_t& src = materials[m];
     Material material;
     material.name = src.name;
     const float alpha = std::clamp(static_cast<float>(src.dissolve), 0.0f, 1.0f);
@@ -260,7 +267,7 @@ Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
     if (!src.diffuse_texname.empty()) {
       std::string name = src.diffuse_texname;
       std::replace(name.begin(), name.end(), '\\', '/');  // paths written on Windows
-      const fs::path mtlFile = m < mtlReader.files.size() ? mtlReader.files[m] : fs::path(path);
+      const fs::path mtlFile = m < mtlFiles.size() ? mtlFiles[m] : fs::path(path);
       const std::string what = "map_Kd " + quoteInput(name);
       auto file = openReference(mtlFile, name, what, options.allowOutsideReferences);
       if (!file) return makeError(path + ": " + file.error().message);
@@ -276,23 +283,41 @@ Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
     }
     scene.materials.push_back(std::move(material));
   }
-  uint32_t defaultMaterial = UINT32_MAX;
-  auto materialFor = [&](int id) -> uint32_t {
-    if (id >= 0 && static_cast<size_t>(id) < objMaterials.size()) return static_cast<uint32_t>(id);
-    if (defaultMaterial == UINT32_MAX) {
+  return {};
+}
+
+// The default material, appended the first time some face needs it.
+struct DefaultMaterial {
+  Scene& scene;
+  size_t objMaterials;
+  uint32_t index = UINT32_MAX;
+
+  uint32_t materialFor(int id) {
+    if (id >= 0 && static_cast<size_t>(id) < objMaterials) return static_cast<uint32_t>(id);
+    if (index == UINT32_MAX) {
       Material material;
       material.name = "default";
       material.alphaMode = AlphaMode::Opaque;
-      defaultMaterial = static_cast<uint32_t>(scene.materials.size());
+      index = static_cast<uint32_t>(scene.materials.size());
       scene.materials.push_back(std::move(material));
     }
-    return defaultMaterial;
-  };
+    return index;
+  }
+};
 
+// Whether every corner has a normal and whether any has a texture coordinate.
+struct CornerUse {
+  bool allNormals = true, anyUvs = false;
+};
+
+// Every corner's indices within the vertex, normal and texture-coordinate arrays.
+Result<CornerUse> checkCorners(const std::string& path, const ObjData& obj) {
+  const tinyobj::attrib_t& attrib = obj.attrib;
+  const std::vector<tinyobj::shape_t>& shapes = obj.shapes;
   const size_t vertexCount = attrib.vertices.size() / 3;
   const size_t normalCount = attrib.normals.size() / 3;
   const size_t uvCount = attrib.texcoords.size() / 2;
-  bool allNormals = true, anyUvs = false;
+  CornerUse use;
   for (const tinyobj::shape_t& shape : shapes)
     for (const tinyobj::index_t& corner : shape.mesh.indices) {
       if (corner.vertex_index < 0 || static_cast<size_t>(corner.vertex_index) >= vertexCount)
@@ -305,12 +330,19 @@ Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
       if (corner.texcoord_index >= 0 && static_cast<size_t>(corner.texcoord_index) >= uvCount)
         return makeError(path + ": face references missing texture coordinate " +
                          std::to_string(corner.texcoord_index + 1));
-      allNormals = allNormals && corner.normal_index >= 0;
-      anyUvs = anyUvs || corner.texcoord_index >= 0;
+      use.allNormals = use.allNormals && corner.normal_index >= 0;
+      use.anyUvs = use.anyUvs || corner.texcoord_index >= 0;
     }
+  return use;
+}
 
-  // One scene vertex per distinct (position, normal, uv) corner; polygons triangulated here
-  // (polygon.hpp), in time linear in their corners when convex.
+// One scene vertex per distinct (position, normal, uv) corner; polygons triangulated here
+// (polygon.hpp), in time linear in their corners when convex.
+Result<void> addObjFaces(const std::string& path, const ObjData& obj,
+                         const std::vector<uint32_t>& faceCorners, CornerUse use,
+                         DefaultMaterial& defaults, Scene& scene) {
+  const tinyobj::attrib_t& attrib = obj.attrib;
+  const std::vector<tinyobj::shape_t>& shapes = obj.shapes;
   std::unordered_map<CornerKey, uint32_t, CornerHash> vertexOf;
   // tinyobjloader keeps each face's corner count in a byte: the scan's counts, when they agree
   // with what it stored (they always should), else its own.
@@ -320,8 +352,8 @@ Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
     storedCorners += shape.mesh.indices.size();
   }
   uint64_t scannedCorners = 0;
-  for (const uint32_t corners : *faceCorners) scannedCorners += corners;
-  const bool useScan = faceCorners->size() == storedFaces && scannedCorners == storedCorners;
+  for (const uint32_t corners : faceCorners) scannedCorners += corners;
+  const bool useScan = faceCorners.size() == storedFaces && scannedCorners == storedCorners;
   size_t face = 0;
   std::vector<glm::vec3> polygon;
   std::vector<uint32_t> triangles;
@@ -329,7 +361,7 @@ Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
     const tinyobj::mesh_t& mesh = shape.mesh;
     size_t offset = 0;
     for (size_t f = 0; f < mesh.num_face_vertices.size(); ++f, ++face) {
-      const size_t corners = useScan ? (*faceCorners)[face] : mesh.num_face_vertices[f];
+      const size_t corners = useScan ? (faceCorners)[face] : mesh.num_face_vertices[f];
       if (corners < 3 || offset + corners > mesh.indices.size()) {  // no surface: skip
         offset += corners;
         continue;
@@ -345,10 +377,10 @@ Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
         return makeError(path + ": " + split.error().message + " (the face starting at vertex " +
                          std::to_string(mesh.indices[offset].vertex_index + 1) + ")");
       const uint32_t material =
-          materialFor(f < mesh.material_ids.size() ? mesh.material_ids[f] : -1);
+          defaults.materialFor(f < mesh.material_ids.size() ? mesh.material_ids[f] : -1);
       for (size_t t = 0; t < triangles.size(); ++t) {
         const tinyobj::index_t& corner = mesh.indices[offset + triangles[t]];
-        const CornerKey key{corner.vertex_index, allNormals ? corner.normal_index : -1,
+        const CornerKey key{corner.vertex_index, use.allNormals ? corner.normal_index : -1,
                             corner.texcoord_index};
         auto [it, inserted] =
             vertexOf.try_emplace(key, static_cast<uint32_t>(scene.positions.size()));
@@ -356,14 +388,14 @@ Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
           const auto v = static_cast<size_t>(key.v);
           scene.positions.emplace_back(attrib.vertices[3 * v], attrib.vertices[3 * v + 1],
                                        attrib.vertices[3 * v + 2]);
-          if (allNormals) {
+          if (use.allNormals) {
             const auto n = static_cast<size_t>(key.n);
             const glm::vec3 normal(attrib.normals[3 * n], attrib.normals[3 * n + 1],
                                    attrib.normals[3 * n + 2]);
             const float length = glm::length(normal);
             scene.normals.push_back(length > 0.0f ? normal / length : normal);
           }
-          if (anyUvs) {
+          if (use.anyUvs) {
             const auto uv = static_cast<size_t>(key.t);
             scene.uvs.push_back(key.t < 0 ? glm::vec2(0.0f)
                                           : glm::vec2(attrib.texcoords[2 * uv],
@@ -376,7 +408,28 @@ Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
       offset += corners;
     }
   }
-  if (scene.materials.empty()) materialFor(-1);  // no faces: still a well-formed material list
+  return {};
+}
+
+Result<Scene> buildObjScene(const std::string& path, const OpenFile& file,
+                            const LoadOptions& options) {
+  const uint64_t memoryLimit = options.memoryLimitBytes.value_or(defaultMemoryLimit());
+  auto text = file.readText(memoryLimit);
+  if (!text) return text.error();
+  auto faceCorners = scanFaces(*text);
+  if (!faceCorners) return makeError(path + ": " + faceCorners.error().message);
+  auto obj = parseObj(path, *text, options);
+  if (!obj) return obj.error();
+  restoreNonFiniteCoordinates(*text, obj->attrib.vertices);
+
+  Scene scene;
+  scene.name = path;
+  MFR_TRY(addObjMaterials(path, obj->materials, obj->mtlFiles, options, memoryLimit, scene));
+  DefaultMaterial defaults{scene, obj->materials.size()};
+  auto use = checkCorners(path, *obj);
+  if (!use) return use.error();
+  MFR_TRY(addObjFaces(path, *obj, *faceCorners, *use, defaults, scene));
+  if (scene.materials.empty()) defaults.materialFor(-1);  // no faces: still a well-formed list
 
   computeVertexNormals(scene);
   MFR_TRY(validateScene(scene));
