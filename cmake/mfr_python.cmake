@@ -43,6 +43,10 @@ file(GLOB MFR_PYTHON_SOURCES CONFIGURE_DEPENDS "${PROJECT_SOURCE_DIR}/python/src
 # NO_EXTRAS: no LTO (libmfr.a is not LTO-built; a 2-core link stays short)
 pybind11_add_module(mfr_python MODULE NO_EXTRAS ${MFR_PYTHON_SOURCES})
 target_link_libraries(mfr_python PRIVATE mfr)
+if(TARGET mfr_gl)  # engine="gl" (the GL engine registers itself when the module loads)
+  target_link_libraries(mfr_python PRIVATE mfr_gl)
+  target_compile_definitions(mfr_python PRIVATE MFR_HAS_GL=1)
+endif()
 target_compile_options(mfr_python PRIVATE ${MFR_WARNINGS})
 target_compile_definitions(mfr_python PRIVATE MFR_VERSION="${PROJECT_VERSION}")
 # the static library's symbols stay inside the module

@@ -15,11 +15,13 @@
 #include "mfr/compare/compare.hpp"
 #include "mfr/compare/compare_output.hpp"
 #include "mfr/compare/temporal.hpp"
+#include "mfr/compare/temporal_run.hpp"
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/dkb_model.hpp"
+#include "mfr/method/make_method.hpp"
 
 namespace mfr::cli {
 namespace {
@@ -129,73 +131,27 @@ void printSummary(const CompareResult& r) {
 int runTemporal(const CompareArgs& a, CompareOptions options, const std::string& version,
                 Engine& engine, const PreparedScene& prepared, Progress& progress,
                 OutputFolder& outFolder) {
-  const int frames = a.scene.orbit;
-  const float step =
-      a.orbitStep > 0.0 ? static_cast<float>(a.orbitStep) : 360.0f / static_cast<float>(frames);
-  const std::vector<Camera> path = orbitPath(prepared.cameras.front(), frames, step);
-  const fs::path dir(outFolder.staging());  // put in place as --out once complete
   const auto [versionNumber, info] = provenance(version);
-  TemporalStability temporal(a.pixelsPerDegree);
-  std::vector<std::string> folders;
-  std::vector<float> previousCosine;  // vkb's Fresnel term: the previous frame's nearest |n.v|
-  std::string engineName;
-  for (int f = 0; f < frames; ++f) {
-    auto view = engine.prepare(sceneView(prepared, a.scene, path[f]));
-    if (!view) return fail(echoPath(a.scene.source) + ": " + view.error().message);
-    options.previousNearestCosine = previousCosine;
-    options.progress = [&progress, f, frames](const std::string& stage, int done, int total) {
-      progress.set("frame " + std::to_string(f + 1) + "/" + std::to_string(frames) + ": " + stage,
-                   done, total);
-    };
-    auto result = runComparison(engine, **view, options);
-    if (!result) return fail(echoPath(a.scene.source) + ": " + result.error().message);
-    engineName = result->engine;
-    char folder[32];
-    std::snprintf(folder, sizeof folder, "frame_%03d", f);
-    folders.push_back(folder);
-    if (auto ready = prepareOutputFolder((dir / folder).string()); !ready)
-      return fail(ready.error().message);
-    auto written = writeComparison(result.value(), (dir / folder).string(), versionNumber, info);
-    if (!written) return fail(written.error().message);
-    if (auto added = temporal.add(result.value()); !added) return fail(added.error().message);
-    auto cosine = engine.nearestCosine(**view);
-    if (!cosine) return fail(echoPath(a.scene.source) + ": " + cosine.error().message);
-    previousCosine = std::move(cosine.value());
-  }
-  progress.set("writing " + a.out);
-  const TemporalResult t = temporal.result();
-  std::vector<std::string> plots;
-  for (const BudgetSpec& b : options.budgets)
-    for (const TemporalMeasure m : {TemporalMeasure::ExcessFlicker, TemporalMeasure::ErrorChange}) {
-      auto plot = temporalPlot(t, b.label, m);
-      if (!plot) continue;  // e.g. every method failed at this budget: nothing to draw
-      const std::string file = "temporal_" + b.fileLabel() +
-                               (m == TemporalMeasure::ErrorChange ? "_error_change" : "") + ".png";
-      if (auto w = writePng((dir / file).string(), plot.value()); !w)
-        return fail(w.error().message);
-      plots.push_back(file);
-    }
-  nlohmann::json j;
-  j["mfr_version"] = versionNumber;
-  j["scene"] = a.scene.source;
-  j["engine"] = engineName;
-  j["width"] = a.scene.width;
-  j["height"] = a.scene.height;
-  j["orbit"] = frames;
-  j["orbit_step_degrees"] = step;
-  j["frames"] = folders;
-  j["plots"] = plots;
-  j["temporal"] = temporalToJson(t);
-  const std::string jsonText = j.dump(2) + "\n";
-  if (auto w = writeFileAtomically((dir / "results.json").string(), jsonText); !w)
-    return fail(w.error().message);
-  if (auto w =
-          writeFileAtomically((dir / "report.html").string(),
-                              temporalReportHtml(t, a.scene.source, a.scene.width, a.scene.height,
-                                                 plots, folders, info.commandLine));
-      !w)
-    return fail(w.error().message);
+  TemporalRequest request;
+  request.scene = &prepared.scene;
+  request.source = a.scene.source;
+  request.start = prepared.cameras.front();
+  request.frames = a.scene.orbit;
+  request.stepDegrees = static_cast<float>(a.orbitStep);
+  request.width = a.scene.width;
+  request.height = a.scene.height;
+  request.versionNumber = versionNumber;
+  request.info = info;
+  request.progress = [&progress](const std::string& stage, int done, int total) {
+    progress.set(stage, done, total);
+  };
+  auto run = runTemporalComparison(engine, request, std::move(options), outFolder.staging());
+  if (!run) return fail(run.error().message);
   if (auto placed = outFolder.commit(); !placed) return fail(placed.error().message);
+  const TemporalResult& t = run->result;
+  const int frames = request.frames;
+  const float step = run->stepDegrees;
+  const std::string& jsonText = run->jsonText;
   progress.clear();
   if (!a.scene.quiet) {
     std::fprintf(stderr, "%s, %d frames %.3g degrees apart; ground truth flicker %.4f\n",
@@ -240,14 +196,8 @@ int run(const CompareArgs& a, const std::string& version) {
   }
   if (options.methods.empty()) return fail("--methods: the method list is empty");
   if (!a.model.empty()) {  // the model must be used by some method, not silently ignored
-    bool used = false;
-    for (const std::string& name : options.methods)
-      used = used || checkMethodOption(MethodOption::Model, methodPreset(name).value());
-    if (!used)
-      return fail(std::string("--model: none of the methods uses it (only ") +
-                  methodOptionRule(MethodOption::Model).appliesTo + ": " +
-                  presetsAccepting(MethodOption::Model) + ")");
-    auto model = loadDkbModel(a.model);
+    if (auto used = checkModelUsed(options.methods); !used) return fail(used.error().message);
+    auto model = loadMethodModel(a.model);
     if (!model) return fail(model.error().message);
     options.model = model.value();
   }
@@ -269,13 +219,10 @@ int run(const CompareArgs& a, const std::string& version) {
     options.compositing = compositing.value();
   }
   if (options.model)  // a model trained for the other compositing rule is refused up front
-    for (const std::string& name : options.methods) {
-      MethodDesc m = methodPreset(name).value();
-      if (!checkMethodOption(MethodOption::Model, m)) continue;
-      if (options.compositing) m.compositing = *options.compositing;
-      if (auto ok = checkModelForMethod(*options.model, a.model, m); !ok)
-        return fail("--model: " + ok.error().message);
-    }
+    if (auto fits =
+            checkComparisonModel(*options.model, a.model, options.methods, options.compositing);
+        !fits)
+      return fail(fits.error().message);
   if (a.capture == "parallel")
     options.capture = CaptureMode::FragmentParallel;
   else if (a.capture != "tile")

@@ -12,8 +12,6 @@
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/raster_frame.hpp"
-#include "mfr/scene/camera_spec.hpp"
-#include "mfr/scene/draw_order.hpp"
 
 namespace mfr::cli {
 
@@ -90,41 +88,26 @@ Result<uint64_t> SceneOptions::memoryLimitBytes() const {
   return bytes.value();
 }
 
-Result<PreparedScene> prepareScene(const SceneOptions& o) {
-  auto finiteAll = [](const std::vector<double>& v) {
-    for (double x : v)
-      if (!std::isfinite(x)) return false;
-    return true;
-  };
-  if (o.width < 1 || o.height < 1 || o.width > kMaxImageSize || o.height > kMaxImageSize)
-    return makeError("--width/--height " + std::to_string(o.width) + "x" +
-                     std::to_string(o.height) + ": must be in [1, " +
-                     std::to_string(kMaxImageSize) + "]");
-  MFR_TRY(checkThreads(o.threads, "--threads"));
-  if (o.orbit < 0 || o.orbit > 10000)
-    return makeError("--orbit " + std::to_string(o.orbit) + ": must be in [1, 10000]");
-  if (o.orbitView >= 0 && o.orbitView >= o.orbit)
-    return makeError("--orbit-view " + std::to_string(o.orbitView) + ": needs --orbit N with N > " +
-                     std::to_string(o.orbitView));
-  if (!(o.zoom >= 0.01 && o.zoom <= 100.0)) return makeError("--zoom: must be in [0.01, 100]");
-  if (o.orbitView < -1) return makeError("--orbit-view: must be a view index (0-based)");
-  if (o.alpha && !(*o.alpha >= 0.0 && *o.alpha <= 1.0))
-    return makeError("--alpha: must be in [0, 1]");
-  if (!finiteAll(o.background)) return makeError("--background: values must be finite numbers");
-  if (!(o.transmissionFloor >= 0.0 && o.transmissionFloor <= 1.0))
-    return makeError("--transmission-floor: must be in [0, 1]");
-  for (double b : o.background)
-    if (b < 0.0 || b > 1.0) return makeError("--background: components must be in [0, 1]");
-  std::optional<Camera> explicitCamera;
-  if (!o.camera.empty()) {
-    auto parsed = parseCameraSpec(o.camera, "--camera");
-    if (!parsed) return parsed.error();
-    explicitCamera = parsed.value();
-  }
-  if (o.view < -1) return makeError("--view: must be a camera index (0-based)");
-  if (!o.camera.empty() && o.view >= 0)
-    return makeError("--view and --camera: give one camera, not both");
+SceneRequest SceneOptions::request() const {
+  SceneRequest r;
+  r.width = width;
+  r.height = height;
+  r.camera = camera;
+  r.view = view;
+  r.orbit = orbit;
+  r.orbitView = orbitView;
+  r.zoom = zoom;
+  r.shuffleDrawOrder = shuffleDrawOrder;
+  r.alpha = alpha;
+  r.background = background;
+  r.transmissionFloor = transmissionFloor;
+  return r;
+}
 
+Result<PreparedScene> prepareScene(const SceneOptions& o) {
+  const SceneRequest request = o.request();
+  MFR_TRY(checkSceneRequest(request));
+  MFR_TRY(checkThreads(o.threads, "--threads"));
   auto memoryLimit = o.memoryLimitBytes();
   if (!memoryLimit) return memoryLimit.error();
 
@@ -136,29 +119,11 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
   auto loaded = loadScene(o.source, load);
   if (!loaded) return loaded.error();
   PreparedScene prepared{std::move(loaded.value()), {}, {}};
-  Scene& scene = prepared.scene;
-  if (o.shuffleDrawOrder) shuffleDrawOrder(scene, *o.shuffleDrawOrder);
-  if (o.alpha) scene.alphaOverride = static_cast<float>(*o.alpha);
-  if (o.background.size() == 3)
-    scene.background = glm::vec3(o.background[0], o.background[1], o.background[2]);
-
-  Camera camera;
-  if (explicitCamera) {
-    camera = *explicitCamera;
-  } else if (o.view >= 0) {
-    if (o.view >= static_cast<int>(scene.cameras.size()))
-      return makeError(echoPath(o.source) + ": --view " + std::to_string(o.view) +
-                       " but the scene has " + std::to_string(scene.cameras.size()) + " camera(s)");
-    camera = scene.cameras[o.view];
-  } else if (scene.defaultCamera) {
-    camera = *scene.defaultCamera;
-  } else {
-    camera = frameBounds(sceneBounds(scene));
-  }
-  camera.eye = camera.target + (camera.eye - camera.target) / static_cast<float>(o.zoom);
-  prepared.cameras = o.orbit > 0 ? orbit(camera, o.orbit) : std::vector<Camera>{camera};
-  if (o.orbitView > 0) prepared.previousCamera = prepared.cameras[o.orbitView - 1];
-  if (o.orbitView >= 0) prepared.cameras = {prepared.cameras[o.orbitView]};
+  applyToScene(request, prepared.scene);
+  auto views = sceneViews(prepared.scene, o.source, request);
+  if (!views) return views.error();
+  prepared.cameras = std::move(views->cameras);
+  prepared.previousCamera = views->previousCamera;
   return prepared;
 }
 
@@ -229,16 +194,6 @@ std::string presetHelp() {
 int fail(const std::string& message) {
   std::fprintf(stderr, "mfr: error: %s\n", message.c_str());
   return 1;
-}
-
-Result<std::shared_ptr<const learn::Model>> loadDkbModel(const std::string& path) {
-  auto model = learn::readModel(path);
-  if (!model) return model.error();
-  // an importance model (dkb, dkb-fill) or a curve model (dkb-curve): which one a method needs
-  // is checkModelForMethod's question
-  if (auto fits = checkDkbModel(model.value(), path); !fits)
-    if (!checkDkbCurveModel(model.value(), path)) return fits.error();
-  return std::make_shared<const learn::Model>(std::move(model.value()));
 }
 
 }  // namespace mfr::cli

@@ -17,6 +17,7 @@
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/scene/load.hpp"
+#include "mfr/scene/scene_request.hpp"
 
 namespace mfr::cli {
 
@@ -48,6 +49,8 @@ struct SceneOptions {
   void add(CLI::App& app, bool sceneArgument = true, bool engineOption = false);
   /// --memory-limit in bytes, or the default share of the physical memory.
   Result<uint64_t> memoryLimitBytes() const;
+  /// The scene options the library checks and applies (mfr/scene/scene_request.hpp).
+  SceneRequest request() const;
 };
 
 struct PreparedScene {
@@ -89,9 +92,6 @@ class Progress {
   bool printed_ = false;
   std::thread thread_;
 };
-
-/// Reads a model file for the deep k-buffer and checks that it fits (errors name the path).
-Result<std::shared_ptr<const learn::Model>> loadDkbModel(const std::string& path);
 
 /// " (applies to: fkb, kplus-array, ...)" for an option's help text, from the option table.
 std::string appliesTo(MethodOption option);

@@ -49,6 +49,7 @@ from ._mfr import (  # noqa: F401  (re-exported)
     builtin_model,
     decode_srgb,
     encode_srgb,
+    engine_names,
     preset_names,
     read_png,
     write_png,
@@ -57,7 +58,7 @@ from ._mfr import (  # noqa: F401  (re-exported)
 __all__ = [
     "DEFAULT_COMPARE_METHODS", "DKB_LAYERS", "FEATURE_COUNT", "FEATURE_SET", "FLIP_DEFAULT_PPD",
     "TARGET_SCALING", "Dataset", "Error", "Model", "RenderResult", "Scene", "builtin_model",
-    "compare", "decode_srgb", "encode_srgb", "load_dataset", "load_model", "load_scene",
+    "compare", "decode_srgb", "encode_srgb", "engine_names", "load_dataset", "load_model", "load_scene",
     "make_model", "metrics", "parse_bytes", "preset_names", "read_png", "render",
     "save_dataset", "save_model", "write_png",
 ]
@@ -111,60 +112,80 @@ DEFAULT_COMPARE_METHODS = ("fkb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "dk
 
 
 def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1024, camera=None,
-           view=None, zoom=1.0, composite=None, capture="tile", threads=0, seed=1, model=None,
-           occupancy_d=None, importance=None, alpha=None, background=None, memory_limit=None,
-           depth_complexity=True) -> RenderResult:
-    """Renders one frame with one method, exactly as `mfr render` with the same options.
+           view=None, orbit=0, orbit_view=None, zoom=1.0, composite=None, capture="tile",
+           threads=0, seed=1, model=None, occupancy_d=None, importance=None, alpha=None,
+           background=None, transmission_floor=0.1, shuffle_draw_order=None, engine="cpu",
+           gl_sync="auto", memory_limit=None, allow_outside_references=False,
+           depth_complexity=True):
+    """Renders with one method, exactly as `mfr render` with the same options (the library checks
+    both the same way: its errors name the Python argument where the CLI names its flag).
 
     scene: an mfr.Scene, or a source string ("procedural:NAME[?k=v&...]" or a file), loaded with
-        `seed` (alpha and background then override its materials' alpha and its background;
+        `seed` and `transmission_floor` (alpha, background and shuffle_draw_order then change it;
         with an mfr.Scene they apply to a copy).
     method: a preset of mfr.preset_names() (optionally "NAME+occupancy").
-    budget: the memory budget M in bytes (int) or as text ("20MB", binary units); bounded
-        methods need it unless k is given.
+    budget: the memory budget M: bytes (int), a size ("20MB", binary units) or a share of the
+        exact A-buffer's node bytes ("25%", resolved on each view's count pass, as
+        `mfr render --budget 25%`); bounded methods need it unless k is given.
     k: explicit k (fixed, counted and dynamic-k presets). composite: "kbuffer" or "hybrid"
         (default: the preset's own rule). capture: "tile" or "parallel". occupancy_d: buckets
         32*d of a "+occupancy" method. model: a .mfrnn path or an mfr.Model (dkb*; default the
         built-in model). importance: vkb's parameters as a dict (alpha, n_limit, periphery_d,
         fovea, noise, depth_term, periphery_term, fresnel_term, noise_term).
-    camera: (eye xyz, target xyz[, up xyz[, fov degrees]]) as 6, 9 or 10 numbers; view: index of
-        a camera of the scene file; default: the scene's own camera, or one framing its bounds.
-        zoom: moves the camera zoom times closer to its target.
+    camera: (eye xyz, target xyz[, up xyz[, fov degrees]]) as 6, 9 or 10 numbers or the CLI's
+        text; view: index of a camera of the scene file; default: the scene's own camera, or one
+        framing its bounds. zoom: moves the camera zoom times closer to its target. orbit: N views
+        on a circle around the camera's target (a list of N results); orbit_view: only view I of
+        them (one result; view I - 1 feeds vkb's previous-frame term, as in the full orbit).
+    shuffle_draw_order: submit the triangles in this seed's random order.
+    engine: "cpu" or "gl" (mfr.engine_names()); gl_sync: the GL k-buffer's "auto", "lock" or
+        "interlock".
     threads: worker threads in [0, 1024] (0: all cores; the output does not depend on it).
         seed: procedural scenes and vkb's noise.
     memory_limit: refuse runs whose buffers need more (bytes or "8GB"; default 75% of the least
         of the physical memory, the address-space limit and the cgroup limit, as
-        `mfr --memory-limit`).
+        `mfr --memory-limit`). allow_outside_references: as `mfr --allow-outside-references`.
     depth_complexity: also count the fragments per pixel when the method does not.
 
-    Returns an mfr.RenderResult: image (float32 (h, w, 3) linear RGB), srgb (uint8 (h, w, 4), the
-    PNG's pixels), k_map (uint32 (h, w); None for methods without fragment slots, e.g. wboit),
-    depth_complexity (uint32 (h, w) or None), importance
-    (float32 (h, w) for vkb*/dkb*, else None) and stats (dict, the keys of --stats-json but
-    'image'). Raises mfr.Error with the library's message for bad input.
+    Returns an mfr.RenderResult (a list of them with orbit and no orbit_view): image (float32
+    (h, w, 3) linear RGB), srgb (uint8 (h, w, 4), the PNG's pixels), k_map (uint32 (h, w); None
+    for methods without fragment slots, e.g. wboit), depth_complexity (uint32 (h, w) or None),
+    importance (float32 (h, w) for vkb*/dkb*, else None) and stats (dict, the keys of
+    --stats-json but 'image'). Raises mfr.Error with the library's message for bad input.
     """
     return _render(scene, method=method, budget=budget, k=k, width=width, height=height,
-                   camera=camera, view=view, zoom=zoom, composite=composite, capture=capture,
-                   threads=threads, seed=seed, model=model, occupancy_d=occupancy_d,
-                   importance=importance, alpha=alpha, background=background,
-                   memory_limit=memory_limit, depth_complexity=depth_complexity)
+                   camera=camera, view=view, orbit=orbit, orbit_view=orbit_view, zoom=zoom,
+                   composite=composite, capture=capture, threads=threads, seed=seed, model=model,
+                   occupancy_d=occupancy_d, importance=importance, alpha=alpha,
+                   background=background, transmission_floor=transmission_floor,
+                   shuffle_draw_order=shuffle_draw_order, engine=engine, gl_sync=gl_sync,
+                   memory_limit=memory_limit, allow_outside_references=allow_outside_references,
+                   depth_complexity=depth_complexity)
 
 
 def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_METHODS, width=1024,
-            height=1024, camera=None, view=None, zoom=1.0, composite=None, capture="tile",
-            threads=0, seed=1, model=None, ppd=FLIP_DEFAULT_PPD, alpha=None,
-            background=None, memory_limit=None) -> dict:
+            height=1024, camera=None, view=None, orbit=0, orbit_view=None, orbit_step=0.0,
+            zoom=1.0,
+            composite=None, capture="tile", threads=0, seed=1, model=None, ppd=FLIP_DEFAULT_PPD,
+            alpha=None, background=None, transmission_floor=0.1, shuffle_draw_order=None,
+            engine="cpu", gl_sync="auto", memory_limit=None,
+            allow_outside_references=False) -> dict:
     """Writes the folder `mfr compare --out OUT` writes for the same options and returns its
     results.json as a dict.
 
     The ground truth (exact A-buffer) once, then every method at every budget, measured against
     it: OUT/ground_truth.png, ground_truth_depth_complexity.png, METHOD_BUDGET.png, _flip.png,
     _kmap.png, (_importance.png), results.json, results.csv and report.html (its command line
-    is this call). budgets: one budget or a list (bytes or "20MB" strings); methods: presets;
-    composite: "kbuffer" / "hybrid" for every method (default each preset's own rule); model:
-    the dkb* network (path or mfr.Model); ppd: FLIP's pixels per degree. scene, camera, view,
-    zoom, width, height, threads, seed, alpha, background, memory_limit: as in mfr.render. A method that fails
-    at a budget is recorded with its error; bad input raises mfr.Error.
+    is this call). budgets: one budget or a list (bytes, "20MB" sizes or "25%" shares of the
+    A-buffer); methods: presets; composite: "kbuffer" / "hybrid" for every method (default each
+    preset's own rule); model: the dkb* network (path or mfr.Model); ppd: FLIP's pixels per
+    degree. orbit=N: the temporal comparison of `mfr compare --orbit N` (every frame in
+    OUT/frame_NNN, the flicker of each method along the path in results.json and report.html;
+    orbit_step: degrees between frames, default 360/N); with orbit_view=I only view I of the N
+    is compared. scene, camera, view, zoom, width, height, threads, seed, alpha,
+    background, transmission_floor, shuffle_draw_order, engine, gl_sync, memory_limit,
+    allow_outside_references: as in mfr.render. A method that fails at a budget is recorded with
+    its error; bad input raises mfr.Error.
     """
     if isinstance(budgets, (str, int)):
         budgets = [budgets]
@@ -175,21 +196,30 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
             f"budgets={list(budgets)!r}", f"methods={list(methods)!r}",
             f"width={width!r}", f"height={height!r}"]
     for name, value, default in (("camera", camera, None), ("view", view, None),
+                                 ("orbit", orbit, 0), ("orbit_view", orbit_view, None),
+                                 ("orbit_step", orbit_step, 0.0),
                                  ("zoom", zoom, 1.0), ("composite", composite, None),
                                  ("capture", capture, "tile"), ("threads", threads, 0),
                                  ("seed", seed, 1), ("ppd", ppd, FLIP_DEFAULT_PPD),
                                  ("alpha", alpha, None), ("background", background, None),
-                                 ("memory_limit", memory_limit, None)):
+                                 ("transmission_floor", transmission_floor, 0.1),
+                                 ("shuffle_draw_order", shuffle_draw_order, None),
+                                 ("engine", engine, "cpu"), ("gl_sync", gl_sync, "auto"),
+                                 ("memory_limit", memory_limit, None),
+                                 ("allow_outside_references", allow_outside_references, False)):
         if value != default:
             call.append(f"{name}={value!r}")
     if model is not None:
         call.append(f"model={os.fspath(model)!r}" if not isinstance(model, Model) else
                     "model=<mfr.Model>")
     return _compare(scene, out, budgets=list(budgets), methods=list(methods), width=width,
-                    height=height, camera=camera, view=view, zoom=zoom,
-                    composite=composite, capture=capture, threads=threads, seed=seed,
+                    height=height, camera=camera, view=view, orbit=orbit, orbit_view=orbit_view,
+                    orbit_step=orbit_step, zoom=zoom, composite=composite, capture=capture, threads=threads, seed=seed,
                     model=model, ppd=ppd, alpha=alpha, background=background,
-                    memory_limit=memory_limit, command_line="mfr.compare(" + ", ".join(call) + ")")
+                    transmission_floor=transmission_floor, shuffle_draw_order=shuffle_draw_order,
+                    engine=engine, gl_sync=gl_sync, memory_limit=memory_limit,
+                    allow_outside_references=allow_outside_references,
+                    command_line="mfr.compare(" + ", ".join(call) + ")")
 
 
 # --- the deep k-buffer's models ----------------------------------------------------------------

@@ -4,9 +4,11 @@
 #include "common.hpp"
 #include "mfr/compare/compare.hpp"
 #include "mfr/compare/compare_output.hpp"
+#include "mfr/compare/temporal_run.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
-#include "mfr/cpu/cpu_engine.hpp"
+#include "mfr/engine/engine.hpp"
+#include "mfr/method/make_method.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
@@ -74,11 +76,22 @@ py::dict metrics(const py::object& referenceArg, const py::object& testArg, doub
 py::object compare(const py::object& sceneArg, const std::string& out,
                    const std::vector<py::object>& budgets, const std::vector<std::string>& methods,
                    int width, int height, const py::object& camera, const py::object& view,
-                   double zoom, const py::object& composite, const std::string& capture,
-                   int threads, uint64_t seed, const py::object& model, double ppd,
-                   const py::object& alpha, const py::object& background,
-                   const py::object& memoryLimitArg, const std::string& commandLine) {
+                   int orbit, const py::object& orbitView, double orbitStep, double zoom,
+                   const py::object& composite, const std::string& capture, int threads,
+                   uint64_t seed, const py::object& model, double ppd, const py::object& alpha,
+                   const py::object& background, double transmissionFloor,
+                   const py::object& shuffleDrawOrder, const std::string& engineName,
+                   const std::string& glSync, const py::object& memoryLimitArg,
+                   bool allowOutsideReferences, const std::string& commandLine) {
   if (out.empty()) throw LibraryError("out: an output folder is required");
+  const bool temporal = orbit != 0 && orbitView.is_none();  // every view of the orbit
+  if (temporal && orbit < 2)
+    throw LibraryError("orbit " + std::to_string(orbit) +
+                       ": a temporal comparison needs at least 2 frames (or give orbit_view)");
+  if (!(orbitStep >= 0.0 && orbitStep <= 360.0))
+    throw LibraryError("orbit_step: must be in (0, 360] degrees");
+  if (orbitStep > 0.0 && !temporal)
+    throw LibraryError("orbit_step: needs orbit N (and no orbit_view)");
   CompareOptions options;
   options.seed = seed;
   options.flipPixelsPerDegree = pixelsPerDegree(ppd);
@@ -90,15 +103,16 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     options.methods.push_back(name);
   }
   if (options.methods.empty()) throw LibraryError("methods: the method list is empty");
+  std::string modelName = "(mfr.Model)";
   if (!model.is_none()) {  // the model must be used by some method, not silently ignored
-    bool used = false;
-    for (const std::string& name : options.methods)
-      used = used || checkMethodOption(MethodOption::Model, methodPreset(name).value());
-    if (!used)
-      throw LibraryError(std::string("model: none of the methods uses it (only ") +
-                         methodOptionRule(MethodOption::Model).appliesTo + ": " +
-                         presetsAccepting(MethodOption::Model) + ")");
-    options.model = modelArgument(model);
+    unwrap(checkModelUsed(options.methods, Spelling::Python));
+    if (py::isinstance<learn::Model>(model)) {
+      options.model = model.cast<std::shared_ptr<learn::Model>>();
+    } else {
+      modelName = pathText(model, "model");
+      py::gil_scoped_release release;
+      options.model = unwrap(loadMethodModel(modelName));
+    }
   }
   for (const py::object& budget : budgets) {
     // a size ("20MB", bytes) or a share of the A-buffer's node bytes ("25%")
@@ -114,32 +128,67 @@ py::object compare(const py::object& sceneArg, const std::string& out,
   if (!composite.is_none())
     options.compositing =
         unwrap(parseCompositing(castArgument<std::string>(composite, "composite")));
+  if (options.model)  // a model trained for the other compositing rule is refused up front
+    unwrap(checkComparisonModel(*options.model, modelName, options.methods, options.compositing,
+                                Spelling::Python));
   options.capture = captureArgument(capture);
-  const RasterOptions ro = rasterArgument(width, height, threads);
+  const SceneRequest request =
+      sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
+                           transmissionFloor, shuffleDrawOrder);
+  unwrap(checkThreads(threads, "threads"));
   // checked and staged before any work; put in place as `out` once complete (as mfr compare)
   OutputFolder folder = unwrap(OutputFolder::begin(out));
 
   options.memoryLimitBytes = memoryLimitArgument(memoryLimitArg);
   const SceneArgument scene =
-      sceneArgument(sceneArg, seed, alpha, background, options.memoryLimitBytes);
+      sceneArgument(sceneArg, seed, request, options.memoryLimitBytes, allowOutsideReferences);
   options.scene = scene.source;
   options.background = scene.scene->background;
-  const Camera cam = cameraArgument(*scene.scene, camera, view, zoom);
+  const SceneViews views =
+      unwrap(sceneViews(*scene.scene, scene.source, request, Spelling::Python));
   std::string jsonText;
   {
     py::gil_scoped_release release;
-    CpuEngine engine(EngineOptions{ro.threads, ro.tileSize});
-    if (auto fits = checkComparisonFits(engine, ro.width, ro.height, options); !fits)
-      throw LibraryError(echoPath(scene.source) + ": " + fits.error().message);
-    auto view = engine.prepare(View{&*scene.scene, cam, ro.width, ro.height});
-    if (!view) throw LibraryError(echoPath(scene.source) + ": " + view.error().message);
-    auto result = runComparison(engine, **view, options);
-    if (!result) throw LibraryError(echoPath(scene.source) + ": " + result.error().message);
+    EngineOptions eo;
+    eo.threads = threads;
+    eo.glSync = glSync;
+    auto engine = unwrap(makeEngine(engineName, eo));
+    const auto named = [&](const Error& e) {
+      return LibraryError(echoPath(scene.source) + ": " + e.message);
+    };
+    if (auto fits = checkComparisonFits(*engine, width, height, options); !fits)
+      throw named(fits.error());
     ReportInfo info;
     info.mfrVersion = std::string("mfr ") + MFR_VERSION;
     info.commandLine = commandLine;
     info.generated = utcTimestamp();
-    jsonText = unwrap(writeComparison(result.value(), folder.staging(), MFR_VERSION, info));
+    if (temporal) {
+      TemporalRequest request;
+      request.scene = &*scene.scene;
+      request.source = scene.source;
+      request.start = views.cameras.front();
+      request.frames = orbit;
+      request.stepDegrees = static_cast<float>(orbitStep);
+      request.width = width;
+      request.height = height;
+      request.versionNumber = MFR_VERSION;
+      request.info = info;
+      jsonText =
+          unwrap(runTemporalComparison(*engine, request, options, folder.staging())).jsonText;
+    } else {
+      auto view = engine->prepare(View{&*scene.scene, views.cameras.front(), width, height});
+      if (!view) throw named(view.error());
+      if (views.previousCamera) {  // orbit_view I: view I - 1 precedes it (vkb's Fresnel term)
+        auto previous = engine->prepare(View{&*scene.scene, *views.previousCamera, width, height});
+        if (!previous) throw named(previous.error());
+        auto cosine = engine->nearestCosine(**previous);
+        if (!cosine) throw named(cosine.error());
+        options.previousNearestCosine = std::move(cosine.value());
+      }
+      auto result = runComparison(*engine, **view, options);
+      if (!result) throw named(result.error());
+      jsonText = unwrap(writeComparison(result.value(), folder.staging(), MFR_VERSION, info));
+    }
     unwrap(folder.commit());
   }
   return py::module_::import("json").attr("loads")(jsonText);
@@ -158,10 +207,12 @@ dict: width, height, mse_linear, mse_srgb, psnr_linear, psnr_srgb (inf when iden
 flip_map (LDR-FLIP per pixel, float32 (h, w) in [0, 1]).)");
   m.def("_compare", &compare, py::arg("scene"), py::arg("out"), py::kw_only(), py::arg("budgets"),
         py::arg("methods"), py::arg("width"), py::arg("height"), py::arg("camera"), py::arg("view"),
-        py::arg("zoom"), py::arg("composite"), py::arg("capture"), py::arg("threads"),
-        py::arg("seed"), py::arg("model"), py::arg("ppd"), py::arg("alpha"), py::arg("background"),
-        py::arg("memory_limit"), py::arg("command_line"),
-        "mfr.compare's work (see python/mfr/__init__.py).");
+        py::arg("orbit"), py::arg("orbit_view"), py::arg("orbit_step"), py::arg("zoom"),
+        py::arg("composite"), py::arg("capture"), py::arg("threads"), py::arg("seed"),
+        py::arg("model"), py::arg("ppd"), py::arg("alpha"), py::arg("background"),
+        py::arg("transmission_floor"), py::arg("shuffle_draw_order"), py::arg("engine"),
+        py::arg("gl_sync"), py::arg("memory_limit"), py::arg("allow_outside_references"),
+        py::arg("command_line"), "mfr.compare's work (see python/mfr/__init__.py).");
 }
 
 }  // namespace mfr::python

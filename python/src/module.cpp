@@ -14,12 +14,18 @@
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/cpu/render.hpp"
+#include "mfr/engine/render_views.hpp"
 #include "mfr/learn/model_file.hpp"
+#include "mfr/method/budget_spec.hpp"
+#include "mfr/method/make_method.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/method/stats_json.hpp"
 #include "mfr/scene/load.hpp"
 #include "scene_options.hpp"
+#ifdef MFR_HAS_GL
+#include "mfr/gl/gl_render_engine.hpp"
+#endif
 
 namespace mfr::python {
 
@@ -52,99 +58,35 @@ py::array viewOf(const Scalar* data, std::vector<py::ssize_t> shape, py::handle 
   return a;
 }
 
-Result<uint32_t> parseK(const py::object& k) {
-  const long long v = castArgument<long long>(k, "k");
-  if (v < 1 || v > (1 << 20)) return makeError("k: must be in [1, 1048576]");
-  return static_cast<uint32_t>(v);
-}
-
-/// The method as `mfr render` builds it from the same options (apps/mfr/cmd_render.cpp).
+/// The method as `mfr render` builds it from the same options: the library's makeMethod.
 MethodDesc buildMethod(const std::string& name, const py::object& k, const py::object& composite,
                        const py::object& model, const py::object& occupancyD,
                        const py::object& importance, uint64_t seed) {
-  MethodDesc m = unwrap(methodPreset(name));
-  const auto applicable = [&](MethodOption option, const char* argument) {
-    unwrap(checkMethodOption(option, m, argument));
-  };
-  if (!k.is_none()) {
-    applicable(MethodOption::K, "k");
-    const uint32_t value = unwrap(parseK(k));
-    if (m.name.rfind("zbuffer", 0) == 0 && value != 1) throw LibraryError("k: zbuffer has k = 1");
-    m.k = value;
-  }
-  if (!composite.is_none()) {
-    applicable(MethodOption::Composite, "composite");
-    m.compositing = unwrap(parseCompositing(castArgument<std::string>(composite, "composite")));
-  }
+  MethodOverrides o;
+  if (!k.is_none()) o.k = castArgument<long long>(k, "k");
+  if (!composite.is_none()) o.composite = castArgument<std::string>(composite, "composite");
+  if (!occupancyD.is_none()) o.occupancyD = castArgument<long long>(occupancyD, "occupancy_d");
   if (!model.is_none()) {
-    applicable(MethodOption::Model, "model");
-    m.model = modelArgument(model);
+    if (py::isinstance<learn::Model>(model))
+      o.model = model.cast<std::shared_ptr<learn::Model>>();
+    else if ((o.modelPath = pathText(model, "model")).empty())
+      throw LibraryError("model: empty path");
   }
-  if (!importance.is_none()) applicable(MethodOption::ImportanceParams, "importance");
-  if (m.allocation == AllocationPolicy::Importance) {
-    ImportanceParams ip;
-    if (!importance.is_none())
-      ip = importanceArgument(castArgument<py::dict>(importance, "importance"));
-    ip.seed = seed;
-    m.importance = ip;
-  }
-  if (!occupancyD.is_none()) {
-    applicable(MethodOption::OccupancyD, "occupancy_d");
-    const long long d = castArgument<long long>(occupancyD, "occupancy_d");
-    if (d < 1 || d > 64) throw LibraryError("occupancy_d: must be in [1, 64]");
-    m.occupancyWords = static_cast<int>(d);
-  }
-  return m;
+  if (!importance.is_none())
+    o.importance = importanceArgument(castArgument<py::dict>(importance, "importance"));
+  o.seed = seed;
+  py::gil_scoped_release release;  // a model file may be read
+  return unwrap(makeMethod(name, o, Spelling::Python));
 }
 
 struct PyRenderResult {
   py::object image, srgb, kMap, depthComplexity, importance, stats;
 };
 
-PyRenderResult renderScene(const py::object& sceneArg, const std::string& method,
-                           const py::object& budget, const py::object& k, int width, int height,
-                           const py::object& camera, const py::object& view, double zoom,
-                           const py::object& composite, const std::string& capture, int threads,
-                           uint64_t seed, const py::object& model, const py::object& occupancyD,
-                           const py::object& importance, const py::object& alpha,
-                           const py::object& background, const py::object& memoryLimitArg,
-                           bool wantDepthComplexity) {
-  const std::optional<uint64_t> memoryLimit = memoryLimitArgument(memoryLimitArg);
-  SceneArgument scene = sceneArgument(sceneArg, seed, alpha, background, memoryLimit);
-  const MethodDesc m = buildMethod(method, k, composite, model, occupancyD, importance, seed);
-  RenderOptions options;
-  if (!budget.is_none()) options.budgetBytes = budgetArgument(budget);
-  options.capture = captureArgument(capture);
-  options.background = scene.scene->background;
-  options.memoryLimitBytes = memoryLimit;
-  RasterOptions ro = rasterArgument(width, height, threads);
-  const Camera cam = cameraArgument(*scene.scene, camera, view, zoom);
-
-  RenderOutput out;
-  {
-    py::gil_scoped_release release;
-    CpuEngine engine(EngineOptions{ro.threads, ro.tileSize});
-    if (auto fits = engine.preflight(ro.width, ro.height, m, options); !fits)
-      throw LibraryError(echoPath(scene.source) + ": " + fits.error().message);
-    auto view = engine.prepare(View{&*scene.scene, cam, ro.width, ro.height});
-    if (!view) throw LibraryError(echoPath(scene.source) + ": " + view.error().message);
-    auto rendered = engine.render(**view, m, options);
-    if (!rendered) throw LibraryError(echoPath(scene.source) + ": " + rendered.error().message);
-    out = std::move(rendered.value());
-    if (wantDepthComplexity && out.depthComplexity.empty())
-      out.depthComplexity = unwrap(engine.countFragments(**view));
-  }
-
-  // the statistics exactly as `mfr render --stats-json` writes them (less "image": no file)
-  nlohmann::json stats = statsToJson(out.stats);
-  stats["scene"] = scene.source;
-  stats["width"] = ro.width;
-  stats["height"] = ro.height;
-  stats["view"] = 0;
-  stats["compositing"] = toString(m.compositing);
-  stats["capture"] = capture;
-
-  const py::ssize_t h = ro.height, w = ro.width;
+/// One view's output as Python values; the statistics exactly as `mfr render --stats-json`
+/// writes them (less "image": no file).
+PyRenderResult renderResult(RenderOutput&& out, nlohmann::json stats, int width, int height) {
+  const py::ssize_t h = height, w = width;
   const size_t pixels = static_cast<size_t>(h) * static_cast<size_t>(w);
   // a per-pixel map, or None when the method has none (e.g. no fragment slots, no importance)
   const auto map = [&](auto&& values) -> py::object {
@@ -161,6 +103,78 @@ PyRenderResult renderScene(const py::object& sceneArg, const std::string& method
   r.importance = map(std::move(out.importance.importance));
   r.stats = toPython(stats);
   return r;
+}
+
+py::object renderScene(const py::object& sceneArg, const std::string& method,
+                       const py::object& budget, const py::object& k, int width, int height,
+                       const py::object& camera, const py::object& view, int orbit,
+                       const py::object& orbitView, double zoom, const py::object& composite,
+                       const std::string& capture, int threads, uint64_t seed,
+                       const py::object& model, const py::object& occupancyD,
+                       const py::object& importance, const py::object& alpha,
+                       const py::object& background, double transmissionFloor,
+                       const py::object& shuffleDrawOrder, const std::string& engineName,
+                       const std::string& glSync, const py::object& memoryLimitArg,
+                       bool allowOutsideReferences, bool wantDepthComplexity) {
+  const std::optional<uint64_t> memoryLimit = memoryLimitArgument(memoryLimitArg);
+  const SceneRequest request =
+      sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
+                           transmissionFloor, shuffleDrawOrder);
+  unwrap(checkThreads(threads, "threads"));
+  const MethodDesc m = buildMethod(method, k, composite, model, occupancyD, importance, seed);
+  RenderOptions options;
+  std::optional<BudgetSpec> spec;
+  if (!budget.is_none()) spec = budgetSpecArgument(budget);
+  options.capture = captureArgument(capture);
+  options.memoryLimitBytes = memoryLimit;
+  const SceneArgument scene =
+      sceneArgument(sceneArg, seed, request, memoryLimit, allowOutsideReferences);
+  options.background = scene.scene->background;
+  const SceneViews views =
+      unwrap(sceneViews(*scene.scene, scene.source, request, Spelling::Python));
+
+  struct Rendered {
+    RenderOutput output;
+    nlohmann::json stats;
+  };
+  std::vector<Rendered> rendered;
+  {
+    py::gil_scoped_release release;
+    EngineOptions eo;
+    eo.threads = threads;
+    eo.glSync = glSync;
+    auto engine = unwrap(makeEngine(engineName, eo));
+    if (spec) options.budgetBytes = spec->bytes;
+    if (auto fits = engine->preflight(width, height, m, options); !fits)
+      throw LibraryError(echoPath(scene.source) + ": " + fits.error().message);
+    unwrap(renderViews(*engine, *scene.scene, scene.source, views, width, height, m, options, spec,
+                       [&](const RenderedView& r) -> Result<void> {
+                         RenderOutput out = std::move(r.output);
+                         if (wantDepthComplexity && out.depthComplexity.empty()) {
+                           auto counted = engine->countFragments(r.view);
+                           if (!counted) return counted.error();
+                           out.depthComplexity = std::move(counted.value());
+                         }
+                         nlohmann::json stats = statsToJson(out.stats);
+                         stats["scene"] = scene.source;
+                         stats["width"] = width;
+                         stats["height"] = height;
+                         stats["view"] = r.index;
+                         stats["compositing"] = toString(m.compositing);
+                         stats["capture"] = capture;
+                         if (spec && spec->isRelative()) stats["budget_label"] = spec->label;
+                         rendered.push_back({std::move(out), std::move(stats)});
+                         return {};
+                       }));
+  }
+  // one view: its result; an orbit of N views: a list of N results
+  if (rendered.size() == 1 && (orbit == 0 || !orbitView.is_none()))
+    return py::cast(
+        renderResult(std::move(rendered[0].output), std::move(rendered[0].stats), width, height));
+  py::list results;
+  for (Rendered& r : rendered)
+    results.append(py::cast(renderResult(std::move(r.output), std::move(r.stats), width, height)));
+  return results;
 }
 
 // --- images -----------------------------------------------------------------------------------
@@ -299,15 +313,20 @@ files outside its folder (`mfr --allow-outside-references`). Raises mfr.Error na
   m.def("render", &renderScene, py::arg("scene"), py::kw_only(), py::arg("method") = "abuffer",
         py::arg("budget") = py::none(), py::arg("k") = py::none(), py::arg("width") = 1024,
         py::arg("height") = 1024, py::arg("camera") = py::none(), py::arg("view") = py::none(),
-        py::arg("zoom") = 1.0, py::arg("composite") = py::none(), py::arg("capture") = "tile",
-        py::arg("threads") = 0, py::arg("seed") = 1, py::arg("model") = py::none(),
-        py::arg("occupancy_d") = py::none(), py::arg("importance") = py::none(),
-        py::arg("alpha") = py::none(), py::arg("background") = py::none(),
-        py::arg("memory_limit") = py::none(), py::arg("depth_complexity") = true,
+        py::arg("orbit") = 0, py::arg("orbit_view") = py::none(), py::arg("zoom") = 1.0,
+        py::arg("composite") = py::none(), py::arg("capture") = "tile", py::arg("threads") = 0,
+        py::arg("seed") = 1, py::arg("model") = py::none(), py::arg("occupancy_d") = py::none(),
+        py::arg("importance") = py::none(), py::arg("alpha") = py::none(),
+        py::arg("background") = py::none(), py::arg("transmission_floor") = 0.1,
+        py::arg("shuffle_draw_order") = py::none(), py::arg("engine") = "cpu",
+        py::arg("gl_sync") = "auto", py::arg("memory_limit") = py::none(),
+        py::arg("allow_outside_references") = false, py::arg("depth_complexity") = true,
         R"(Renders a scene (an mfr.Scene, or a source string loaded with `seed`) with one method, as
-`mfr render` does with the same options, and returns an mfr.RenderResult. See mfr.render's
-Python documentation (python/mfr/__init__.py) for the arguments.)");
+`mfr render` does with the same options, and returns an mfr.RenderResult (a list of them for an
+orbit of several views). See mfr.render's Python documentation (python/mfr/__init__.py) for the
+arguments.)");
 
+  m.def("engine_names", &engineNames, "The engines render and compare accept (\"cpu\", \"gl\").");
   m.def("preset_names", &presetNames,
         "The method presets (each bounded one also as NAME+occupancy).");
   m.def(
@@ -333,6 +352,9 @@ PYBIND11_MODULE(_mfr, m) {
   m.doc() = "mfr: bounded-memory multi-fragment rendering (the C++ library's Python binding)";
   m.attr("__version__") = MFR_VERSION;
   py::register_exception<LibraryError>(m, "Error", PyExc_RuntimeError);
+#ifdef MFR_HAS_GL
+  mfr::gl::registerGlEngine();  // engine="gl"
+#endif
   addSceneAndRender(m);
   addMetricsAndCompare(m);
   addLearn(m);

@@ -7,6 +7,7 @@
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
+#include "mfr/method/budget_spec.hpp"
 #include "mfr/scene/camera_spec.hpp"
 #include "mfr/scene/load.hpp"
 
@@ -70,20 +71,80 @@ std::shared_ptr<Scene> loadSceneArgument(const std::string& source, uint64_t see
   return scene;
 }
 
-SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const py::object& alpha,
-                            const py::object& background, std::optional<uint64_t> memoryLimit) {
+SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const SceneRequest& request,
+                            std::optional<uint64_t> memoryLimit, bool allowOutsideReferences) {
   if (!py::isinstance<Scene>(scene)) {
     if (!py::isinstance<py::str>(scene) && !py::hasattr(scene, "__fspath__"))
       throw py::type_error("scene: expected an mfr.Scene or a source (str or os.PathLike)");
     const std::string source = pathText(scene, "scene");
-    return {loadSceneArgument(source, seed, 0.1, alpha, background, memoryLimit), source};
+    LoadOptions load;
+    load.seed = seed;
+    load.transmissionAlphaFloor = static_cast<float>(request.transmissionFloor);
+    load.memoryLimitBytes = memoryLimit;
+    load.allowOutsideReferences = allowOutsideReferences;
+    auto loaded = std::make_shared<Scene>();
+    {
+      py::gil_scoped_release release;
+      *loaded = unwrap(loadScene(source, load));
+      applyToScene(request, *loaded);
+    }
+    return {loaded, source};
   }
   auto loaded = scene.cast<std::shared_ptr<Scene>>();
-  if (alpha.is_none() && background.is_none()) return {loaded, loaded->name};
+  if (!request.changesScene()) return {loaded, loaded->name};
   auto changed = std::make_shared<Scene>(*loaded);  // the caller's scene stays as it is
-  if (const auto a = alphaArgument(alpha)) changed->alphaOverride = a;
-  if (!background.is_none()) changed->background = backgroundArgument(background);
+  applyToScene(request, *changed);
   return {changed, loaded->name};
+}
+
+SceneRequest sceneRequestArgument(int width, int height, const py::object& camera,
+                                  const py::object& view, int orbit, const py::object& orbitView,
+                                  double zoom, const py::object& alpha,
+                                  const py::object& background, double transmissionFloor,
+                                  const py::object& shuffleDrawOrder) {
+  SceneRequest r;
+  r.width = width;
+  r.height = height;
+  if (!camera.is_none()) {
+    if (py::isinstance<py::str>(camera)) {  // the command line's text, "EX,EY,EZ,TX,TY,TZ,..."
+      r.camera = camera.cast<std::string>();
+      if (r.camera.empty()) throw LibraryError("camera: empty");
+    } else {
+      if (!py::isinstance<py::iterable>(camera))
+        throw py::type_error("camera: expected 6, 9 or 10 numbers or a str, got " +
+                             std::string(py::str(camera.get_type().attr("__name__"))));
+      for (const py::handle item : camera)
+        r.cameraNumbers.push_back(
+            castArgument<double>(item, "camera[" + std::to_string(r.cameraNumbers.size()) + "]"));
+      if (r.cameraNumbers.empty()) throw LibraryError("camera: expected 6, 9 or 10 numbers");
+    }
+  }
+  if (!view.is_none()) {
+    const long long v = castArgument<long long>(view, "view");
+    r.view = v < 0 ? -2 : static_cast<int>(std::min<long long>(v, 1 << 30));
+  }
+  r.orbit = orbit;
+  if (!orbitView.is_none()) {
+    const long long v = castArgument<long long>(orbitView, "orbit_view");
+    r.orbitView = v < 0 ? -2 : static_cast<int>(std::min<long long>(v, 1 << 30));
+  }
+  r.zoom = zoom;
+  if (!alpha.is_none()) r.alpha = castArgument<double>(alpha, "alpha");
+  if (!background.is_none()) r.background = numbers(background, "background");
+  r.transmissionFloor = transmissionFloor;
+  if (!shuffleDrawOrder.is_none())
+    r.shuffleDrawOrder = castArgument<uint64_t>(shuffleDrawOrder, "shuffle_draw_order");
+  unwrap(checkSceneRequest(r, Spelling::Python));
+  return r;
+}
+
+BudgetSpec budgetSpecArgument(const py::object& budget) {
+  if (py::isinstance<py::str>(budget)) {
+    auto spec = parseBudgetSpec(budget.cast<std::string>());
+    if (!spec) throw LibraryError("budget: " + spec.error().message);
+    return spec.value();
+  }
+  return BudgetSpec(budgetArgument(budget));
 }
 
 uint64_t budgetArgument(const py::object& budget) {
@@ -117,109 +178,36 @@ CaptureMode captureArgument(const std::string& capture) {
   throw LibraryError("capture " + quoteInput(capture) + ": expected tile or parallel");
 }
 
-RasterOptions rasterArgument(int width, int height, int threads) {
-  if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize)
-    throw LibraryError("width/height " + std::to_string(width) + "x" + std::to_string(height) +
-                       ": must be in [1, " + std::to_string(kMaxImageSize) + "]");
-  unwrap(checkThreads(threads, "threads"));
-  RasterOptions ro;
-  ro.width = width;
-  ro.height = height;
-  ro.threads = threads;
-  return ro;
-}
-
-Camera cameraArgument(const Scene& scene, const py::object& camera, const py::object& view,
-                      double zoom) {
-  if (!(zoom >= 0.01 && zoom <= 100.0)) throw LibraryError("zoom: must be in [0.01, 100]");
-  if (!camera.is_none() && !view.is_none())
-    throw LibraryError("view and camera: give one camera, not both");
-  Camera c;
-  if (!camera.is_none()) {
-    if (py::isinstance<py::str>(camera)) {  // the command line's text, "EX,EY,EZ,TX,TY,TZ,..."
-      c = unwrap(parseCameraSpec(camera.cast<std::string>(), "camera"));
-    } else {
-      if (!py::isinstance<py::iterable>(camera))
-        throw py::type_error("camera: expected 6, 9 or 10 numbers or a str, got " +
-                             std::string(py::str(camera.get_type().attr("__name__"))));
-      std::vector<double> v;
-      for (const py::handle item : camera)
-        v.push_back(castArgument<double>(item, "camera[" + std::to_string(v.size()) + "]"));
-      c = unwrap(cameraFromNumbers(v, "camera"));
-    }
-  } else if (!view.is_none()) {
-    const long long i = castArgument<long long>(view, "view");
-    if (i < 0) throw LibraryError("view: must be a camera index (0-based)");
-    if (i >= static_cast<long long>(scene.cameras.size()))
-      throw LibraryError(scene.name + ": view " + std::to_string(i) + " but the scene has " +
-                         std::to_string(scene.cameras.size()) + " camera(s)");
-    c = scene.cameras[static_cast<size_t>(i)];
-  } else if (scene.defaultCamera) {
-    c = *scene.defaultCamera;
-  } else {
-    c = frameBounds(sceneBounds(scene));
-  }
-  c.eye = c.target + (c.eye - c.target) / static_cast<float>(zoom);
-  return c;
-}
-
-std::shared_ptr<const learn::Model> modelArgument(const py::object& model) {
-  if (py::isinstance<py::str>(model) || py::hasattr(model, "__fspath__")) {
-    const std::string path = pathText(model, "model");
-    learn::Model read;
-    {
-      py::gil_scoped_release release;
-      read = unwrap(learn::readModel(path));
-    }
-    unwrap(checkDkbModel(read, path));
-    return std::make_shared<const learn::Model>(std::move(read));
-  }
-  if (!py::isinstance<learn::Model>(model))
-    throw py::type_error("model: expected an mfr.Model or a .mfrnn path");
-  auto object = model.cast<std::shared_ptr<learn::Model>>();
-  unwrap(checkDkbModel(*object, "(mfr.Model)"));
-  return object;
-}
-
-ImportanceParams importanceArgument(const py::dict& params) {
-  ImportanceParams ip;
+ImportanceOverrides importanceArgument(const py::dict& params) {
+  ImportanceOverrides o;
   for (const auto& [key, value] : params) {
     const std::string k = py::str(key);
     const std::string name = "importance[" + quoteInput(k) + "]";
-    const auto number = [&](float lo, float hi, bool openLow) {
-      const double v = castArgument<double>(value, name);
-      if (!(openLow ? v > lo : v >= lo) || !(v <= hi))
-        throw LibraryError(name + ": must be in " + (openLow ? "(" : "[") + std::to_string(lo) +
-                           ", " + std::to_string(hi) + "]");
-      return static_cast<float>(v);
-    };
     if (k == "alpha") {
-      ip.alpha = number(0.0f, 1.0f, false);
+      o.alpha = castArgument<double>(value, name);
     } else if (k == "n_limit") {
-      ip.nLimit = number(1.0f, 1e6f, false);
+      o.nLimit = castArgument<double>(value, name);
     } else if (k == "periphery_d") {
-      ip.peripheryExponent = number(0.0f, 100.0f, true);
+      o.peripheryD = castArgument<double>(value, name);
     } else if (k == "noise") {
-      ip.noise = number(0.0f, 1.0f, false);
+      o.noise = castArgument<double>(value, name);
     } else if (k == "fovea") {
-      const std::vector<double> v = numbers(value.cast<py::object>(), "importance['fovea']");
-      if (v.size() != 2) throw LibraryError("importance['fovea']: expected two pixel coordinates");
-      ip.fovea = glm::vec2(v[0], v[1]);
+      o.fovea = numbers(value.cast<py::object>(), "importance['fovea']");
     } else if (k == "depth_term") {
-      ip.useDepth = castArgument<bool>(value, name);
+      o.depthTerm = castArgument<bool>(value, name);
     } else if (k == "periphery_term") {
-      ip.usePeriphery = castArgument<bool>(value, name);
+      o.peripheryTerm = castArgument<bool>(value, name);
     } else if (k == "fresnel_term") {
-      ip.useFresnel = castArgument<bool>(value, name);
+      o.fresnelTerm = castArgument<bool>(value, name);
     } else if (k == "noise_term") {
-      ip.useNoise = castArgument<bool>(value, name);
+      o.noiseTerm = castArgument<bool>(value, name);
     } else {
       throw LibraryError("importance: unknown parameter " + quoteInput(k) +
                          " (alpha, n_limit, periphery_d, fovea, noise, depth_term, "
                          "periphery_term, fresnel_term, noise_term)");
     }
   }
-  return ip;
+  return o;
 }
 
 Image8 image8Argument(const py::array& image, const char* what) {

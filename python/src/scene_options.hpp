@@ -11,8 +11,11 @@
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/cpu/render.hpp"
 #include "mfr/learn/model_file.hpp"
+#include "mfr/method/budget_spec.hpp"
 #include "mfr/method/importance.hpp"
+#include "mfr/method/make_method.hpp"
 #include "mfr/scene/scene.hpp"
+#include "mfr/scene/scene_request.hpp"
 
 namespace mfr::python {
 
@@ -28,10 +31,23 @@ std::shared_ptr<Scene> loadSceneArgument(const std::string& source, uint64_t see
                                          std::optional<uint64_t> memoryLimit,
                                          bool allowOutsideReferences = false);
 
-/// An mfr.Scene (copied only when alpha or background must change it) or a source string
-/// (loaded with `seed`).
-SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const py::object& alpha,
-                            const py::object& background, std::optional<uint64_t> memoryLimit);
+/// An mfr.Scene (copied only when the request changes it: draw order, alpha, background) or a
+/// source string (loaded with `seed`, the request's transmission floor and overrides applied).
+SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const SceneRequest& request,
+                            std::optional<uint64_t> memoryLimit,
+                            bool allowOutsideReferences = false);
+
+/// The scene options as the library checks them (checkSceneRequest, Python spelling): camera as
+/// 6, 9 or 10 numbers or the command line's text, the file's camera `view`, an orbit of N views
+/// (or view `orbit_view` of it), zoom, alpha, background, transmission floor, draw order.
+SceneRequest sceneRequestArgument(int width, int height, const py::object& camera,
+                                  const py::object& view, int orbit, const py::object& orbitView,
+                                  double zoom, const py::object& alpha,
+                                  const py::object& background, double transmissionFloor,
+                                  const py::object& shuffleDrawOrder);
+
+/// A budget: bytes as an int, a size ("20MB") or a share of the A-buffer ("25%").
+BudgetSpec budgetSpecArgument(const py::object& budget);
 
 /// None, or alpha in [0, 1].
 std::optional<float> alphaArgument(const py::object& alpha);
@@ -43,19 +59,10 @@ uint64_t budgetArgument(const py::object& budget);
 std::optional<uint64_t> memoryLimitArgument(const py::object& limit);
 /// "tile" or "parallel".
 CaptureMode captureArgument(const std::string& capture);
-/// width, height in [1, kMaxImageSize], threads in [0, 1024] (0 = all cores).
-RasterOptions rasterArgument(int width, int height, int threads);
-/// The camera as `mfr render` picks it: `camera` (6, 9 or 10 numbers: eye, target, [up, [fov]], or
-/// that text, checked by cameraFromNumbers / parseCameraSpec),
-/// or the scene's camera `view`, or the scene's default camera / one framing its bounds; then
-/// moved `zoom` times closer to its target.
-Camera cameraArgument(const Scene& scene, const py::object& camera, const py::object& view,
-                      double zoom);
-/// An mfr.Model or a .mfrnn path; checked to fit the deep k-buffer (checkDkbModel).
-std::shared_ptr<const learn::Model> modelArgument(const py::object& model);
 /// vkb's importance parameters from a dict (alpha, n_limit, periphery_d, fovea, noise,
-/// depth_term, periphery_term, fresnel_term, noise_term), defaults for keys not given.
-ImportanceParams importanceArgument(const py::dict& params);
+/// depth_term, periphery_term, fresnel_term, noise_term): their types here, their ranges in
+/// makeMethod.
+ImportanceOverrides importanceArgument(const py::dict& params);
 /// An image array: uint8 (h, w, 3|4) sRGB (alpha set to 255 for 3 channels), or floating-point
 /// (h, w, 3) linear RGB, sRGB-encoded with encodeSrgb. `what` names it in errors.
 Image8 image8Argument(const py::array& image, const char* what);

@@ -146,3 +146,28 @@ def test_relative_budgets_match_the_cli(tmp_path, cli):
     assert vkb["budget_bytes"] - dynamic["budget_bytes"] == SIZE * SIZE * 1 - 4096
     with pytest.raises(Exception, match="0%"):
         mfr.compare(SCENE, tmp_path / "bad", ["0%"], methods=["vkb"], width=SIZE, height=SIZE)
+
+
+def test_temporal_orbit_and_orbit_view_match_the_cli(tmp_path, cli):
+    # orbit=N: the CLI's temporal comparison (frames, flicker, plots); orbit_view: one view of it
+    import subprocess
+    common = ["--width", "24", "--height", "20", "--budget", "50%", "--methods", "fkb,vkb",
+              "--threads", "2", "--quiet"]
+    subprocess.run([cli, "compare", SCENE, "--orbit", "3", "--orbit-step", "5", *common,
+                    "--out", str(tmp_path / "cli_t")], check=True)
+    py_t = mfr.compare(SCENE, tmp_path / "py_t", "50%", methods=["fkb", "vkb"], width=24,
+                       height=20, threads=2, orbit=3, orbit_step=5)
+    cli_t = read_json(tmp_path / "cli_t" / "results.json")
+    assert without_times(cli_t) == without_times(py_t)
+    assert py_t["frames"] == ["frame_000", "frame_001", "frame_002"]
+    for frame in py_t["frames"]:
+        assert (tmp_path / "cli_t" / frame / "ground_truth.png").read_bytes() == \
+            (tmp_path / "py_t" / frame / "ground_truth.png").read_bytes()
+    subprocess.run([cli, "compare", SCENE, "--orbit", "4", "--orbit-view", "2", *common,
+                    "--out", str(tmp_path / "cli_v")], check=True)
+    py_v = mfr.compare(SCENE, tmp_path / "py_v", "50%", methods=["fkb", "vkb"], width=24,
+                       height=20, threads=2, orbit=4, orbit_view=2)
+    assert without_times(read_json(tmp_path / "cli_v" / "results.json")) == without_times(py_v)
+    with pytest.raises(mfr.Error, match=r"^orbit_step: needs orbit N"):
+        mfr.compare(SCENE, tmp_path / "x", "50%", methods=["fkb"], width=24, height=20,
+                    orbit_step=5)

@@ -121,10 +121,27 @@ CASES = [
     (dict(method="kplus-heap", k=2, alpha=0.4, background=(0.1, 0.2, 0.3), capture="parallel"),
      ["-m", "kplus-heap", "--k", "2", "--alpha", "0.4", "--background", "0.1,0.2,0.3",
       "--capture", "parallel"]),
+    # options the library's makeMethod and scene request took over from the front ends
+    (dict(method="vkb", budget="25%"), ["-m", "vkb", "-M", "25%"]),
+    (dict(method="kplus-sb", budget="40%", composite="hybrid"),
+     ["-m", "kplus-sb", "-M", "40%", "--composite", "hybrid"]),
+    (dict(method="vkb", budget="80KB", importance={"fovea": (10, 5), "n_limit": 8,
+                                                   "fresnel_term": False, "noise_term": False}),
+     ["-m", "vkb", "-M", "80KB", "--fovea", "10,5", "--n-limit", "8", "--no-fresnel-term",
+      "--no-noise"]),
+    (dict(method="vkb", budget="30%", orbit=5, orbit_view=3),
+     ["-m", "vkb", "-M", "30%", "--orbit", "5", "--orbit-view", "3"]),
+    (dict(method="mlab", k=2, shuffle_draw_order=7), ["-m", "mlab", "--k", "2",
+                                                       "--shuffle-draw-order", "7"]),
+    (dict(method="kplus-array", k=3, engine="gl"),
+     ["-m", "kplus-array", "--k", "3", "--engine", "gl"]),
+    (dict(method="wboit", budget="50%", engine="gl"),
+     ["-m", "wboit", "-M", "50%", "--engine", "gl"]),
 ]
 
 
-@pytest.mark.parametrize("kwargs,flags", CASES, ids=[c[0]["method"] for c in CASES])
+@pytest.mark.parametrize("kwargs,flags", CASES,
+                         ids=[f"{i}-{c[0]['method']}" for i, c in enumerate(CASES)])
 def test_render_equals_cli(tmp_path, run_cli, kwargs, flags):
     scene = "procedural:bottles?count=3"
     png, stats = tmp_path / "cli.png", tmp_path / "stats.json"
@@ -141,9 +158,38 @@ def test_render_equals_cli(tmp_path, run_cli, kwargs, flags):
     # fragment-parallel capture: which thread's k+ test rejects a fragment first is a race, so
     # the culling counts vary from run to run (the captured sets and the image do not)
     racy = {"culled", "inserted", "evicted"} if kwargs.get("capture") == "parallel" else set()
+    if kwargs.get("engine") == "gl":  # the GL engine's buffer sizes and timer counters
+        racy |= {"engine_counters"}
     assert without_times({k: v for k, v in cli_stats.items() if k not in {"image"} | racy}) == \
         without_times({k: v for k, v in r.stats.items() if k not in racy})
     assert set(cli_stats["time_ms"]) == set(r.stats["time_ms"])
+
+
+def test_orbit_renders_every_view_as_the_cli(tmp_path, run_cli):
+    # an orbit without orbit_view: one result per view, the CLI's out_vNNN.png and stats array;
+    # a relative budget is resolved on each view's own count pass, vkb carries n.v across views
+    scene = "procedural:bottles?count=3"
+    run_cli("render", scene, "--width", W, "--height", H, "--quiet", "-m", "vkb", "-M", "25%",
+            "--orbit", 3, "-o", tmp_path / "o.png", "--stats-json", tmp_path / "s.json")
+    results = mfr.render(scene, width=W, height=H, method="vkb", budget="25%", orbit=3)
+    assert isinstance(results, list) and len(results) == 3
+    cli_stats = read_json(tmp_path / "s.json")
+    assert len(cli_stats) == 3
+    budgets = set()
+    for v, r in enumerate(results):
+        mfr.write_png(tmp_path / f"py{v}.png", r.srgb)
+        assert (tmp_path / f"py{v}.png").read_bytes() == (tmp_path / f"o_v{v:03d}.png").read_bytes()
+        assert r.stats["view"] == v
+        assert without_times({k: x for k, x in cli_stats[v].items() if k != "image"}) == \
+            without_times(r.stats)
+        budgets.add(r.stats["budget_bytes"])
+    assert len(budgets) > 1  # each view's own A-buffer
+
+
+def test_engine_names_and_bad_engine():
+    assert mfr.engine_names()[0] == "cpu"
+    with pytest.raises(mfr.Error, match=r"engine"):
+        mfr.render("procedural:bottles", width=W, height=H, engine="vulkan")
 
 
 def test_k_map_and_depth_complexity_match_cli_maps(tmp_path, run_cli):
@@ -225,9 +271,9 @@ def test_errors_carry_the_librarys_messages(tmp_path, cli_error):
         message = str(e.value)
         assert "\n" not in message
         cli_message = cli_error(*args)
-        # the CLI prefixes option names ("--composite: ") where Python has none
-        assert message == cli_message or cli_message.endswith(": " + message), \
-            (message, cli_message)
+        # the same message, the option named as a flag there ("--budget: ") and as a keyword
+        # here ("budget: ")
+        assert message == cli_message or "--" + message == cli_message, (message, cli_message)
 
 
 @pytest.mark.parametrize("kwargs,pattern", [
@@ -254,6 +300,14 @@ def test_errors_carry_the_librarys_messages(tmp_path, cli_error):
     (dict(alpha=1.5), r"^alpha: must be in \[0, 1\]"),
     (dict(budget=-5, method="fkb"), r"^budget: must be a positive"),
     (dict(method="dkb", budget="1MB", model="/nonexistent/m.mfrnn"), r"/nonexistent/m.mfrnn"),
+    (dict(method="vkb", budget="lots"), r"^budget: "),
+    (dict(orbit=3, orbit_view=3), r"^orbit_view 3: needs orbit N with N > 3"),
+    (dict(orbit_view=0), r"^orbit_view 0: needs orbit N"),
+    (dict(method="vkb", budget="1MB", importance={"fovea": (1, 2, 3)}),
+     r"^importance\['fovea'\]: expected two finite pixel coordinates"),
+    (dict(method="vkb", budget="1MB", importance={"periphery_d": 0}),
+     r"^importance\['periphery_d'\]: must be in \(0, 100\]"),
+    (dict(method="kplus-dynamic", budget="1MB", k=0), r"^k: must be in"),
 ])
 def test_bad_options_raise_mfr_error(kwargs, pattern):
     args = dict(width=W, height=H)

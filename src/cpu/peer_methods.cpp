@@ -7,8 +7,9 @@
 //   mlab   Salvi & Vaidyanathan, "Multi-layer Alpha Blending", I3D 2014 (mlab.hpp): k blended
 //          nodes per pixel (the fixed-k allocation's offsets and capacity), insertion in depth
 //          order, merge of the two farthest when full, front-to-back resolve.
-// They run inside render()'s pass structure (allocate -> [moments] -> capture -> resolve) on the
-// same rasterizer; only the per-pixel update and the resolve differ from the k-buffer family.
+// Each is a type (mfr/method/peer_method.hpp) run by the one template below inside render()'s pass
+// structure (allocate -> [its extra passes, e.g. moments] -> capture -> resolve) on the same
+// rasterizer; only the per-pixel update and the resolve differ from the k-buffer family.
 // Tile-owned mode: a pixel's fragments arrive in primitive order on one worker (no locks, the
 // float sums in a fixed order). Fragment-parallel mode: any interleaving, each update under the
 // pixel's spin-lock (the lock word MemoryModel charges in that mode or for mlab).
@@ -79,6 +80,29 @@ uint64_t forEachFragment(const RasterFrame& frame, CaptureMode mode, Stores& sto
   return total;
 }
 
+/// The CPU engine's run of one peer method (peer_method.hpp): its buffer, each of its geometry
+/// passes, its resolve.
+template <class Peer>
+struct PeerRun {
+  using Slot = typename Peer::Slot;
+
+  static Slot* slotsOf(Stores& stores, const Allocation& a, uint32_t p) {
+    Slot* base = stores.peer.template data<Slot>();
+    if constexpr (Peer::kNodes) return base + a.offsets[p];
+    return base + p;
+  }
+
+  static uint64_t pass(const RasterFrame& frame, const Allocation& a, CaptureMode mode,
+                       Stores& stores, int pass) {
+    return forEachFragment(frame, mode, stores, [&](const Fragment& f) {
+      const uint32_t p = f.pixel;
+      Peer::add(PeerPixel<Slot>{slotsOf(stores, a, p), stores.counts[p],
+                                Peer::kNodes ? a.capacity[p] : 1u},
+                pass, f.depth, f.rgba);
+    });
+  }
+};
+
 }  // namespace
 
 bool isPeerRule(Compositing c) {
@@ -87,92 +111,51 @@ bool isPeerRule(Compositing c) {
 
 void allocatePeerStores(const MethodDesc& method, const Allocation& allocation, size_t pixels,
                         Stores& stores) {
-  switch (method.compositing) {
-    case Compositing::WeightedBlended:
-      stores.wboit.assign(pixels, WboitPixel{});
-      break;
-    case Compositing::MomentBased:
-      stores.mboit.assign(pixels, MboitPixel{});
-      break;
-    case Compositing::MultiLayerAlpha:
-      stores.mlab.assign(allocation.slots, MlabNode{});
-      break;
-    case Compositing::KBuffer:
-    case Compositing::Hybrid:
-      break;
-  }
+  visitPeer(method.compositing, [&]<class Peer>() {
+    stores.peer.assign<typename Peer::Slot>(Peer::kNodes ? allocation.slots : pixels);
+    stores.peerHoldsNodes = Peer::kNodes;
+  });
 }
 
-void accumulateMoments(const RasterFrame& frame, CaptureMode mode, Stores& stores) {
-  (void)forEachFragment(frame, mode, stores, [&](const Fragment& f) {
-    stores.mboit[f.pixel].addMoments(f.depth, static_cast<float>(f.rgba >> 24) / 255.0f);
+void runPeerPass(const RasterFrame& frame, const MethodDesc& method, const Allocation& allocation,
+                 CaptureMode mode, Stores& stores, int pass) {
+  visitPeer(method.compositing, [&]<class Peer>() {
+    (void)PeerRun<Peer>::pass(frame, allocation, mode, stores, pass);
   });
 }
 
 CaptureCounters capturePeer(const RasterFrame& frame, const MethodDesc& method,
                             const Allocation& allocation, CaptureMode mode, Stores& stores) {
   CaptureCounters c;
-  switch (method.compositing) {
-    case Compositing::WeightedBlended:
-      c.generated = forEachFragment(frame, mode, stores, [&](const Fragment& f) {
-        stores.wboit[f.pixel].add(f.depth, f.rgba);
-        ++stores.counts[f.pixel];
-      });
-      c.inserted = c.generated;
-      break;
-    case Compositing::MomentBased:
-      c.generated = forEachFragment(frame, mode, stores, [&](const Fragment& f) {
-        stores.mboit[f.pixel].addColor(f.depth, f.rgba);
-        ++stores.counts[f.pixel];
-      });
-      c.inserted = c.generated;
-      break;
-    case Compositing::MultiLayerAlpha: {
-      c.generated = forEachFragment(frame, mode, stores, [&](const Fragment& f) {
-        const uint32_t p = f.pixel;
-        (void)mlabInsert(stores.mlab.data() + allocation.offsets[p], stores.counts[p],
-                         allocation.capacity[p], MlabNode::fromFragment(f.depth, f.rgba));
-      });
+  visitPeer(method.compositing, [&]<class Peer>() {
+    const int capturePass = static_cast<int>(Peer::kExtraPasses.size());
+    c.generated = PeerRun<Peer>::pass(frame, allocation, mode, stores, capturePass);
+    if constexpr (Peer::kNodes) {
       // a fragment either opened a node or was blended into a farther one (a merge)
       uint64_t nodes = 0;
       for (uint32_t n : stores.counts) nodes += n;
       c.inserted = nodes;
       c.evicted = c.generated - nodes;
-      break;
+    } else {
+      c.inserted = c.generated;
     }
-    case Compositing::KBuffer:
-    case Compositing::Hybrid:
-      break;
-  }
+  });
   return c;
 }
 
 ImageRGB resolvePeer(const RasterFrame& frame, const MethodDesc& method,
-                     const Allocation& allocation, const Stores& stores, glm::vec3 background) {
+                     const Allocation& allocation, Stores& stores, glm::vec3 background) {
   ImageRGB image(frame.width(), frame.height());
-  frame.forEachTile([&](int tile) {
-    const TileRect r = frame.tileRect(tile);
-    for (int y = r.y0; y <= r.y1; ++y)
-      for (int x = r.x0; x <= r.x1; ++x) {
-        const size_t p = static_cast<size_t>(y) * frame.width() + x;
-        glm::vec3& out = image.pixels[p];
-        switch (method.compositing) {
-          case Compositing::WeightedBlended:
-            out = stores.wboit[p].composite(background);
-            break;
-          case Compositing::MomentBased:
-            out = stores.mboit[p].composite(background);
-            break;
-          case Compositing::MultiLayerAlpha:
-            out = compositeMlab(stores.mlab.data() + allocation.offsets[p], stores.counts[p],
-                                background);
-            break;
-          case Compositing::KBuffer:
-          case Compositing::Hybrid:
-            out = background;
-            break;
+  visitPeer(method.compositing, [&]<class Peer>() {
+    frame.forEachTile([&](int tile) {
+      const TileRect r = frame.tileRect(tile);
+      for (int y = r.y0; y <= r.y1; ++y)
+        for (int x = r.x0; x <= r.x1; ++x) {
+          const uint32_t p = static_cast<uint32_t>(y) * frame.width() + x;
+          image.pixels[p] = Peer::composite(PeerRun<Peer>::slotsOf(stores, allocation, p),
+                                            stores.counts[p], background);
         }
-      }
+    });
   });
   return image;
 }

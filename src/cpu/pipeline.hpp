@@ -1,11 +1,14 @@
 // Internal state shared by the passes of render(): the allocation and the per-pixel stores.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "mfr/core/isa.hpp"
@@ -14,10 +17,8 @@
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/allocation.hpp"
 #include "mfr/method/compositing.hpp"
-#include "mfr/method/mboit.hpp"
 #include "mfr/method/memory_model.hpp"
-#include "mfr/method/mlab.hpp"
-#include "mfr/method/wboit.hpp"
+#include "mfr/method/peer_method.hpp"
 
 namespace mfr::detail {
 
@@ -76,15 +77,38 @@ class UninitializedBuffer {
   size_t size_ = 0;
 };
 
+/// A peer method's buffer (peer_method.hpp): its Slots, one per pixel or k(p) per pixel, of the
+/// type the method names (trivially copyable float state, value-initialised by assign).
+class PeerBuffer {
+ public:
+  template <class Slot>
+  void assign(size_t n) {
+    static_assert(std::is_trivially_copyable_v<Slot> && alignof(Slot) <= alignof(std::max_align_t));
+    storage_.reset(n ? new std::max_align_t[(n * sizeof(Slot) + sizeof(std::max_align_t) - 1) /
+                                            sizeof(std::max_align_t)]
+                     : nullptr);
+    Slot* slots = data<Slot>();
+    for (size_t i = 0; i < n; ++i) new (slots + i) Slot{};
+    bytes_ = n * sizeof(Slot);
+  }
+  template <class Slot>
+  Slot* data() {
+    return std::launder(reinterpret_cast<Slot*>(storage_.get()));
+  }
+  uint64_t bytes() const { return bytes_; }
+
+ private:
+  std::unique_ptr<std::max_align_t[]> storage_;
+  uint64_t bytes_ = 0;
+};
+
 struct Stores {
   UninitializedBuffer<FragmentNode> nodes;
   std::vector<uint32_t> counts;
   std::vector<uint32_t> locks;
   std::vector<HybridTail> tails;  // empty unless hybrid
-  // the peer methods' buffers (peer_methods.cpp), empty for the others
-  std::vector<WboitPixel> wboit;  // per pixel
-  std::vector<MboitPixel> mboit;  // per pixel
-  std::vector<MlabNode> mlab;     // k(p) per pixel at offsets[p] (the node pool of mlab)
+  PeerBuffer peer;                // the peer method's accumulators or nodes (peer_methods.cpp)
+  bool peerHoldsNodes = false;    // the peer buffer holds nodes (mlab), not accumulators
 };
 
 /// The instruction set capture() runs this method on (what the statistics report as "isa").
@@ -95,16 +119,18 @@ CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,
                         const Allocation& allocation, const OccupancyMap* occupancy,
                         CaptureMode mode, Stores& stores);
 
-/// The peer methods (wboit, mboit, mlab): their buffers, the MBOIT moments pass, the capture
-/// (accumulation / MLAB insertion; counts[p] is the fragments accumulated, or MLAB's nodes in use)
-/// and the resolve. Fragment-parallel mode takes the per-pixel spin-lock around each update.
+/// The peer methods (mfr/method/peer_method.hpp: wboit, mboit, mlab) through one template: their
+/// buffer, their extra geometry passes (pass i of Peer::kExtraPasses), the capture (accumulation
+/// or MLAB insertion; counts[p] is the fragments accumulated, or MLAB's nodes in use) and the
+/// resolve. Fragment-parallel mode takes the per-pixel spin-lock around each update.
 bool isPeerRule(Compositing c);
 void allocatePeerStores(const MethodDesc& method, const Allocation& allocation, size_t pixels,
                         Stores& stores);
-void accumulateMoments(const RasterFrame& frame, CaptureMode mode, Stores& stores);
+void runPeerPass(const RasterFrame& frame, const MethodDesc& method, const Allocation& allocation,
+                 CaptureMode mode, Stores& stores, int pass);
 CaptureCounters capturePeer(const RasterFrame& frame, const MethodDesc& method,
                             const Allocation& allocation, CaptureMode mode, Stores& stores);
 ImageRGB resolvePeer(const RasterFrame& frame, const MethodDesc& method,
-                     const Allocation& allocation, const Stores& stores, glm::vec3 background);
+                     const Allocation& allocation, Stores& stores, glm::vec3 background);
 
 }  // namespace mfr::detail

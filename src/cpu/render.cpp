@@ -20,6 +20,7 @@
 #include "mfr/cpu/optimal_oracle.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/optimal_allocation.hpp"
+#include "mfr/method/pass_plan.hpp"
 #include "pipeline.hpp"
 #include "sort_nodes.hpp"
 
@@ -84,7 +85,7 @@ void buildOccupancy(const RasterFrame& frame, const Allocation& alloc, Occupancy
 }
 
 ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method, const Allocation& alloc,
-                 const detail::Stores& stores, glm::vec3 background) {
+                 detail::Stores& stores, glm::vec3 background) {
   if (detail::isPeerRule(method.compositing))
     return detail::resolvePeer(frame, method, alloc, stores, background);
   ImageRGB image(frame.width(), frame.height());
@@ -176,77 +177,50 @@ Result<void> checkPixelBuffers(int width, int height, const MethodDesc& method,
                          options.memoryLimitBytes.value_or(defaultMemoryLimit()));
 }
 
-static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodDesc& method,
-                                         const RenderOptions& options, uint64_t memoryLimit) {
-  if (method.occupancyWords < 0 || method.occupancyWords > 64)
-    return makeError(method.name + ": occupancy d must be in [1, 64]");
-  if (method.allocation == AllocationPolicy::Unbounded && method.occupancyWords > 0)
-    return makeError(method.name + ": occupancy culling needs a bounded k");
-  if (method.store == StoreChoice::Append && method.allocation != AllocationPolicy::Unbounded)
-    return makeError(method.name + ": the append store needs exact (unbounded) allocation");
-  // the peer methods' rules go with their own allocation and store (docs/METHODS.md)
-  const bool accumulates = method.compositing == Compositing::WeightedBlended ||
-                           method.compositing == Compositing::MomentBased;
-  if (accumulates != (method.allocation == AllocationPolicy::NoNodes) ||
-      accumulates != (method.store == StoreChoice::None))
-    return makeError(method.name + ": " + toString(method.compositing) +
-                     " compositing goes with no-nodes allocation and no store, and only it");
-  if ((method.compositing == Compositing::MultiLayerAlpha) !=
-          (method.store == StoreChoice::MultiLayer) ||
-      (method.store == StoreChoice::MultiLayer && method.allocation != AllocationPolicy::FixedK))
-    return makeError(method.name + ": the multi-layer store goes with fixed k and " +
-                     "multi-layer-alpha compositing, and only them");
-  if (detail::isPeerRule(method.compositing) && method.occupancyWords > 0)
-    return makeError(method.name + ": occupancy culling applies to k-buffers only");
-  RenderOutput out;
-  RenderStats& stats = out.stats;
-  stats.method = method.name;
-  stats.budgetBytes = options.budgetBytes;
-  PassTimer timer(stats.passes);
-  detail::BufferLedger ledger;
-  const size_t pixels = frame.pixelCount();
-  const MemoryModel memory =
-      MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
-  // memory pre-flight: the per-pixel buffers here (callers may have checked them before
-  // building the frame), the node pool after allocate
-  MFR_TRY(checkPixelBytes(frame.width(), frame.height(), method, options.capture, memoryLimit));
+namespace {
 
-  // count pass
-  // (the optimal oracle counts in its own A-buffer pre-pass)
-  // (the deep k-buffer's count pass also finds the image's depth range, a network input)
-  const bool deep = method.allocation == AllocationPolicy::Importance &&
-                    method.importanceSource == ImportanceSource::Network;
-  ImageFeatureStats imageFeatures;
-  if (deep)
+/// What the passes before the allocation hand to it.
+struct AllocationInputs {
+  ImageFeatureStats imageFeatures;  // dkb: the image's depth range, from the count pass
+  std::vector<uint32_t> oracleK;    // optimal, dkb-curve: k(p) chosen before allocate
+};
+
+/// count [+ depth range]: n(p) before the allocation.
+void countStep(const RasterFrame& frame, const PassPlan& plan, PassTimer& timer, RenderOutput& out,
+               AllocationInputs& inputs, detail::BufferLedger& ledger) {
+  if (plan.depthRange)
     out.depthComplexity =
-        timer.run("count", [&] { return countWithDepthRange(frame, imageFeatures); });
-  else if (method.allocation != AllocationPolicy::FixedK &&
-           method.allocation != AllocationPolicy::NoNodes &&
-           !(method.allocation == AllocationPolicy::Optimal && options.budgetBytes))
+        timer.run("count", [&] { return countWithDepthRange(frame, inputs.imageFeatures); });
+  else if (plan.count)
     out.depthComplexity = timer.run("count", [&] { return countFragments(frame); });
   ledger.add("depth_complexity", out.depthComplexity);
+}
 
-  // importance (variable k-buffer): the previous frame's nearest |n.v| (a preceding frame from
-  // the same camera unless the caller hands one over), then the map
-  if (deep) {
-    if (!options.budgetBytes) return makeError(method.name + ": needs a budget");
-    auto resolved = dkbModelFor(method);
-    if (!resolved) return resolved.error();
-    const std::shared_ptr<const learn::Model> model = std::move(resolved.value());
-    // features and inference run fused per tile; the wall time is split between the two passes
-    // in proportion to their CPU time
+/// The importance map: the deep k-buffer's network (features and inference run fused per tile;
+/// the wall time is split between the two in proportion to their CPU time), or the variable
+/// k-buffer's heuristic over the previous frame's nearest |n.v| (a preceding frame from the same
+/// camera unless the caller hands one over).
+Result<void> importanceStep(const RasterFrame& frame, const MethodDesc& method,
+                            const RenderOptions& options, const PassPlan& plan,
+                            const MemoryModel& memory, PassTimer& timer, RenderOutput& out,
+                            const AllocationInputs& inputs, detail::BufferLedger& ledger) {
+  const size_t pixels = frame.pixelCount();
+  if (plan.networkImportance) {
+    auto model = dkbModelFor(method);
+    if (!model) return model.error();
     double featureCpu = 0.0, inferenceCpu = 0.0;
     const auto start = std::chrono::steady_clock::now();
     out.importance.importance = predictImportance(
-        frame, *model, imageFeatures, memory.fragmentSlots(*options.budgetBytes, pixels),
+        frame, **model, inputs.imageFeatures, memory.fragmentSlots(*options.budgetBytes, pixels),
         &featureCpu, &inferenceCpu);
     const double wall =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     const double cpu = featureCpu + inferenceCpu;
-    stats.passes.push_back({"features", cpu > 0.0 ? wall * featureCpu / cpu : wall});
-    stats.passes.push_back({"inference", cpu > 0.0 ? wall * inferenceCpu / cpu : 0.0});
+    out.stats.passes.push_back({"features", cpu > 0.0 ? wall * featureCpu / cpu : wall});
+    out.stats.passes.push_back({"inference", cpu > 0.0 ? wall * inferenceCpu / cpu : 0.0});
     ledger.add("importance", out.importance.importance);
-  } else if (method.allocation == AllocationPolicy::Importance) {
+  }
+  if (plan.heuristicImportance) {
     out.nearestCosine = timer.run("nearest_normal", [&] { return nearestCosine(frame); });
     const std::vector<float>& previous =
         options.previousNearestCosine && options.previousNearestCosine->size() == pixels
@@ -262,35 +236,118 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
           &out.importance.fresnel, &out.importance.noise})
       ledger.add("importance", *map);
   }
+  return {};
+}
 
-  // optimal k-buffer (offline oracle): exact A-buffer, per-pixel hybrid error curves, allocation
-  std::vector<uint32_t> oracleK;
-  if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes &&
-      method.predictedCurves) {  // dkb-curve: the hull allocation over predicted curves
-    const uint64_t slots = memory.fragmentSlots(*options.budgetBytes, pixels);
+/// The optimal k-buffer's k(p) before allocate: from the exact A-buffer pre-pass's error curves
+/// (the offline oracle) or from curves a network predicts (dkb-curve); both count n(p) too.
+Result<void> oracleStep(const RasterFrame& frame, const MethodDesc& method,
+                        const RenderOptions& options, const PassPlan& plan,
+                        const MemoryModel& memory, PassTimer& timer, RenderOutput& out,
+                        AllocationInputs& inputs, detail::BufferLedger& ledger) {
+  if (!plan.oracle && !plan.predictedCurves) return {};
+  const uint64_t slots = memory.fragmentSlots(*options.budgetBytes, frame.pixelCount());
+  uint64_t prepassBytes = 0;
+  if (plan.predictedCurves) {
     auto chosen = timer.run("curves", [&] { return predictedCurveK(frame, method, slots); });
     if (!chosen) return chosen.error();
     out.depthComplexity = std::move(chosen->n);
-    oracleK = std::move(chosen->k);
-    ledger.add("depth_complexity", out.depthComplexity);
-    ledger.add("oracle_k", oracleK);
-    ledger.addBytes("oracle_prepass", chosen->bytesAllocated);
-  } else if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes) {
-    const uint64_t slots = memory.fragmentSlots(*options.budgetBytes, pixels);
+    inputs.oracleK = std::move(chosen->k);
+    prepassBytes = chosen->bytesAllocated;
+  } else {
     auto chosen = timer.run("oracle", [&] { return optimalK(frame, method, options, slots); });
     if (!chosen) return chosen.error();
     out.depthComplexity = std::move(chosen->n);
-    oracleK = std::move(chosen->k);
-    stats.oracle = std::move(chosen->report);
-    ledger.add("depth_complexity", out.depthComplexity);
-    ledger.add("oracle_k", oracleK);
-    ledger.addBytes("oracle_prepass", chosen->bytesAllocated);
+    inputs.oracleK = std::move(chosen->k);
+    out.stats.oracle = std::move(chosen->report);
+    prepassBytes = chosen->bytesAllocated;
   }
+  ledger.add("depth_complexity", out.depthComplexity);
+  ledger.add("oracle_k", inputs.oracleK);
+  ledger.addBytes("oracle_prepass", prepassBytes);
+  return {};
+}
+
+/// The node pool (a copy with keepStores), stores and image on top of what is allocated by now
+/// (less what is freed: the oracle's pre-pass, the allocation's scratch) must fit the limit.
+Result<void> checkNodePool(const RasterFrame& frame, const MethodDesc& method,
+                           const RenderOptions& options, const MemoryModel& memory,
+                           const Allocation& alloc, const detail::BufferLedger& ledger,
+                           uint64_t memoryLimit) {
+  const uint64_t nodeBytes = saturatingMul(
+      alloc.slots, method.store == StoreChoice::MultiLayer ? memory.node : sizeof(FragmentNode));
+  const uint64_t perPixel =
+      4 + sizeof(glm::vec3) + memory.lock + memory.occupancy + memory.tail + memory.accum;
+  uint64_t held = ledger.total();
+  for (const char* freed : {"oracle_prepass", "allocation_scratch"})
+    if (auto it = ledger.byCategory().find(freed); it != ledger.byCategory().end())
+      held -= it->second;
+  const uint64_t needed =
+      saturatingAdd(saturatingAdd(held, saturatingMul(nodeBytes, options.keepStores ? 2 : 1)),
+                    saturatingMul(frame.pixelCount(), perPixel));
+  return checkMemory(needed, memoryLimit,
+                     renderWhat(frame, method) + ": its " + std::to_string(alloc.slots) +
+                         " fragment slots and buffers");
+}
+
+/// The stores the capture fills: nodes (or the peer method's buffer), counters, locks, tails.
+void clearStores(const MethodDesc& method, const RenderOptions& options, const Allocation& alloc,
+                 size_t pixels, detail::Stores& stores, detail::BufferLedger& ledger) {
+  const bool peer = detail::isPeerRule(method.compositing);
+  stores.nodes.allocate(peer ? 0 : alloc.slots);
+  detail::allocatePeerStores(method, alloc, pixels, stores);
+  if (options.keepStores && !peer)  // unused slots are handed out: make them defined
+    std::fill(stores.nodes.data(), stores.nodes.data() + alloc.slots, FragmentNode{0});
+  stores.counts.assign(pixels, 0);
+  if (options.capture == CaptureMode::FragmentParallel) stores.locks.assign(pixels, 0);
+  if (method.compositing == Compositing::Hybrid) stores.tails.assign(pixels, HybridTail{});
+  ledger.addBytes("nodes", stores.nodes.size() * sizeof(FragmentNode));
+  ledger.add("counters", stores.counts);
+  ledger.add("locks", stores.locks);
+  ledger.add("tail", stores.tails);
+  ledger.addBytes(stores.peerHoldsNodes ? "nodes" : "accumulators", stores.peer.bytes());
+}
+
+/// The capture's counters and what only the CPU engine measures, beside fillSharedStats.
+void cpuStats(const detail::CaptureCounters& counters, const detail::BufferLedger& ledger,
+              RenderStats& stats) {
+  stats.bytesAllocatedByCategory = ledger.byCategory();
+  stats.bytesAllocated = ledger.total();
+  stats.culledOccupancy = counters.culledOccupancy;
+  stats.culledKPlus = counters.culledKPlus;
+  stats.rejectedInStore = counters.rejected;
+  stats.inserted = counters.inserted;
+  stats.evicted = counters.evicted;
+}
+
+}  // namespace
+
+static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodDesc& method,
+                                         const RenderOptions& options, uint64_t memoryLimit) {
+  auto planned = planPasses(method, options);
+  if (!planned) return planned.error();
+  const PassPlan& plan = planned.value();
+  RenderOutput out;
+  PassTimer timer(out.stats.passes);
+  detail::BufferLedger ledger;
+  const size_t pixels = frame.pixelCount();
+  const MemoryModel memory =
+      MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
+  // memory pre-flight: the per-pixel buffers here (callers may have checked them before
+  // building the frame), the node pool after allocate
+  MFR_TRY(checkPixelBytes(frame.width(), frame.height(), method, options.capture, memoryLimit));
+
+  // the passes before the allocation: n(p), the importance map, the oracle's k(p)
+  AllocationInputs inputs;
+  countStep(frame, plan, timer, out, inputs, ledger);
+  MFR_TRY(importanceStep(frame, method, options, plan, memory, timer, out, inputs, ledger));
+  MFR_TRY(oracleStep(frame, method, options, plan, memory, timer, out, inputs, ledger));
 
   // allocate
   auto allocated = timer.run("allocate", [&] {
     return allocate(PixelLayout{frame.width(), frame.height(), frame.tileSize()}, method, memory,
-                    options.budgetBytes, out.depthComplexity, out.importance.importance, oracleK);
+                    options.budgetBytes, out.depthComplexity, out.importance.importance,
+                    inputs.oracleK);
   });
   if (!allocated) return allocated.error();
   Allocation& alloc = allocated.value();
@@ -299,59 +356,30 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
   ledger.add("offsets", alloc.offsets);
   ledger.add("store_kind", alloc.kind);
   ledger.addBytes("allocation_scratch", alloc.scratchBytes);
-  {  // the node pool (a copy with keepStores), stores and image on top of what is allocated
-    const uint64_t nodeBytes = saturatingMul(
-        alloc.slots, method.store == StoreChoice::MultiLayer ? memory.node : sizeof(FragmentNode));
-    const uint64_t perPixel =
-        4 + sizeof(glm::vec3) + memory.lock + memory.occupancy + memory.tail + memory.accum;
-    uint64_t held = ledger.total();  // less what is freed by now (the oracle's, the scratch)
-    for (const char* freed : {"oracle_prepass", "allocation_scratch"})
-      if (auto it = ledger.byCategory().find(freed); it != ledger.byCategory().end())
-        held -= it->second;
-    const uint64_t needed =
-        saturatingAdd(saturatingAdd(held, saturatingMul(nodeBytes, options.keepStores ? 2 : 1)),
-                      saturatingMul(pixels, perPixel));
-    MFR_TRY(checkMemory(needed, memoryLimit,
-                        renderWhat(frame, method) + ": its " + std::to_string(alloc.slots) +
-                            " fragment slots and buffers"));
-  }
+  MFR_TRY(checkNodePool(frame, method, options, memory, alloc, ledger, memoryLimit));
 
   // buffers
   detail::Stores stores;
-  timer.run("clear", [&] {
-    const bool mlab = method.store == StoreChoice::MultiLayer;  // its nodes: stores.mlab
-    stores.nodes.allocate(mlab ? 0 : alloc.slots);
-    detail::allocatePeerStores(method, alloc, pixels, stores);
-    if (options.keepStores && !mlab)  // unused slots are handed out: make them defined
-      std::fill(stores.nodes.data(), stores.nodes.data() + alloc.slots, FragmentNode{0});
-    stores.counts.assign(pixels, 0);
-    if (options.capture == CaptureMode::FragmentParallel) stores.locks.assign(pixels, 0);
-    if (method.compositing == Compositing::Hybrid) stores.tails.assign(pixels, HybridTail{});
-  });
-  ledger.addBytes("nodes", stores.nodes.size() * sizeof(FragmentNode));
-  ledger.add("counters", stores.counts);
-  ledger.add("locks", stores.locks);
-  ledger.add("tail", stores.tails);
-  ledger.add("nodes", stores.mlab);
-  ledger.add("accumulators", stores.wboit);
-  ledger.add("accumulators", stores.mboit);
+  timer.run("clear", [&] { clearStores(method, options, alloc, pixels, stores, ledger); });
 
   // occupancy culling passes
   OccupancyMap occupancy;
-  if (method.occupancyWords > 0) {
+  if (plan.occupancy) {
     occupancy = OccupancyMap(pixels, method.occupancyWords);
     buildOccupancy(frame, alloc, occupancy, timer);
     ledger.addBytes("occupancy", occupancy.allocatedBytes());
   }
 
-  // moment-based OIT: the moments pass before the capture (its second geometry pass)
-  if (method.compositing == Compositing::MomentBased)
-    timer.run("moments", [&] { detail::accumulateMoments(frame, options.capture, stores); });
+  // the peer method's own passes before its capture (mboit's moments)
+  for (size_t pass = 0; pass < plan.peerPasses.size(); ++pass)
+    timer.run(plan.peerPasses[pass].c_str(), [&] {
+      detail::runPeerPass(frame, method, alloc, options.capture, stores, static_cast<int>(pass));
+    });
 
   // capture
-  stats.isa = std::string(isaName(detail::captureIsaFor(method, options.capture)));
+  out.stats.isa = std::string(isaName(detail::captureIsaFor(method, options.capture)));
   const detail::CaptureCounters counters = timer.run("capture", [&] {
-    return detail::capture(frame, method, alloc, method.occupancyWords > 0 ? &occupancy : nullptr,
+    return detail::capture(frame, method, alloc, plan.occupancy ? &occupancy : nullptr,
                            options.capture, stores);
   });
 
@@ -360,44 +388,16 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
                         [&] { return resolve(frame, method, alloc, stores, options.background); });
 
   // statistics
-  stats.fragmentSlots = alloc.reservedSlots;
-  stats.bytesByCategory = memory.breakdown(pixels, alloc.reservedSlots);
-  for (const auto& [category, bytes] : stats.bytesByCategory) stats.bytesUsed += bytes;
-  if (options.budgetBytes) MFR_CHECK(stats.bytesUsed <= *options.budgetBytes);
-  stats.bytesAllocatedByCategory = ledger.byCategory();
-  stats.bytesAllocated = ledger.total();
-  stats.fragmentsGenerated = counters.generated;
-  stats.culledOccupancy = counters.culledOccupancy;
-  stats.culledKPlus = counters.culledKPlus;
-  stats.rejectedInStore = counters.rejected;
-  stats.inserted = counters.inserted;
-  stats.evicted = counters.evicted;
-  stats.globalK = alloc.globalK;
-  uint32_t kMin = UINT32_MAX, kMax = 0;
-  uint64_t sumN = 0;
-  uint32_t maxN = 0;
-  for (size_t p = 0; p < pixels; ++p) {
-    stats.captured += stores.counts[p];
-    const bool covered =
-        out.depthComplexity.empty() ? stores.counts[p] > 0 : out.depthComplexity[p] > 0;
-    if (!covered) continue;
-    ++stats.coveredPixels;
-    const uint32_t k = alloc.reservedK.empty() ? alloc.capacity[p] : alloc.reservedK[p];
-    kMin = std::min(kMin, k);
-    kMax = std::max(kMax, k);
-    if (!out.depthComplexity.empty()) {
-      sumN += out.depthComplexity[p];
-      maxN = std::max(maxN, out.depthComplexity[p]);
-    }
-  }
-  stats.kMin = stats.coveredPixels ? kMin : 0;
-  stats.kMax = kMax;
-  stats.lost = stats.fragmentsGenerated - stats.captured;
-  if (!out.depthComplexity.empty()) {
-    stats.maxDepthComplexity = maxN;
-    stats.meanDepthComplexity =
-        stats.coveredPixels ? static_cast<double>(sumN) / stats.coveredPixels : 0.0;
-  }
+  fillSharedStats(SharedMeasures{method,
+                                 memory,
+                                 alloc,
+                                 out.depthComplexity,
+                                 stores.counts,
+                                 {},
+                                 counters.generated,
+                                 options.budgetBytes},
+                  out.stats);
+  cpuStats(counters, ledger, out.stats);
   out.kMap = alloc.reservedK.empty() ? std::move(alloc.capacity) : std::move(alloc.reservedK);
   if (options.keepStores) {
     out.nodes.assign(stores.nodes.data(), stores.nodes.data() + stores.nodes.size());

@@ -71,7 +71,7 @@ std::string composeSource(const std::string& file, bool fragmentCommon,
 
 Result<GLuint> compileShader(GLenum stage, const std::string& file, bool fragmentCommon,
                              const std::string& prelude) {
-  if (embeddedShader(file).empty()) return makeError("GL engine: no embedded shader " + file);
+  if (embeddedShader(file).empty()) return makeError("--engine gl: no embedded shader " + file);
   return compileShaderSource(stage, file, composeSource(file, fragmentCommon, prelude));
 }
 
@@ -108,7 +108,7 @@ Result<GLuint> linkProgram(const std::string& name, const std::vector<StageFile>
     std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
     glGetProgramInfoLog(program, length, nullptr, log.data());
     glDeleteProgram(program);
-    return makeError("GL engine: program " + name + " does not link: " + oneLine(log.c_str()));
+    return makeError("--engine gl: program " + name + " does not link: " + oneLine(log.c_str()));
   }
   return program;
 }
@@ -205,7 +205,7 @@ Result<unsigned> createCheckedBuffer(const std::string& name, uint64_t bytes, co
 Result<unsigned> compileShaderSource(unsigned stage, const std::string& name,
                                      const std::string& source) {
   const GLuint shader = glCreateShader(stage);
-  if (shader == 0) return makeError("GL engine: shader " + name + ": glCreateShader failed");
+  if (shader == 0) return makeError("--engine gl: shader " + name + ": glCreateShader failed");
   const char* text = source.c_str();
   glShaderSource(shader, 1, &text, nullptr);
   glCompileShader(shader);
@@ -217,7 +217,7 @@ Result<unsigned> compileShaderSource(unsigned stage, const std::string& name,
     std::string log(static_cast<size_t>(std::max(length, 1)), '\0');
     glGetShaderInfoLog(shader, length, nullptr, log.data());
     glDeleteShader(shader);
-    return makeError("GL engine: shader " + name + " does not compile: " + oneLine(log.c_str()));
+    return makeError("--engine gl: shader " + name + " does not compile: " + oneLine(log.c_str()));
   }
   return shader;
 }
@@ -735,7 +735,7 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   s->createFramebufferAndQuery();
   if (s->uploadFailure) return *s->uploadFailure;
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
-    return makeError("GL engine: scene upload failed (GL error 0x" + [&] {
+    return makeError("--engine gl: scene upload failed (GL error 0x" + [&] {
       char buf[16];
       std::snprintf(buf, sizeof buf, "%x", e);
       return std::string(buf);

@@ -21,6 +21,7 @@
 #include "mfr/method/importance.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/optimal_allocation.hpp"
+#include "mfr/method/pass_plan.hpp"
 
 namespace mfr::gl {
 namespace {
@@ -69,6 +70,247 @@ Result<CurveChoice> cpuCurves(const View& view, const MethodDesc& method, uint64
   return predictedCurveK(*frame, method, slots);
 }
 
+// One render on the GL engine, in the pass plan's steps: the allocation (in compute shaders, or
+// on the host from n(p) and the importance map or the CPU oracle's k(p)), the GL capture and
+// resolve, the statistics.
+class GlFrame {
+ public:
+  GlFrame(const GlView& view, const MethodDesc& method, const PassPlan& plan,
+          const RenderOptions& options)
+      : gv_(view),
+        method_(method),
+        plan_(plan),
+        options_(options),
+        layout_{view.width(), view.height(), 0},  // row-major prefix sums on GL
+        // the GL k-buffers take the per-pixel spin-lock: the CPU engine's fragment-parallel
+        // memory (wboit's accumulators too); the A-buffer appends with atomics
+        memory_(MemoryModel::of(method, method.allocation != AllocationPolicy::Unbounded)) {}
+
+  /// Counted, dynamic and importance-map k: count, histogram, importance, k(p), prefix sum in
+  /// compute shaders; the host reads a few totals and checks them with allocate()'s words.
+  bool onDevice() const {
+    const AllocationPolicy a = method_.allocation;
+    return a == AllocationPolicy::CountedK || a == AllocationPolicy::DynamicK ||
+           (a == AllocationPolicy::Importance &&
+            method_.importanceSource != ImportanceSource::Network && !method_.fillUnusedSlots);
+  }
+  /// Variable k the host allocates: n(p) [and I(p) or the oracle's k(p)] measured first, k(p)
+  /// and offsets from the shared allocate(), then the GL capture and resolve with them.
+  bool onHost() const {
+    const AllocationPolicy a = method_.allocation;
+    return !onDevice() && (a == AllocationPolicy::CountedK || a == AllocationPolicy::DynamicK ||
+                           a == AllocationPolicy::Importance || a == AllocationPolicy::Optimal);
+  }
+
+  Result<RenderOutput> run(bool interlock) {
+    if (method_.allocation == AllocationPolicy::FixedK) {  // k from the budget, as on the CPU
+      auto a = allocate(layout_, method_, memory_, options_.budgetBytes, {}, {}, {});
+      if (!a) return a.error();
+      method_.k = a->globalK;
+    }
+    std::optional<uint32_t> deviceGlobalK;
+    std::optional<Allocation> perPixel;
+    if (onDevice()) {
+      auto k = allocateOnDevice();
+      if (!k) return k.error();
+      deviceGlobalK = k.value();
+    } else if (onHost()) {
+      auto a = allocateOnHost();
+      if (!a) return a.error();
+      perPixel = std::move(a.value());
+    }
+    GlRenderOptions go;
+    go.background = options_.background;
+    go.readNodes = options_.keepStores;
+    go.warmUp = gv_.firstRender();
+    go.allocation = perPixel ? &*perPixel : nullptr;
+    go.deviceAllocation = onDevice();
+    // (GL's own n(p) only: the optimal k-buffer's and dkb-curve's come from CPU passes)
+    go.counts = n_.empty() || method_.allocation == AllocationPolicy::Optimal ? nullptr : &n_;
+    auto gl = gv_.engine().render(method_, go);
+    if (!gl) return gl.error();
+    GlRenderOutput& g = gl.value();
+    // the A-buffer's slots are its fragments: the budget check needs the count pass's n(p)
+    auto a = onDevice() ? gv_.engine().readDeviceAllocation()
+             : perPixel
+                 ? Result<Allocation>(std::move(*perPixel))
+                 : allocate(layout_, method_, memory_, options_.budgetBytes, g.counts, {}, {});
+    if (!a) return a.error();
+    if (onDevice()) {
+      a->globalK = deviceGlobalK;
+      MFR_TRY(readDeviceMaps());
+    }
+    fillStats(g, a.value(), interlock);
+    out_.image = std::move(g.image);
+    out_.kMap = a->reservedK.empty() ? std::move(a->capacity) : std::move(a->reservedK);
+    out_.depthComplexity = std::move(g.counts);
+    if (options_.keepStores) {
+      out_.nodes = std::move(g.nodes);
+      out_.offsets = std::move(g.nodeOffsets);
+      out_.counts = std::move(g.nodeCounts);
+    }
+    return std::move(out_);
+  }
+
+ private:
+  uint64_t slots() const { return memory_.fragmentSlots(*options_.budgetBytes, layout_.pixels()); }
+
+  const std::vector<float>& previousCosine(const std::vector<float>& otherwise) const {
+    const std::vector<float>* previous = options_.previousNearestCosine;
+    return previous && previous->size() == layout_.pixels() ? *previous : otherwise;
+  }
+
+  /// The device allocation; the global k of a counted or dynamic k.
+  Result<std::optional<uint32_t>> allocateOnDevice() {
+    MFR_TRY(budgetSlots(layout_, method_, memory_, options_.budgetBytes));  // before any pass
+    std::vector<GlPassTime> passes;
+    auto summary = gv_.engine().countOnDevice(&passes);
+    if (!summary) return summary.error();
+    std::optional<uint32_t> globalK;
+    if (method_.allocation == AllocationPolicy::Importance) {
+      MFR_TRY(
+          checkCoveredPixels(layout_, method_, memory_, options_.budgetBytes, summary->covered));
+      static const std::vector<float> none;
+      auto totals = gv_.engine().allocateByImportance(method_.importance, previousCosine(none),
+                                                      slots(), method_.store, &passes);
+      if (!totals) return totals.error();
+      // floor(P(p) F(M)) sums to at most F(M) with IEEE double arithmetic (as on the host);
+      // a driver whose double division rounds otherwise could exceed it by a few slots
+      if (totals->reservedSlots > slots())
+        return makeError("--engine gl: " + method_.name +
+                         ": the GPU's importance allocation took " +
+                         std::to_string(totals->reservedSlots) + " slots of " +
+                         std::to_string(slots()) + " (double arithmetic not IEEE on this driver)");
+    } else {
+      auto k = boundedK(layout_, method_, memory_, options_.budgetBytes, *summary);
+      if (!k) return k.error();
+      auto totals = gv_.engine().allocateCapped(*k, method_.store, &passes);
+      if (!totals) return totals.error();
+      MFR_TRY(
+          checkBoundedSlots(layout_, method_, memory_, options_.budgetBytes, *k, totals->slots));
+      globalK = *k;
+    }
+    for (const GlPassTime& t : passes) hostPasses_.push_back({t.name + " (allocation)", t.wallMs});
+    return globalK;
+  }
+
+  /// The host allocation: n(p) (the count pass, or the CPU oracle's or curves' pre-pass), the
+  /// importance map, then the shared allocate().
+  Result<Allocation> allocateOnHost() {
+    std::vector<uint32_t> oracleK;
+    auto t0 = std::chrono::steady_clock::now();
+    if (plan_.predictedCurves) {  // dkb-curve: features, network and hull on the host
+      auto chosen = cpuCurves(gv_.view(), method_, slots());
+      if (!chosen) return chosen.error();
+      n_ = std::move(chosen->n);
+      oracleK = std::move(chosen->k);
+      hostPasses_.push_back({"curves (cpu)", msSince(t0)});
+    } else if (plan_.oracle) {
+      auto chosen = cpuOracle(gv_.view(), method_, options_, slots());
+      if (!chosen) return chosen.error();
+      n_ = std::move(chosen->n);
+      oracleK = std::move(chosen->k);
+      out_.stats.oracle = std::move(chosen->report);
+      hostPasses_.push_back({"oracle (cpu)", msSince(t0)});
+    } else {
+      auto counted = gv_.engine().count();
+      if (!counted) return counted.error();
+      n_ = std::move(counted.value());
+      hostPasses_.push_back({"count (n(p) read back)", msSince(t0)});
+    }
+    if (plan_.networkImportance) MFR_TRY(networkImportance());
+    if (plan_.heuristicImportance) MFR_TRY(heuristicImportance());
+    t0 = std::chrono::steady_clock::now();
+    auto a = allocate(layout_, method_, memory_, options_.budgetBytes, n_,
+                      out_.importance.importance, oracleK);
+    hostPasses_.push_back({"allocate (host)", msSince(t0)});
+    return a;
+  }
+
+  /// The deep k-buffer: features and network on GL (dkb_infer.comp).
+  Result<void> networkImportance() {
+    auto model = dkbModelFor(method_);
+    if (!model) return model.error();
+    const learn::Mlp& net = (*model)->net;
+    if (net.sizes != learn::kDkbLayers)
+      return makeError("--engine gl: " + method_.name +
+                       ": the GL engine runs 12-128-64-1 networks only");
+    std::vector<float> weights;
+    for (size_t l = 0; l < net.weights.size(); ++l) {
+      const auto& w = net.weights[l];
+      const auto& b = net.biases[l];
+      weights.insert(weights.end(), w.data(), w.data() + w.size());  // column-major
+      weights.insert(weights.end(), b.data(), b.data() + b.size());
+    }
+    std::vector<GlPassTime> passes;
+    auto importance = gv_.engine().dkbImportance(weights, slots(), &passes);
+    if (!importance) return importance.error();
+    out_.importance.importance = std::move(importance.value());
+    for (const GlPassTime& t : passes) hostPasses_.push_back({t.name, t.wallMs});
+    return {};
+  }
+
+  /// The variable k-buffer: the nearest |n.v| on GL, the map on the host.
+  Result<void> heuristicImportance() {
+    auto t0 = std::chrono::steady_clock::now();
+    auto cosine = gv_.engine().nearestCosine();
+    if (!cosine) return cosine.error();
+    out_.nearestCosine = std::move(cosine.value());
+    hostPasses_.push_back({"nearest_normal", msSince(t0)});
+    t0 = std::chrono::steady_clock::now();
+    out_.importance = computeImportance(layout_.width, layout_.height, n_,
+                                        previousCosine(out_.nearestCosine), method_.importance);
+    hostPasses_.push_back({"importance (host)", msSince(t0)});
+    return {};
+  }
+
+  /// The device allocation's importance maps, read back for the output.
+  Result<void> readDeviceMaps() {
+    if (method_.allocation != AllocationPolicy::Importance) return {};
+    auto maps = gv_.engine().readImportance();
+    if (!maps) return maps.error();
+    out_.importance = std::move(maps.value());
+    auto cosine = gv_.engine().readNearestCosine();
+    if (!cosine) return cosine.error();
+    out_.nearestCosine = std::move(cosine.value());
+    return {};
+  }
+
+  void fillStats(const GlRenderOutput& g, const Allocation& a, bool interlock) {
+    RenderStats& s = out_.stats;
+    // the plan's n(p) (a count pass, the oracle's pre-pass) as the CPU engine reports it; the
+    // stores hold min(n(p), k(p)) of the n(p) the capture counted
+    const bool counted = plan_.count || plan_.oracle || plan_.predictedCurves;
+    static const std::vector<uint32_t> none;
+    fillSharedStats(SharedMeasures{method_, memory_, a, counted ? g.counts : none, none, g.counts,
+                                   g.fragments, options_.budgetBytes},
+                    s);
+    s.bytesAllocatedByCategory = g.bufferBytes;
+    s.bytesAllocated = g.totalBufferBytes();
+    s.culledOccupancy = g.culledOccupancy;
+    s.culledKPlus = g.culledKPlus;
+    s.engine = "gl";
+    s.passes = std::move(hostPasses_);  // the host side of a variable-k allocation first
+    for (const GlPassTime& t : g.passes) {
+      s.passes.push_back({t.name, t.wallMs});  // llvmpipe's GL_TIME_ELAPSED is not usable
+      s.engineCounters["gpu_ms_" + t.name] = t.gpuMs;
+    }
+    s.engineCounters["sync_interlock"] = interlock ? 1 : 0;  // the k-buffer capture's sync
+    // the fixed-k capture with 64-bit atomicMin instead of the lock (where the driver has them)
+    s.engineCounters["atomic64"] = g.atomic64 ? 1 : 0;
+  }
+
+  const GlView& gv_;
+  MethodDesc method_;
+  const PassPlan& plan_;
+  const RenderOptions& options_;
+  const PixelLayout layout_;
+  const MemoryModel memory_;
+  std::vector<PassTime> hostPasses_;
+  std::vector<uint32_t> n_;  // host allocation: n(p) measured first, reused by the frame
+  RenderOutput out_;
+};
+
 class GlRenderEngine final : public Engine {
  public:
   GlRenderEngine(GlContext context, bool interlock)
@@ -96,229 +338,20 @@ class GlRenderEngine final : public Engine {
   }
 
   Result<std::unique_ptr<PreparedView>> prepare(const View& view) override {
-    if (!view.scene) return makeError("engine gl: a view without a scene");
+    if (!view.scene) return makeError("--engine gl: a view without a scene");
     auto engine =
         GlEngine::create(context_, *view.scene, view.camera, view.width, view.height, interlock_);
     if (!engine) return engine.error();
     return std::unique_ptr<PreparedView>(std::make_unique<GlView>(std::move(engine.value()), view));
   }
 
-  Result<RenderOutput> render(const PreparedView& view, const MethodDesc& methodIn,
+  Result<RenderOutput> render(const PreparedView& view, const MethodDesc& method,
                               const RenderOptions& options) override {
     const auto* gv = dynamic_cast<const GlView*>(&view);
-    if (!gv) return makeError("engine gl: the view was prepared by another engine");
-    const PixelLayout layout{view.width(), view.height(), 0};  // row-major prefix sums on GL
-    const uint64_t pixels = layout.pixels();
-    MethodDesc method = methodIn;
-    const bool fixedK = method.allocation == AllocationPolicy::FixedK;
-    const bool accumulates = method.allocation == AllocationPolicy::NoNodes;
-    // variable k (counted, dynamic, importance, optimal): n(p) [and I(p) or the oracle's k(p)]
-    // measured first, k(p) and offsets from the shared allocate() on the host, then the GL
-    // capture and resolve with that allocation
-    const bool variable = method.allocation == AllocationPolicy::CountedK ||
-                          method.allocation == AllocationPolicy::DynamicK ||
-                          method.allocation == AllocationPolicy::Importance ||
-                          method.allocation == AllocationPolicy::Optimal;
-    const bool deep = method.allocation == AllocationPolicy::Importance &&
-                      method.importanceSource == ImportanceSource::Network;
-    // the GL k-buffers take the per-pixel spin-lock: the CPU engine's fragment-parallel memory
-    // (wboit's accumulators too)
-    const MemoryModel memory =
-        MemoryModel::of(method, /*fragmentParallel=*/fixedK || variable || accumulates);
-    if (fixedK) {  // k from the budget (or explicit), checked as on the CPU engine
-      auto a = allocate(layout, method, memory, options.budgetBytes, {}, {}, {});
-      if (!a) return a.error();
-      method.k = a->globalK;
-    }
-    std::vector<PassTime> hostPasses;
-    RenderOutput out;
-    std::optional<Allocation> perPixel;
-    std::vector<uint32_t> n;  // variable k: n(p) measured first, reused by the frame
-    // counted, dynamic and importance-map k: count, histogram, importance, k(p), prefix sum in
-    // compute shaders; the host reads a few totals and checks them with allocate()'s words
-    const bool onDevice =
-        method.allocation == AllocationPolicy::CountedK ||
-        method.allocation == AllocationPolicy::DynamicK ||
-        (method.allocation == AllocationPolicy::Importance &&
-         method.importanceSource != ImportanceSource::Network && !method.fillUnusedSlots);
-    std::optional<uint32_t> deviceGlobalK;
-    if (onDevice) {
-      MFR_TRY(budgetSlots(layout, method, memory, options.budgetBytes));  // before any pass
-      std::vector<GlPassTime> passes;
-      auto summary = gv->engine().countOnDevice(&passes);
-      if (!summary) return summary.error();
-      if (method.allocation == AllocationPolicy::Importance) {
-        MFR_TRY(checkCoveredPixels(layout, method, memory, options.budgetBytes, summary->covered));
-        const uint64_t slots = memory.fragmentSlots(*options.budgetBytes, pixels);
-        static const std::vector<float> none;
-        const std::vector<float>& previous =
-            options.previousNearestCosine && options.previousNearestCosine->size() == pixels
-                ? *options.previousNearestCosine
-                : none;
-        auto totals = gv->engine().allocateByImportance(method.importance, previous, slots,
-                                                        method.store, &passes);
-        if (!totals) return totals.error();
-        // floor(P(p) F(M)) sums to at most F(M) with IEEE double arithmetic (as on the host);
-        // a driver whose double division rounds otherwise could exceed it by a few slots
-        if (totals->reservedSlots > slots)
-          return makeError("--engine gl: " + method.name +
-                           ": the GPU's importance allocation took " +
-                           std::to_string(totals->reservedSlots) + " slots of " +
-                           std::to_string(slots) + " (double arithmetic not IEEE on this driver)");
-      } else {
-        auto k = boundedK(layout, method, memory, options.budgetBytes, *summary);
-        if (!k) return k.error();
-        auto totals = gv->engine().allocateCapped(*k, method.store, &passes);
-        if (!totals) return totals.error();
-        MFR_TRY(checkBoundedSlots(layout, method, memory, options.budgetBytes, *k, totals->slots));
-        deviceGlobalK = *k;
-      }
-      for (const GlPassTime& t : passes) hostPasses.push_back({t.name + " (allocation)", t.wallMs});
-    } else if (variable) {
-      std::vector<uint32_t> oracleK;
-      auto t0 = std::chrono::steady_clock::now();
-      if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes &&
-          method.predictedCurves) {  // dkb-curve: features, network and hull on the host
-        auto chosen =
-            cpuCurves(gv->view(), method, memory.fragmentSlots(*options.budgetBytes, pixels));
-        if (!chosen) return chosen.error();
-        n = std::move(chosen->n);
-        oracleK = std::move(chosen->k);
-        hostPasses.push_back({"curves (cpu)", msSince(t0)});
-      } else if (method.allocation == AllocationPolicy::Optimal && options.budgetBytes) {
-        auto chosen = cpuOracle(gv->view(), method, options,
-                                memory.fragmentSlots(*options.budgetBytes, pixels));
-        if (!chosen) return chosen.error();
-        n = std::move(chosen->n);
-        oracleK = std::move(chosen->k);
-        out.stats.oracle = std::move(chosen->report);
-        hostPasses.push_back({"oracle (cpu)", msSince(t0)});
-      } else {
-        auto counted = gv->engine().count();
-        if (!counted) return counted.error();
-        n = std::move(counted.value());
-        hostPasses.push_back({"count (n(p) read back)", msSince(t0)});
-      }
-      if (deep) {  // the deep k-buffer: features and network on GL (dkb_infer.comp)
-        if (!options.budgetBytes) return makeError(method.name + ": needs a budget");
-        auto resolved = dkbModelFor(method);
-        if (!resolved) return resolved.error();
-        const std::shared_ptr<const learn::Model> model = std::move(resolved.value());
-        std::vector<float> weights;
-        for (size_t l = 0; l < model->net.weights.size(); ++l) {
-          const auto& w = model->net.weights[l];
-          const auto& b = model->net.biases[l];
-          weights.insert(weights.end(), w.data(), w.data() + w.size());  // column-major
-          weights.insert(weights.end(), b.data(), b.data() + b.size());
-        }
-        if (model->net.sizes != learn::kDkbLayers)
-          return makeError("--engine gl: " + method.name +
-                           ": the GL engine runs 12-128-64-1 networks only");
-        std::vector<GlPassTime> dkbPasses;
-        auto importance = gv->engine().dkbImportance(
-            weights, memory.fragmentSlots(*options.budgetBytes, pixels), &dkbPasses);
-        if (!importance) return importance.error();
-        out.importance.importance = std::move(importance.value());
-        for (const GlPassTime& t : dkbPasses) hostPasses.push_back({t.name, t.wallMs});
-      } else if (method.allocation == AllocationPolicy::Importance) {
-        t0 = std::chrono::steady_clock::now();
-        auto cosine = gv->engine().nearestCosine();
-        if (!cosine) return cosine.error();
-        out.nearestCosine = std::move(cosine.value());
-        hostPasses.push_back({"nearest_normal", msSince(t0)});
-        t0 = std::chrono::steady_clock::now();
-        const std::vector<float>& previous =
-            options.previousNearestCosine && options.previousNearestCosine->size() == pixels
-                ? *options.previousNearestCosine
-                : out.nearestCosine;
-        out.importance =
-            computeImportance(layout.width, layout.height, n, previous, method.importance);
-        hostPasses.push_back({"importance (host)", msSince(t0)});
-      }
-      t0 = std::chrono::steady_clock::now();
-      auto a = allocate(layout, method, memory, options.budgetBytes, n, out.importance.importance,
-                        oracleK);
-      if (!a) return a.error();
-      perPixel = std::move(a.value());
-      hostPasses.push_back({"allocate (host)", msSince(t0)});
-    }
-    GlRenderOptions go;
-    go.background = options.background;
-    go.readNodes = options.keepStores;
-    go.warmUp = gv->firstRender();
-    go.allocation = perPixel ? &*perPixel : nullptr;
-    go.deviceAllocation = onDevice;
-    // (GL's own n(p) only: the optimal k-buffer's and dkb-curve's come from CPU passes)
-    go.counts = n.empty() || method.allocation == AllocationPolicy::Optimal ? nullptr : &n;
-    auto gl = gv->engine().render(method, go);
-    if (!gl) return gl.error();
-    GlRenderOutput& g = gl.value();
-    // the A-buffer's slots are its fragments: the budget check needs the count pass's n(p)
-    auto a = onDevice   ? gv->engine().readDeviceAllocation()
-             : perPixel ? Result<Allocation>(std::move(*perPixel))
-                        : allocate(layout, method, memory, options.budgetBytes, g.counts, {}, {});
-    if (!a) return a.error();
-    if (onDevice) {  // the output's maps, read back
-      a->globalK = deviceGlobalK;
-      if (method.allocation == AllocationPolicy::Importance) {
-        auto maps = gv->engine().readImportance();
-        if (!maps) return maps.error();
-        out.importance = std::move(maps.value());
-        auto cosine = gv->engine().readNearestCosine();
-        if (!cosine) return cosine.error();
-        out.nearestCosine = std::move(cosine.value());
-      }
-    }
-
-    out.image = std::move(g.image);
-    RenderStats& s = out.stats;
-    s.method = method.name;
-    s.budgetBytes = options.budgetBytes;
-    s.fragmentSlots = a->reservedSlots;
-    s.bytesByCategory = memory.breakdown(pixels, a->reservedSlots);
-    for (const auto& [category, bytes] : s.bytesByCategory) s.bytesUsed += bytes;
-    s.bytesAllocatedByCategory = g.bufferBytes;
-    s.bytesAllocated = g.totalBufferBytes();
-    s.fragmentsGenerated = g.fragments;
-    s.culledOccupancy = g.culledOccupancy;
-    s.culledKPlus = g.culledKPlus;
-    s.globalK = a->globalK;
-    uint32_t kMin = UINT32_MAX, kMax = 0, maxN = 0;
-    // the k reported: as allocated (importance may reserve more slots than n(p))
-    const std::vector<uint32_t>& reported = a->reservedK.empty() ? a->capacity : a->reservedK;
-    for (size_t p = 0; p < pixels; ++p) {
-      const uint32_t n = g.counts[p];
-      // every store keeps the min(n, k) nearest; wboit's accumulators take every fragment
-      s.captured += accumulates ? n : std::min(n, a->capacity[p]);
-      if (n == 0) continue;
-      ++s.coveredPixels;
-      kMin = std::min(kMin, reported[p]);
-      kMax = std::max(kMax, reported[p]);
-      maxN = std::max(maxN, n);
-    }
-    s.kMin = s.coveredPixels ? kMin : 0;
-    s.kMax = kMax;
-    s.lost = s.fragmentsGenerated - s.captured;
-    s.maxDepthComplexity = maxN;
-    s.meanDepthComplexity =
-        s.coveredPixels ? static_cast<double>(g.fragments) / s.coveredPixels : 0.0;
-    s.engine = "gl";
-    s.passes = std::move(hostPasses);  // the host side of a variable-k allocation first
-    for (const GlPassTime& t : g.passes) {
-      s.passes.push_back({t.name, t.wallMs});  // llvmpipe's GL_TIME_ELAPSED is not usable
-      s.engineCounters["gpu_ms_" + t.name] = t.gpuMs;
-    }
-    s.engineCounters["sync_interlock"] = interlock_ ? 1 : 0;  // the k-buffer capture's sync
-    // the fixed-k capture with 64-bit atomicMin instead of the lock (where the driver has them)
-    s.engineCounters["atomic64"] = g.atomic64 ? 1 : 0;
-    out.kMap = a->reservedK.empty() ? std::move(a->capacity) : std::move(a->reservedK);
-    out.depthComplexity = std::move(g.counts);
-    if (options.keepStores) {
-      out.nodes = std::move(g.nodes);
-      out.offsets = std::move(g.nodeOffsets);
-      out.counts = std::move(g.nodeCounts);
-    }
-    return out;
+    if (!gv) return makeError("--engine gl: the view was prepared by another engine");
+    auto plan = planPasses(method, options);
+    if (!plan) return plan.error();
+    return GlFrame(*gv, method, plan.value(), options).run(interlock_);
   }
 
   Result<std::vector<uint32_t>> countFragments(const PreparedView& view) override {
@@ -329,7 +362,7 @@ class GlRenderEngine final : public Engine {
 
   Result<std::vector<float>> nearestCosine(const PreparedView& view) override {
     const auto* gv = dynamic_cast<const GlView*>(&view);
-    if (!gv) return makeError("engine gl: the view was prepared by another engine");
+    if (!gv) return makeError("--engine gl: the view was prepared by another engine");
     return gv->engine().nearestCosine();
   }
 

@@ -239,7 +239,7 @@ size_t Mlp::parameterCount() const {
 
 Mlp makeMlp(const std::vector<int>& sizes, uint64_t seed) {
   MFR_CHECK(sizes.size() >= 2);
-  for (int s : sizes) MFR_CHECK(s >= 1);
+  for (int s : sizes) MFR_CHECK_GE(s, 1);
   std::mt19937_64 gen(seed);
   Mlp net;
   net.sizes = sizes;
@@ -368,7 +368,7 @@ std::vector<EpochLog> train(Mlp& net, const Eigen::MatrixXf& trainInputs,
   checkShapes(net);
   checkData(net, trainInputs, trainTargets);
   checkData(net, validationInputs, validationTargets);
-  MFR_CHECK(options.batchSize >= 1);
+  MFR_CHECK_GE(options.batchSize, 1);
   std::vector<EpochLog> logs;
   const size_t count = static_cast<size_t>(trainInputs.cols());
   if (count == 0) return logs;

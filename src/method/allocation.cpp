@@ -319,7 +319,7 @@ Result<void> allocateByImportance(const AllocationInputs& in, const std::vector<
     a.capacity[p] = static_cast<uint32_t>(std::min<uint64_t>(k[p], n[p]));
     a.slots += a.capacity[p];
   }
-  MFR_CHECK(a.reservedSlots <= slotsInBudget);
+  MFR_CHECK_LE(a.reservedSlots, slotsInBudget);
   return {};
 }
 
@@ -332,7 +332,7 @@ Result<void> allocateOptimal(const AllocationInputs& in, const std::vector<uint3
     a.capacity[p] = oracleK[p];
     a.slots += oracleK[p];
   }
-  MFR_CHECK(a.slots <= in.slotsInBudget);
+  MFR_CHECK_LE(a.slots, in.slotsInBudget);
   return {};
 }
 
@@ -351,7 +351,7 @@ void tileMajorOffsets(const PixelLayout& frame, Allocation& a) {
           a.offsets[p] = running;
           running += a.capacity[p];
         }
-  MFR_CHECK(running == a.slots);
+  MFR_CHECK_EQ(running, a.slots);
 }
 
 }  // namespace

@@ -24,7 +24,7 @@ double squared(float v) {
 }  // namespace
 
 CurveTargets curveTargets(const std::vector<double>& curve, double scale) {
-  MFR_CHECK(scale > 0.0);
+  MFR_CHECK_GT(scale, 0.0);
   CurveTargets t{};
   const size_t n = curve.size();
   for (size_t j = 1; j <= kCurveDrops; ++j)

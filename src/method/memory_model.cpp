@@ -1,8 +1,6 @@
 #include "mfr/method/memory_model.hpp"
 
-#include "mfr/method/mboit.hpp"
-#include "mfr/method/mlab.hpp"
-#include "mfr/method/wboit.hpp"
+#include "mfr/method/peer_method.hpp"
 
 namespace mfr {
 
@@ -19,19 +17,12 @@ MemoryModel MemoryModel::of(const MethodDesc& method, bool fragmentParallel) {
                        method.importanceSource == ImportanceSource::Heuristic
                    ? 1
                    : 0;
-  switch (method.compositing) {
-    case Compositing::WeightedBlended:
-      m.accum = sizeof(WboitPixel);
-      break;
-    case Compositing::MomentBased:
-      m.accum = sizeof(MboitPixel);
-      break;
-    case Compositing::KBuffer:
-    case Compositing::Hybrid:
-    case Compositing::MultiLayerAlpha:
-      break;
-  }
-  if (method.store == StoreChoice::MultiLayer) m.node = kMlabNodeBytes;
+  visitPeer(method.compositing, [&]<class Peer>() {
+    if constexpr (Peer::kNodes)
+      m.node = sizeof(typename Peer::Slot);
+    else
+      m.accum = sizeof(typename Peer::Slot);
+  });
   if (noNodes) m.node = 0;
   m.image = method.allocation == AllocationPolicy::DynamicK ? kHistogramBins * 4 : 0;
   return m;

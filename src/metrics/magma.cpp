@@ -162,7 +162,7 @@ std::array<uint8_t, 3> magma8(int index) {
 Image8 magmaImage(const std::vector<float>& values, int width, int height, float scale) {
   MFR_CHECK(width >= 0 && height >= 0);
   MFR_CHECK(values.size() == static_cast<size_t>(width) * static_cast<size_t>(height));
-  MFR_CHECK(scale > 0.0f);
+  MFR_CHECK_GT(scale, 0.0f);
   std::array<std::array<uint8_t, 3>, 256> lut;
   for (int i = 0; i < 256; ++i) lut[static_cast<size_t>(i)] = magma8(i);
   Image8 image;

@@ -314,7 +314,7 @@ void computeProfileNormals(std::span<ProfilePoint> profile) {
 
 void appendUvSphere(MeshBuilder& mesh, const glm::vec3& center, float radius, int rings,
                     int sectors, uint32_t material) {
-  MFR_CHECK(rings >= 2);
+  MFR_CHECK_GE(rings, 2);
   std::vector<ProfilePoint> profile(static_cast<size_t>(rings) + 1);
   for (int i = 0; i <= rings; ++i) {
     // Colatitude from the north pole; the poles themselves are exactly on the axis.

@@ -6,7 +6,7 @@
 
 #include "mfr/core/colormap.hpp"
 #include "mfr/core/quote.hpp"
-#include "mfr/method/method_options.hpp"
+#include "mfr/method/make_method.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
 
@@ -48,38 +48,15 @@ Image8 blank(int w, int h) {
 }  // namespace
 
 Result<MethodDesc> settingsMethod(const ViewSettings& s) {
-  auto preset = methodPreset(s.method);
-  if (!preset) return preset.error();
-  MethodDesc m = preset.value();
-  if (s.k > 0 && checkMethodOption(MethodOption::K, m, "--k")) {
-    if (m.name.rfind("zbuffer", 0) != 0) m.k = s.k;
-  }
-  if (!s.composite.empty() && checkMethodOption(MethodOption::Composite, m, "--composite")) {
-    auto rule = parseCompositing(s.composite);
-    if (!rule) return makeError("--composite: " + rule.error().message);
-    m.compositing = rule.value();
-  }
-  if (m.occupancyWords > 0 && s.occupancyD > 0) {  // as `mfr render --occupancy-d`
-    if (s.occupancyD > 64) return makeError("--occupancy-d: must be in [1, 64]");
-    m.occupancyWords = s.occupancyD;
-  }
-  if (m.allocation == AllocationPolicy::Importance) {  // as render's vkb options
-    const ImportanceParams& ip = s.importance;
-    if (!(ip.alpha >= 0.0f && ip.alpha <= 1.0f))
-      return makeError("--importance-alpha: must be in [0, 1]");
-    if (!(ip.nLimit >= 1.0f && ip.nLimit <= 1e6f))
-      return makeError("--n-limit: must be in [1, 1e6]");
-    if (!(ip.peripheryExponent > 0.0f && ip.peripheryExponent <= 100.0f))
-      return makeError("--periphery-d: must be in (0, 100]");
-    if (!(ip.noise >= 0.0f && ip.noise <= 1.0f)) return makeError("--noise: must be in [0, 1]");
-    m.importance = ip;
-  }
-  if (!s.model.empty() && checkMethodOption(MethodOption::Model, m, "--model")) {
-    auto model = cli::loadDkbModel(s.model);
-    if (!model) return model.error();
-    m.model = model.value();
-  }
-  return m;
+  MethodOverrides o;  // the panel keeps its settings across methods: those a method lacks wait
+  o.ignoreInapplicable = true;
+  if (s.k > 0) o.k = s.k;
+  if (!s.composite.empty()) o.composite = s.composite;
+  if (s.occupancyD > 0) o.occupancyD = s.occupancyD;
+  if (!s.model.empty()) o.modelPath = s.model;
+  o.importance = ImportanceOverrides::all(s.importance);
+  o.seed = s.importance.seed;
+  return makeMethod(s.method, o);
 }
 
 FrameRenderer::FrameRenderer(Engine& engine, const EngineContext& context, GLFWwindow* window,

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <string>
+#include <string_view>
+#include <type_traits>
 #include <utility>
 #include <variant>
 
@@ -56,6 +58,42 @@ inline Error makeError(std::string message) {
   return Error{std::move(message)};
 }
 
+namespace detail {
+
+/// A checked value as MFR_CHECK_EQ and its kin print it: numbers (floating point with 9
+/// significant digits), enums as their number, bools, strings, pointers; "?" for anything else.
+template <class T>
+std::string checkValueText(const T& v) {
+  char text[64];
+  if constexpr (std::is_same_v<T, bool>) {
+    return v ? "true" : "false";
+  } else if constexpr (std::is_floating_point_v<T>) {
+    std::snprintf(text, sizeof text, "%.9g", static_cast<double>(v));
+    return text;
+  } else if constexpr (std::is_integral_v<T>) {
+    return std::to_string(v);
+  } else if constexpr (std::is_enum_v<T>) {
+    return std::to_string(static_cast<std::underlying_type_t<T>>(v));
+  } else if constexpr (std::is_convertible_v<const T&, std::string_view>) {
+    return std::string(std::string_view(v));
+  } else if constexpr (std::is_pointer_v<T>) {
+    std::snprintf(text, sizeof text, "%p", static_cast<const void*>(v));
+    return text;
+  } else {
+    return "?";
+  }
+}
+
+template <class A, class B>
+[[noreturn]] void checkOpFailed(const char* file, int line, const char* expression, const A& a,
+                                const B& b) {
+  std::fprintf(stderr, "%s:%d: internal check failed: %s (%s vs. %s)\n", file, line, expression,
+               checkValueText(a).c_str(), checkValueText(b).c_str());
+  std::abort();
+}
+
+}  // namespace detail
+
 }  // namespace mfr
 
 /// Always-on check of a programmer invariant (not of user input).
@@ -66,6 +104,23 @@ inline Error makeError(std::string message) {
       std::abort();                                                                          \
     }                                                                                        \
   } while (0)
+
+/// MFR_CHECK of one comparison that also prints both values, as
+/// "file:line: internal check failed: a <= b (5 vs. 3)". Each operand is evaluated once.
+#define MFR_CHECK_OP_(op, a, b)                                                         \
+  do {                                                                                  \
+    const auto& mfr_check_a_ = (a);                                                     \
+    const auto& mfr_check_b_ = (b);                                                     \
+    if (!(mfr_check_a_ op mfr_check_b_))                                                \
+      ::mfr::detail::checkOpFailed(__FILE__, __LINE__, #a " " #op " " #b, mfr_check_a_, \
+                                   mfr_check_b_);                                       \
+  } while (0)
+#define MFR_CHECK_EQ(a, b) MFR_CHECK_OP_(==, a, b)
+#define MFR_CHECK_NE(a, b) MFR_CHECK_OP_(!=, a, b)
+#define MFR_CHECK_LT(a, b) MFR_CHECK_OP_(<, a, b)
+#define MFR_CHECK_LE(a, b) MFR_CHECK_OP_(<=, a, b)
+#define MFR_CHECK_GT(a, b) MFR_CHECK_OP_(>, a, b)
+#define MFR_CHECK_GE(a, b) MFR_CHECK_OP_(>=, a, b)
 
 /// Propagate an error from an expression returning Result<...>.
 #define MFR_TRY(expr)                                     \

@@ -23,6 +23,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 
@@ -127,5 +128,26 @@ struct MboitPixel {
   }
 };
 static_assert(sizeof(MboitPixel) == 36);
+
+/// mboit as a peer method (peer_method.hpp): the moments pass, then the capture weighting each
+/// fragment by the reconstructed transmittance, 36 bytes per pixel.
+struct MboitMethod {
+  static constexpr const char* kName = "mboit";
+  using Slot = MboitPixel;
+  static constexpr bool kNodes = false;
+  static constexpr std::array<const char*, 1> kExtraPasses{"moments"};
+  template <class Pixel>
+  static void add(Pixel px, int pass, float depth, uint32_t rgba) {
+    if (pass == 0) {
+      px.slots->addMoments(depth, static_cast<float>(rgba >> 24) / 255.0f);
+      return;
+    }
+    px.slots->addColor(depth, rgba);
+    ++px.count;
+  }
+  static glm::vec3 composite(const MboitPixel* slots, uint32_t, glm::vec3 background) {
+    return slots->composite(background);
+  }
+};
 
 }  // namespace mfr

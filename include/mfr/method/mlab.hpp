@@ -15,6 +15,7 @@
 // mfr keeps float32 (20 bytes: depth, r, g, b, T) and charges those 20 bytes per node.
 #pragma once
 
+#include <array>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -77,5 +78,21 @@ inline glm::vec3 compositeMlab(const MlabNode* nodes, uint32_t count, glm::vec3 
   }
   return color + T * background;
 }
+
+/// mlab as a peer method (peer_method.hpp): k(p) blended nodes of 20 bytes at the fixed-k
+/// allocation's offsets; the count is the nodes in use.
+struct MlabMethod {
+  static constexpr const char* kName = "mlab";
+  using Slot = MlabNode;
+  static constexpr bool kNodes = true;
+  static constexpr std::array<const char*, 0> kExtraPasses{};
+  template <class Pixel>
+  static void add(Pixel px, int /*pass*/, float depth, uint32_t rgba) {
+    (void)mlabInsert(px.slots, px.count, px.capacity, MlabNode::fromFragment(depth, rgba));
+  }
+  static glm::vec3 composite(const MlabNode* nodes, uint32_t count, glm::vec3 background) {
+    return compositeMlab(nodes, count, background);
+  }
+};
 
 }  // namespace mfr

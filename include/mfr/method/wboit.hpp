@@ -18,6 +18,8 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <cstdint>
 
 #include <glm/glm.hpp>
 
@@ -58,5 +60,21 @@ struct WboitPixel {
   }
 };
 static_assert(sizeof(WboitPixel) == 20);
+
+/// wboit as a peer method (peer_method.hpp): one accumulation pass into 20 bytes per pixel.
+struct WboitMethod {
+  static constexpr const char* kName = "wboit";
+  using Slot = WboitPixel;
+  static constexpr bool kNodes = false;
+  static constexpr std::array<const char*, 0> kExtraPasses{};
+  template <class Pixel>
+  static void add(Pixel px, int /*pass*/, float depth, uint32_t rgba) {
+    px.slots->add(depth, rgba);
+    ++px.count;
+  }
+  static glm::vec3 composite(const WboitPixel* slots, uint32_t, glm::vec3 background) {
+    return slots->composite(background);
+  }
+};
 
 }  // namespace mfr

@@ -1,0 +1,96 @@
+// runTemporalComparison (temporal_run.hpp).
+#include "mfr/compare/temporal_run.hpp"
+
+#include <cstdio>
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "mfr/compare/compare_output.hpp"
+#include "mfr/core/atomic_file.hpp"
+#include "mfr/core/image.hpp"
+#include "mfr/core/quote.hpp"
+
+namespace mfr {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// One plot per budget and measure; a budget where every method failed has nothing to draw.
+Result<std::vector<std::string>> writePlots(const TemporalResult& t, const CompareOptions& options,
+                                            const fs::path& dir) {
+  std::vector<std::string> plots;
+  for (const BudgetSpec& b : options.budgets)
+    for (const TemporalMeasure m : {TemporalMeasure::ExcessFlicker, TemporalMeasure::ErrorChange}) {
+      auto plot = temporalPlot(t, b.label, m);
+      if (!plot) continue;
+      const std::string file = "temporal_" + b.fileLabel() +
+                               (m == TemporalMeasure::ErrorChange ? "_error_change" : "") + ".png";
+      MFR_TRY(writePng((dir / file).string(), plot.value()));
+      plots.push_back(file);
+    }
+  return plots;
+}
+
+}  // namespace
+
+Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest& r,
+                                          CompareOptions options, const std::string& dirText) {
+  const auto named = [&](const Error& e) {
+    return makeError(echoPath(r.source) + ": " + e.message);
+  };
+  TemporalRun run;
+  run.stepDegrees = r.stepDegrees > 0.0f ? r.stepDegrees : 360.0f / static_cast<float>(r.frames);
+  const std::vector<Camera> path = orbitPath(r.start, r.frames, run.stepDegrees);
+  const fs::path dir(dirText);
+  TemporalStability temporal(options.flipPixelsPerDegree);
+  std::vector<std::string> folders;
+  std::vector<float> previousCosine;  // vkb's Fresnel term: the previous frame's nearest |n.v|
+  std::string engineName;
+  for (int f = 0; f < r.frames; ++f) {
+    auto view = engine.prepare(View{r.scene, path[f], r.width, r.height});
+    if (!view) return named(view.error());
+    options.previousNearestCosine = previousCosine;
+    options.progress = [&r, f](const std::string& stage, int done, int total) {
+      if (r.progress)
+        r.progress("frame " + std::to_string(f + 1) + "/" + std::to_string(r.frames) + ": " + stage,
+                   done, total);
+    };
+    auto result = runComparison(engine, **view, options);
+    if (!result) return named(result.error());
+    engineName = result->engine;
+    char folder[32];
+    std::snprintf(folder, sizeof folder, "frame_%03d", f);
+    folders.push_back(folder);
+    MFR_TRY(prepareOutputFolder((dir / folder).string()));
+    auto written =
+        writeComparison(result.value(), (dir / folder).string(), r.versionNumber, r.info);
+    if (!written) return written.error();
+    MFR_TRY(temporal.add(result.value()));
+    auto cosine = engine.nearestCosine(**view);
+    if (!cosine) return named(cosine.error());
+    previousCosine = std::move(cosine.value());
+  }
+  run.result = temporal.result();
+  auto plots = writePlots(run.result, options, dir);
+  if (!plots) return plots.error();
+  nlohmann::json j;
+  j["mfr_version"] = r.versionNumber;
+  j["scene"] = r.source;
+  j["engine"] = engineName;
+  j["width"] = r.width;
+  j["height"] = r.height;
+  j["orbit"] = r.frames;
+  j["orbit_step_degrees"] = run.stepDegrees;
+  j["frames"] = folders;
+  j["plots"] = plots.value();
+  j["temporal"] = temporalToJson(run.result);
+  run.jsonText = j.dump(2) + "\n";
+  MFR_TRY(writeFileAtomically((dir / "results.json").string(), run.jsonText));
+  MFR_TRY(writeFileAtomically((dir / "report.html").string(),
+                              temporalReportHtml(run.result, r.source, r.width, r.height,
+                                                 plots.value(), folders, r.info.commandLine)));
+  return run;
+}
+
+}  // namespace mfr

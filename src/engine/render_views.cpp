@@ -1,0 +1,48 @@
+// renderViews (render_views.hpp).
+#include "mfr/engine/render_views.hpp"
+
+#include "mfr/core/quote.hpp"
+#include "mfr/method/memory_model.hpp"
+
+namespace mfr {
+
+Result<void> renderViews(Engine& engine, const Scene& scene, const std::string& source,
+                         const SceneViews& views, int width, int height, const MethodDesc& method,
+                         RenderOptions options, const std::optional<BudgetSpec>& budget,
+                         const std::function<Result<void>(const RenderedView&)>& each) {
+  const auto named = [&](const Error& e) { return makeError(echoPath(source) + ": " + e.message); };
+  const auto viewOf = [&](const Camera& camera) { return View{&scene, camera, width, height}; };
+  if (budget) options.budgetBytes = budget->bytes;
+  std::vector<float> previousCosine;  // importance methods: nearest |n.v| of the previous view
+  if (views.previousCamera && method.allocation == AllocationPolicy::Importance &&
+      method.importanceSource == ImportanceSource::Heuristic) {
+    auto previous = engine.prepare(viewOf(*views.previousCamera));
+    if (!previous) return named(previous.error());
+    auto cosine = engine.nearestCosine(**previous);
+    if (!cosine) return named(cosine.error());
+    previousCosine = std::move(cosine.value());
+  }
+  const std::string size = std::to_string(width) + "x" + std::to_string(height);
+  for (size_t v = 0; v < views.cameras.size(); ++v) {
+    auto view = engine.prepare(viewOf(views.cameras[v]));
+    if (!view) return named(view.error());
+    options.previousNearestCosine = previousCosine.empty() ? nullptr : &previousCosine;
+    if (budget && budget->isRelative()) {
+      auto counted = engine.countFragments(**view);
+      if (!counted) return named(counted.error());
+      auto bytes =
+          resolveBudget(*budget, method,
+                        MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel),
+                        FrameCounts::of(counted.value()), size);
+      if (!bytes) return named(bytes.error());
+      options.budgetBytes = bytes.value();
+    }
+    auto result = engine.render(**view, method, options);
+    if (!result) return named(result.error());
+    previousCosine = result->nearestCosine;
+    MFR_TRY(each(RenderedView{static_cast<int>(v), **view, result.value()}));
+  }
+  return {};
+}
+
+}  // namespace mfr
