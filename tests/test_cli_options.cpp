@@ -494,3 +494,19 @@ TEST(CliOptions, RenderWithATrainedModelDiffersFromTheBuiltInAndIsReproducible) 
 }
 
 }  // namespace
+
+// An option given with an empty value is given: `--composite ""` names no rule, `--model ""` no
+// file; each is one error line, not the preset's default.
+TEST(CliOptions, EmptyCompositeAndModelAreErrors) {
+  const std::string base =
+      "render procedural:bottles --width 16 --height 16 -q -o " + path("e.png");
+  for (const auto& [args, message] :
+       {std::pair<std::string, std::string>{" --method fkb --k 2 --composite ''",
+                                            "mfr: error: --composite: "},
+        {" --method dkb --budget 1MB --model ''", "mfr: error: --model: empty path"}}) {
+    const mfr::test::CliRun r = runCli(base + args);
+    EXPECT_EQ(r.exitCode, 1) << args;
+    EXPECT_EQ(r.err.rfind(message, 0), 0u) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}

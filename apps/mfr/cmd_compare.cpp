@@ -223,10 +223,9 @@ int run(const CompareArgs& a, const std::string& version) {
             checkComparisonModel(*options.model, a.model, options.methods, options.compositing);
         !fits)
       return fail(fits.error().message);
-  if (a.capture == "parallel")
-    options.capture = CaptureMode::FragmentParallel;
-  else if (a.capture != "tile")
-    return fail("--capture " + quoteInput(a.capture) + ": expected tile or parallel");
+  auto capture = parseCaptureOption(a.capture);
+  if (!capture) return fail(capture.error().message);
+  options.capture = capture.value();
 
   // output folder: checked and its staging folder made before any work; put in place at the end
   auto outFolder = OutputFolder::begin(a.out);

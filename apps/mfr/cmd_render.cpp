@@ -52,6 +52,10 @@ Result<MethodDesc> buildMethod(const RenderArgs& a) {
   if (a.given("--no-fresnel-term")) o.importance.fresnelTerm = false;
   if (a.given("--no-noise")) o.importance.noiseTerm = false;
   o.seed = a.scene.seed;
+  // an empty value is not "not given": --composite "" is no rule, --model "" no file
+  if (a.given("--composite") && o.composite.empty())
+    return makeError("--composite: " + parseCompositing("").error().message);
+  if (a.given("--model") && o.modelPath.empty()) return makeError("--model: empty path");
   auto m = makeMethod(a.method, o);
   if (!m) return m.error();
   if (a.given("--importance-map"))
@@ -126,10 +130,9 @@ int run(const RenderArgs& a) {
     if (!parsed) return fail("--budget: " + parsed.error().message);
     budget = parsed.value();
   }
-  if (a.capture == "parallel")
-    options.capture = CaptureMode::FragmentParallel;
-  else if (a.capture != "tile")
-    return fail("--capture " + quoteInput(a.capture) + ": expected tile or parallel");
+  auto capture = parseCaptureOption(a.capture);
+  if (!capture) return fail(capture.error().message);
+  options.capture = capture.value();
   if (a.out.empty()) return fail("--out: empty path");
 
   auto memoryLimit = a.scene.memoryLimitBytes();

@@ -12,6 +12,7 @@
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/raster_frame.hpp"
+#include "mfr/method/make_method.hpp"
 
 namespace mfr::cli {
 
@@ -81,11 +82,7 @@ View sceneView(const PreparedScene& prepared, const SceneOptions& o, const Camer
 
 Result<uint64_t> SceneOptions::memoryLimitBytes() const {
   if (memoryLimit.empty()) return defaultMemoryLimit();
-  auto bytes = parseByteSize(memoryLimit);
-  if (!bytes)
-    return makeError("--memory-limit " + quoteInput(memoryLimit) +
-                     ": expected a size such as 8GB, 512MB or 1048576 (at most 1 TiB)");
-  return bytes.value();
+  return parseMemoryLimitOption(memoryLimit);
 }
 
 SceneRequest SceneOptions::request() const {

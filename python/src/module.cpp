@@ -8,6 +8,7 @@
 
 #include "common.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
@@ -64,7 +65,11 @@ MethodDesc buildMethod(const std::string& name, const py::object& k, const py::o
                        const py::object& importance, uint64_t seed) {
   MethodOverrides o;
   if (!k.is_none()) o.k = castArgument<long long>(k, "k");
-  if (!composite.is_none()) o.composite = castArgument<std::string>(composite, "composite");
+  if (!composite.is_none()) {
+    o.composite = castArgument<std::string>(composite, "composite");
+    if (o.composite.empty())
+      throw LibraryError("composite: " + parseCompositing("").error().message);
+  }
   if (!occupancyD.is_none()) o.occupancyD = castArgument<long long>(occupancyD, "occupancy_d");
   if (!model.is_none()) {
     if (py::isinstance<learn::Model>(model))
@@ -132,6 +137,15 @@ py::object renderScene(const py::object& sceneArg, const std::string& method,
   options.background = scene.scene->background;
   const SceneViews views =
       unwrap(sceneViews(*scene.scene, scene.source, request, Spelling::Python));
+  // an orbit's arrays are returned together (the CLI writes each view and drops it): image,
+  // sRGB, k(p), n(p) and importance, 28 bytes per pixel and view
+  if (views.cameras.size() > 1) {
+    const uint64_t outputBytes = saturatingMul(
+        saturatingMul(views.cameras.size(), static_cast<uint64_t>(width) * height), 28);
+    unwrap(checkMemory(outputBytes, memoryLimit.value_or(defaultMemoryLimit()),
+                       echoPath(scene.source) + ": the arrays of " +
+                           std::to_string(views.cameras.size()) + " views"));
+  }
 
   struct Rendered {
     RenderOutput output;

@@ -90,6 +90,12 @@ SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const SceneR
     }
     return {loaded, source};
   }
+  // a loaded scene's files are read: its loading options cannot change it now
+  if (request.transmissionFloor != 0.1)
+    throw LibraryError("transmission_floor: applies when the scene is loaded (mfr.load_scene)");
+  if (allowOutsideReferences)
+    throw LibraryError(
+        "allow_outside_references: applies when the scene is loaded (mfr.load_scene)");
   auto loaded = scene.cast<std::shared_ptr<Scene>>();
   if (!request.changesScene()) return {loaded, loaded->name};
   auto changed = std::make_shared<Scene>(*loaded);  // the caller's scene stays as it is
@@ -158,13 +164,8 @@ uint64_t budgetArgument(const py::object& budget) {
 
 std::optional<uint64_t> memoryLimitArgument(const py::object& limit) {
   if (limit.is_none()) return std::nullopt;
-  if (py::isinstance<py::str>(limit)) {
-    auto bytes = parseByteSize(limit.cast<std::string>());
-    if (!bytes)
-      throw LibraryError("memory_limit " + quoteInput(limit.cast<std::string>()) + ": " +
-                         bytes.error().message);
-    return bytes.value();
-  }
+  if (py::isinstance<py::str>(limit))
+    return unwrap(parseMemoryLimitOption(limit.cast<std::string>(), Spelling::Python));
   if (py::isinstance<py::bool_>(limit) || !py::isinstance<py::int_>(limit))
     throw LibraryError("memory_limit: expected bytes (an int) or a size such as \"8GB\"");
   const long long bytes = limit.cast<long long>();
@@ -173,13 +174,12 @@ std::optional<uint64_t> memoryLimitArgument(const py::object& limit) {
 }
 
 CaptureMode captureArgument(const std::string& capture) {
-  if (capture == "tile") return CaptureMode::TileOwned;
-  if (capture == "parallel") return CaptureMode::FragmentParallel;
-  throw LibraryError("capture " + quoteInput(capture) + ": expected tile or parallel");
+  return unwrap(parseCaptureOption(capture, Spelling::Python));
 }
 
 ImportanceOverrides importanceArgument(const py::dict& params) {
   ImportanceOverrides o;
+  o.asGroup = true;
   for (const auto& [key, value] : params) {
     const std::string k = py::str(key);
     const std::string name = "importance[" + quoteInput(k) + "]";

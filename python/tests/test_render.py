@@ -186,6 +186,22 @@ def test_orbit_renders_every_view_as_the_cli(tmp_path, run_cli):
     assert len(budgets) > 1  # each view's own A-buffer
 
 
+def test_an_orbit_of_arrays_beyond_the_memory_limit_is_refused():
+    # 1000 views at 1024 x 1024 would hold 28 GB of arrays: refused before rendering
+    with pytest.raises(mfr.Error, match=r"the arrays of 1000 views"):
+        mfr.render("procedural:bottles", orbit=1000, memory_limit="1GB")
+
+
+def test_empty_values_are_not_absent_values():
+    with pytest.raises(mfr.Error, match=r"^composite: "):
+        mfr.render("procedural:bottles", width=W, height=H, method="fkb", k=2, composite="")
+    with pytest.raises(mfr.Error, match=r"^importance: does not apply to fkb"):
+        mfr.render("procedural:bottles", width=W, height=H, method="fkb", k=2, importance={})
+    with pytest.raises(mfr.Error, match=r"^transmission_floor: applies when the scene is loaded"):
+        mfr.render(mfr.load_scene("procedural:bottles"), width=W, height=H,
+                   transmission_floor=0.5)
+
+
 def test_engine_names_and_bad_engine():
     assert mfr.engine_names()[0] == "cpu"
     with pytest.raises(mfr.Error, match=r"engine"):

@@ -201,8 +201,7 @@ Result<std::vector<uint32_t>> compareOneRun(const RunSetting& s, const BudgetSpe
                                             const CompareProgress& progress, CompareRun& run) {
   run.method = method.name;
   run.compositing = method.compositing;
-  const MemoryModel memory =
-      MemoryModel::of(method, s.options.capture == CaptureMode::FragmentParallel);
+  const MemoryModel memory = s.engine.memoryModel(method, s.renderOptions);
   auto budget = resolveBudget(spec, method, memory, s.counts, s.sizeName);
   if (!budget) {
     run.error = budget.error().message;

@@ -5,10 +5,9 @@
 #include <cstdint>
 #include <map>
 #include <memory>
-#include <new>
 #include <optional>
 #include <string>
-#include <type_traits>
+#include <typeinfo>
 #include <vector>
 
 #include "mfr/core/isa.hpp"
@@ -78,27 +77,26 @@ class UninitializedBuffer {
 };
 
 /// A peer method's buffer (peer_method.hpp): its Slots, one per pixel or k(p) per pixel, of the
-/// type the method names (trivially copyable float state, value-initialised by assign).
+/// type the method names, value-initialised (each Slot's own defaults) by assign.
 class PeerBuffer {
  public:
   template <class Slot>
   void assign(size_t n) {
-    static_assert(std::is_trivially_copyable_v<Slot> && alignof(Slot) <= alignof(std::max_align_t));
-    storage_.reset(n ? new std::max_align_t[(n * sizeof(Slot) + sizeof(std::max_align_t) - 1) /
-                                            sizeof(std::max_align_t)]
-                     : nullptr);
-    Slot* slots = data<Slot>();
-    for (size_t i = 0; i < n; ++i) new (slots + i) Slot{};
+    storage_ =
+        std::shared_ptr<void>(new Slot[n](), [](void* p) { delete[] static_cast<Slot*>(p); });
+    type_ = &typeid(Slot);
     bytes_ = n * sizeof(Slot);
   }
   template <class Slot>
   Slot* data() {
-    return std::launder(reinterpret_cast<Slot*>(storage_.get()));
+    MFR_CHECK(type_ && *type_ == typeid(Slot));
+    return static_cast<Slot*>(storage_.get());
   }
   uint64_t bytes() const { return bytes_; }
 
  private:
-  std::unique_ptr<std::max_align_t[]> storage_;
+  std::shared_ptr<void> storage_;
+  const std::type_info* type_ = nullptr;
   uint64_t bytes_ = 0;
 };
 

@@ -69,6 +69,91 @@ inline int32_t cullDepthOf(const FragmentNode* slots, uint32_t count, uint32_t c
   return _mm256_add_epi32(code, _mm256_castps_si256(_mm256_cmp_ps(c, below, _CMP_LT_OQ)));
 }
 
+/// The pixels [xs, xe] of a row whose three edge values (row[i] at x0, stepping stepX[i]) are
+/// all >= 0, exactly as rasterizeRect finds them (xe < xs: none).
+[[gnu::always_inline]] inline void coveredSpan(const int64_t row[3], const int64_t stepX[3], int x0,
+                                               int x1, int& xs, int& xe) {
+  for (int i = 0; i < 3 && xs <= xe; ++i) {
+    const int64_t rr = row[i], st = stepX[i];
+    if (rr >= 0 && rr + st * (x1 - x0) >= 0) continue;
+    if (st > 0) {
+      xs = static_cast<int>(std::max<int64_t>(xs, x0 + detail::ceilDivPositive(-rr, st)));
+    } else if (st < 0 && rr >= 0) {
+      xe = static_cast<int>(std::min<int64_t>(xe, x0 + detail::floorDivPositive(rr, -st)));
+    } else {
+      xe = xs - 1;
+    }
+  }
+}
+
+/// One triangle's shading on 8 lanes: the interpolated normal against the view ray (the
+/// headlight of RasterFrame::surface, |n.v| with the scalar path's clamp and its 1 for a zero
+/// normal), the lit base colour sRGB-encoded with the frame's tables, the alpha byte.
+struct LaneShading {
+  __m256 n0x, n1x, n2x, n0y, n1y, n2y, n0z, n1z, n2z;
+  __m256 rayScaleX, rayBiasX, baseR, baseG, baseB;
+  __m256i alpha;
+
+  [[gnu::always_inline]] MFR_TARGET_AVX2 LaneShading(const ShadingInputs& in,
+                                                     const TriangleSetup& t, glm::vec4 base,
+                                                     uint32_t alphaByte)
+      : n0x(_mm256_set1_ps(t.normalW[0].x)),
+        n1x(_mm256_set1_ps(t.normalW[1].x)),
+        n2x(_mm256_set1_ps(t.normalW[2].x)),
+        n0y(_mm256_set1_ps(t.normalW[0].y)),
+        n1y(_mm256_set1_ps(t.normalW[1].y)),
+        n2y(_mm256_set1_ps(t.normalW[2].y)),
+        n0z(_mm256_set1_ps(t.normalW[0].z)),
+        n1z(_mm256_set1_ps(t.normalW[1].z)),
+        n2z(_mm256_set1_ps(t.normalW[2].z)),
+        rayScaleX(_mm256_set1_ps(in.rayScaleX)),
+        rayBiasX(_mm256_set1_ps(in.rayBiasX)),
+        baseR(_mm256_set1_ps(base.r)),
+        baseG(_mm256_set1_ps(base.g)),
+        baseB(_mm256_set1_ps(base.b)),
+        alpha(_mm256_set1_epi32(static_cast<int>(alphaByte))) {}
+
+  /// The packed colour words of pixels x .. x + 7 at barycentrics (l1, l2); their n.v in `ndotv`.
+  [[gnu::always_inline]] MFR_TARGET_AVX2 __m256i shade(const ColorTables& tables, __m256 l1,
+                                                       __m256 l2, int x, __m256 dy,
+                                                       __m256 dySquared, __m256& ndotv) const {
+    const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+    const __m256 minusOne = _mm256_set1_ps(-1.0f);
+    const __m256 absMask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+    const __m256 ambient = _mm256_set1_ps(kAmbient), diffuse = _mm256_set1_ps(1.0f - kAmbient);
+    const __m256i laneIndex = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    const __m256 l0 = _mm256_sub_ps(_mm256_sub_ps(one, l1), l2);
+    const __m256 nx = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(n0x, l0), _mm256_mul_ps(n1x, l1)),
+                                    _mm256_mul_ps(n2x, l2));
+    const __m256 ny = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(n0y, l0), _mm256_mul_ps(n1y, l1)),
+                                    _mm256_mul_ps(n2y, l2));
+    const __m256 nz = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(n0z, l0), _mm256_mul_ps(n1z, l1)),
+                                    _mm256_mul_ps(n2z, l2));
+    const __m256 px = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x), laneIndex));
+    const __m256 dx = _mm256_add_ps(_mm256_mul_ps(px, rayScaleX), rayBiasX);
+    const __m256 nn =
+        _mm256_mul_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(nx, nx), _mm256_mul_ps(ny, ny)),
+                                    _mm256_mul_ps(nz, nz)),
+                      _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), dySquared), one));
+    const __m256 ratio = _mm256_div_ps(
+        _mm256_sub_ps(_mm256_sub_ps(nz, _mm256_mul_ps(nx, dx)), _mm256_mul_ps(ny, dy)),
+        _mm256_sqrt_ps(nn));
+    // std::clamp(v, -1, 1): v < -1 ? -1 : (1 < v ? 1 : v), NaN stays
+    __m256 clamped = _mm256_blendv_ps(ratio, minusOne, _mm256_cmp_ps(ratio, minusOne, _CMP_LT_OQ));
+    clamped = _mm256_blendv_ps(clamped, one, _mm256_cmp_ps(one, clamped, _CMP_LT_OQ));
+    ndotv = _mm256_blendv_ps(one, clamped, _mm256_cmp_ps(nn, zero, _CMP_GT_OQ));
+    const __m256 light =
+        _mm256_add_ps(ambient, _mm256_mul_ps(diffuse, _mm256_and_ps(ndotv, absMask)));
+    return _mm256_or_si256(
+        _mm256_or_si256(
+            detail::encodeSrgb8x8(tables, _mm256_mul_ps(baseR, light)),
+            _mm256_slli_epi32(detail::encodeSrgb8x8(tables, _mm256_mul_ps(baseG, light)), 8)),
+        _mm256_or_si256(
+            _mm256_slli_epi32(detail::encodeSrgb8x8(tables, _mm256_mul_ps(baseB, light)), 16),
+            alpha));
+  }
+};
+
 /// One triangle over one tile, 8 pixels at a time (see the file comment).
 template <class Sink>
 MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingInputs& in,
@@ -103,34 +188,13 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
   const __m256 z0v = _mm256_set1_ps(t.z[0]), dz1v = _mm256_set1_ps(dz1), dz2v = _mm256_set1_ps(dz2);
   const __m256d laneLo = _mm256_setr_pd(0, 1, 2, 3), laneHi = _mm256_setr_pd(4, 5, 6, 7);
   const __m256i laneIndex = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const __m256 n0x = _mm256_set1_ps(t.normalW[0].x), n1x = _mm256_set1_ps(t.normalW[1].x),
-               n2x = _mm256_set1_ps(t.normalW[2].x);
-  const __m256 n0y = _mm256_set1_ps(t.normalW[0].y), n1y = _mm256_set1_ps(t.normalW[1].y),
-               n2y = _mm256_set1_ps(t.normalW[2].y);
-  const __m256 n0z = _mm256_set1_ps(t.normalW[0].z), n1z = _mm256_set1_ps(t.normalW[1].z),
-               n2z = _mm256_set1_ps(t.normalW[2].z);
-  const __m256 rayScaleX = _mm256_set1_ps(in.rayScaleX), rayBiasX = _mm256_set1_ps(in.rayBiasX);
-  const __m256 ambient = _mm256_set1_ps(kAmbient), diffuse = _mm256_set1_ps(1.0f - kAmbient);
-  const __m256 minusOne = _mm256_set1_ps(-1.0f);
-  const __m256 absMask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  const __m256 baseR = _mm256_set1_ps(base.r), baseG = _mm256_set1_ps(base.g),
-               baseB = _mm256_set1_ps(base.b);
+  const LaneShading shading(in, t, base, alphaByte);
 
   Fragment f;
   f.prim = t.prim;
   for (int y = y0; y <= y1; ++y) {
     int xs = x0, xe = x1;  // the covered span, exactly as rasterizeRect
-    for (int i = 0; i < 3 && xs <= xe; ++i) {
-      const int64_t rr = row[i], st = stepX[i];
-      if (rr >= 0 && rr + st * (x1 - x0) >= 0) continue;
-      if (st > 0) {
-        xs = static_cast<int>(std::max<int64_t>(xs, x0 + detail::ceilDivPositive(-rr, st)));
-      } else if (st < 0 && rr >= 0) {
-        xe = static_cast<int>(std::min<int64_t>(xe, x0 + detail::floorDivPositive(rr, -st)));
-      } else {
-        xe = xs - 1;
-      }
-    }
+    coveredSpan(row, stepX, x0, x1, xs, xe);
     if (xs <= xe) {
       const int64_t skip = xs - x0;
       // edge values less their bias, exact integers in doubles
@@ -176,36 +240,8 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
           if (passBits == 0) continue;
         }
         // shading of the 8 lanes (only the passing ones are used)
-        const __m256 l0 = _mm256_sub_ps(_mm256_sub_ps(one, l1), l2);
-        const __m256 nx = _mm256_add_ps(
-            _mm256_add_ps(_mm256_mul_ps(n0x, l0), _mm256_mul_ps(n1x, l1)), _mm256_mul_ps(n2x, l2));
-        const __m256 ny = _mm256_add_ps(
-            _mm256_add_ps(_mm256_mul_ps(n0y, l0), _mm256_mul_ps(n1y, l1)), _mm256_mul_ps(n2y, l2));
-        const __m256 nz = _mm256_add_ps(
-            _mm256_add_ps(_mm256_mul_ps(n0z, l0), _mm256_mul_ps(n1z, l1)), _mm256_mul_ps(n2z, l2));
-        const __m256 px = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x), laneIndex));
-        const __m256 dx = _mm256_add_ps(_mm256_mul_ps(px, rayScaleX), rayBiasX);
-        const __m256 nn =
-            _mm256_mul_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(nx, nx), _mm256_mul_ps(ny, ny)),
-                                        _mm256_mul_ps(nz, nz)),
-                          _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(dx, dx), dySquared), one));
-        const __m256 ratio = _mm256_div_ps(
-            _mm256_sub_ps(_mm256_sub_ps(nz, _mm256_mul_ps(nx, dx)), _mm256_mul_ps(ny, dy)),
-            _mm256_sqrt_ps(nn));
-        // std::clamp(v, -1, 1): v < -1 ? -1 : (1 < v ? 1 : v), NaN stays
-        __m256 clamped =
-            _mm256_blendv_ps(ratio, minusOne, _mm256_cmp_ps(ratio, minusOne, _CMP_LT_OQ));
-        clamped = _mm256_blendv_ps(clamped, one, _mm256_cmp_ps(one, clamped, _CMP_LT_OQ));
-        const __m256 ndotv = _mm256_blendv_ps(one, clamped, _mm256_cmp_ps(nn, zero, _CMP_GT_OQ));
-        const __m256 light =
-            _mm256_add_ps(ambient, _mm256_mul_ps(diffuse, _mm256_and_ps(ndotv, absMask)));
-        const __m256i rgba = _mm256_or_si256(
-            _mm256_or_si256(
-                detail::encodeSrgb8x8(tables, _mm256_mul_ps(baseR, light)),
-                _mm256_slli_epi32(detail::encodeSrgb8x8(tables, _mm256_mul_ps(baseG, light)), 8)),
-            _mm256_or_si256(
-                _mm256_slli_epi32(detail::encodeSrgb8x8(tables, _mm256_mul_ps(baseB, light)), 16),
-                _mm256_set1_epi32(static_cast<int>(alphaByte))));
+        __m256 ndotv;
+        const __m256i rgba = shading.shade(tables, l1, l2, x, dy, dySquared, ndotv);
         alignas(32) float depths[8], cosines[8];
         alignas(32) uint32_t words[8];
         _mm256_store_ps(depths, depth);

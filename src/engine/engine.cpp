@@ -10,6 +10,10 @@ Result<void> Engine::preflight(int, int, const MethodDesc&, const RenderOptions&
   return {};
 }
 
+MemoryModel Engine::memoryModel(const MethodDesc& method, const RenderOptions& options) const {
+  return MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
+}
+
 Result<RenderOutput> Engine::render(const View& view, const MethodDesc& method,
                                     const RenderOptions& options) {
   MFR_TRY(preflight(view.width, view.height, method, options));

@@ -30,10 +30,8 @@ Result<void> renderViews(Engine& engine, const Scene& scene, const std::string& 
     if (budget && budget->isRelative()) {
       auto counted = engine.countFragments(**view);
       if (!counted) return named(counted.error());
-      auto bytes =
-          resolveBudget(*budget, method,
-                        MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel),
-                        FrameCounts::of(counted.value()), size);
+      auto bytes = resolveBudget(*budget, method, engine.memoryModel(method, options),
+                                 FrameCounts::of(counted.value()), size);
       if (!bytes) return named(bytes.error());
       options.budgetBytes = bytes.value();
     }

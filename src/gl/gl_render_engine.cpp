@@ -70,6 +70,12 @@ Result<CurveChoice> cpuCurves(const View& view, const MethodDesc& method, uint64
   return predictedCurveK(*frame, method, slots);
 }
 
+// The GL k-buffers take the per-pixel spin-lock: the CPU engine's fragment-parallel memory
+// (wboit's accumulators too); the A-buffer appends with atomics.
+MemoryModel glMemoryModel(const MethodDesc& method) {
+  return MemoryModel::of(method, method.allocation != AllocationPolicy::Unbounded);
+}
+
 // One render on the GL engine, in the pass plan's steps: the allocation (in compute shaders, or
 // on the host from n(p) and the importance map or the CPU oracle's k(p)), the GL capture and
 // resolve, the statistics.
@@ -82,9 +88,7 @@ class GlFrame {
         plan_(plan),
         options_(options),
         layout_{view.width(), view.height(), 0},  // row-major prefix sums on GL
-        // the GL k-buffers take the per-pixel spin-lock: the CPU engine's fragment-parallel
-        // memory (wboit's accumulators too); the A-buffer appends with atomics
-        memory_(MemoryModel::of(method, method.allocation != AllocationPolicy::Unbounded)) {}
+        memory_(glMemoryModel(method)) {}
 
   /// Counted, dynamic and importance-map k: count, histogram, importance, k(p), prefix sum in
   /// compute shaders; the host reads a few totals and checks them with allocate()'s words.
@@ -335,6 +339,10 @@ class GlRenderEngine final : public Engine {
             {"GL_NV_shader_atomic_int64", yes(c.nvShaderAtomicInt64)},
             // the fixed-k k-buffer without tail or occupancy: 64-bit atomicMin or the lock
             {"fixed_k_capture", hasAtomic64(context_) ? "atomic64" : "lock"}};
+  }
+
+  MemoryModel memoryModel(const MethodDesc& method, const RenderOptions&) const override {
+    return glMemoryModel(method);
   }
 
   Result<std::unique_ptr<PreparedView>> prepare(const View& view) override {

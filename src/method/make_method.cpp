@@ -4,6 +4,8 @@
 
 #include <cmath>
 
+#include "mfr/core/quote.hpp"
+#include "mfr/core/units.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/dkb_model.hpp"
 #include "mfr/method/method_options.hpp"
@@ -16,12 +18,14 @@ std::string importanceName(Spelling spelling, const char* flag, const char* key)
   return spelling == Spelling::Cli ? std::string(flag) : "importance['" + std::string(key) + "']";
 }
 
-/// A number given for an option must lie in [lo, hi] (or (lo, hi] when `openLow`).
-Result<float> inRange(double value, double lo, double hi, bool openLow, const std::string& name,
+/// A number given for an option must lie in [lo, hi] (or (lo, hi] when `openLow`) as the float
+/// the method keeps.
+Result<float> inRange(double given, double lo, double hi, bool openLow, const std::string& name,
                       const char* range) {
+  const float value = static_cast<float>(given);
   if (!(openLow ? value > lo : value >= lo) || !(value <= hi))
     return makeError(name + ": must be in " + range);
-  return static_cast<float>(value);
+  return value;
 }
 
 Result<ImportanceParams> importanceParams(const ImportanceOverrides& o, uint64_t seed,
@@ -139,7 +143,7 @@ Result<MethodDesc> makeMethod(const std::string& name, const MethodOverrides& o,
       m.occupancyWords = static_cast<int>(*o.occupancyD);
     }
   }
-  if (const std::string given = o.importance.firstGiven(); !given.empty()) {
+  if (const std::string given = o.importance.firstGiven(); !given.empty() || o.importance.asGroup) {
     const std::string typed = spelling == Spelling::Cli ? given : std::string("importance");
     auto applies = takes(MethodOption::ImportanceParams, m, o, typed);
     if (!applies) return applies.error();
@@ -167,6 +171,21 @@ Result<MethodDesc> makeMethod(const std::string& name, const MethodOverrides& o,
     }
   }
   return m;
+}
+
+Result<CaptureMode> parseCaptureOption(const std::string& text, Spelling spelling) {
+  if (text == "tile") return CaptureMode::TileOwned;
+  if (text == "parallel") return CaptureMode::FragmentParallel;
+  return makeError(spell(spelling, "--capture") + " " + quoteInput(text) +
+                   ": expected tile or parallel");
+}
+
+Result<uint64_t> parseMemoryLimitOption(const std::string& text, Spelling spelling) {
+  auto bytes = parseByteSize(text);
+  if (!bytes)
+    return makeError(spell(spelling, "--memory-limit") + " " + quoteInput(text) +
+                     ": expected a size such as 8GB, 512MB or 1048576 (at most 1 TiB)");
+  return bytes.value();
 }
 
 Result<std::shared_ptr<const learn::Model>> loadMethodModel(const std::string& path) {

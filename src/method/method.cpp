@@ -274,16 +274,8 @@ const char* toString(Compositing c) {
 }
 
 bool kBufferFamilyRule(Compositing c) {
-  switch (c) {
-    case Compositing::KBuffer:
-    case Compositing::Hybrid:
-      return true;
-    case Compositing::WeightedBlended:
-    case Compositing::MomentBased:
-    case Compositing::MultiLayerAlpha:
-      return false;
-  }
-  return false;
+  // every other rule is a peer method's own (mfr/method/peer_method.hpp)
+  return c == Compositing::KBuffer || c == Compositing::Hybrid;
 }
 
 Result<Compositing> parseCompositing(const std::string& text) {

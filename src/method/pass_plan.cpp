@@ -16,14 +16,18 @@ Result<void> checkComposition(const MethodDesc& m) {
     return makeError(m.name + ": occupancy culling needs a bounded k");
   if (m.store == StoreChoice::Append && m.allocation != AllocationPolicy::Unbounded)
     return makeError(m.name + ": the append store needs exact (unbounded) allocation");
-  // the peer methods' rules go with their own allocation and store (docs: peer methods)
-  const bool accumulates =
-      m.compositing == Compositing::WeightedBlended || m.compositing == Compositing::MomentBased;
+  // the peer methods' rules go with their own allocation and store (docs/METHODS.md): an
+  // accumulating one with no nodes, one of nodes with the multi-layer store and fixed k
+  bool accumulates = false, peerNodes = false;
+  visitPeer(m.compositing, [&]<class Peer>() {
+    accumulates = !Peer::kNodes;
+    peerNodes = Peer::kNodes;
+  });
   if (accumulates != (m.allocation == AllocationPolicy::NoNodes) ||
       accumulates != (m.store == StoreChoice::None))
     return makeError(m.name + ": " + toString(m.compositing) +
                      " compositing goes with no-nodes allocation and no store, and only it");
-  if ((m.compositing == Compositing::MultiLayerAlpha) != (m.store == StoreChoice::MultiLayer) ||
+  if (peerNodes != (m.store == StoreChoice::MultiLayer) ||
       (m.store == StoreChoice::MultiLayer && m.allocation != AllocationPolicy::FixedK))
     return makeError(m.name + ": the multi-layer store goes with fixed k and " +
                      "multi-layer-alpha compositing, and only them");

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mfr/core/result.hpp"
+#include "mfr/method/memory_model.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/method/render_output.hpp"
 #include "mfr/scene/camera.hpp"
@@ -62,6 +63,10 @@ class Engine {
   /// nothing to check). render() checks it again.
   virtual Result<void> preflight(int width, int height, const MethodDesc& method,
                                  const RenderOptions& options) const;
+  /// The memory this engine charges a method (DHOIT Eq. 1 as it lays the buffers out): what a
+  /// relative budget adds its share to. The CPU engine charges a lock word per pixel only in
+  /// fragment-parallel capture; the GL engine's k-buffers always take the per-pixel lock.
+  virtual MemoryModel memoryModel(const MethodDesc& method, const RenderOptions& options) const;
   /// Sets up a view. Errors (one line): the size, the scene or the camera (see RasterFrame::build).
   virtual Result<std::unique_ptr<PreparedView>> prepare(const View& view) = 0;
   /// Renders one method on a prepared view (the passes of the method's description).

@@ -15,6 +15,7 @@
 #include "mfr/core/result.hpp"
 #include "mfr/method/importance.hpp"
 #include "mfr/method/method.hpp"
+#include "mfr/method/render_output.hpp"
 
 namespace mfr {
 
@@ -31,6 +32,9 @@ struct ImportanceOverrides {
   std::optional<double> noise;               // --noise, in [0, 1]
   std::optional<std::vector<double>> fovea;  // --fovea X,Y: two finite pixel coordinates
   std::optional<bool> depthTerm, peripheryTerm, fresnelTerm, noiseTerm;  // --no-*-term
+  /// Set by a front end that takes the parameters as one argument (Python's importance dict):
+  /// given, even when empty.
+  bool asGroup = false;
   /// The first parameter set, as the CLI spells it (empty: none): the one an error names when the
   /// method has no heuristic importance.
   std::string firstGiven() const;
@@ -58,6 +62,12 @@ struct MethodOverrides {
 /// range names the option and its range; a model that does not fit the method names the model.
 Result<MethodDesc> makeMethod(const std::string& name, const MethodOverrides& overrides,
                               Spelling spelling = Spelling::Cli);
+
+/// The render options every front end takes as text, checked once: --capture tile|parallel and
+/// --memory-limit SIZE (bytes of parseByteSize), errors in the caller's spelling. A budget is a
+/// BudgetSpec (parseBudgetSpec: a size or a share of the A-buffer).
+Result<CaptureMode> parseCaptureOption(const std::string& text, Spelling spelling = Spelling::Cli);
+Result<uint64_t> parseMemoryLimitOption(const std::string& text, Spelling spelling = Spelling::Cli);
 
 /// Reads a deep k-buffer model file (an importance model for dkb / dkb-fill or a curve model for
 /// dkb-curve); errors name the path.
