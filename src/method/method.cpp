@@ -1,6 +1,7 @@
 #include "mfr/method/method.hpp"
 
 #include "mfr/core/quote.hpp"
+#include "mfr/method/peer_method.hpp"
 
 namespace mfr {
 
@@ -20,144 +21,127 @@ void kPlusCore(MethodDesc& m) {  // the k+-buffer family: k+ culling test under 
 }
 
 const std::vector<PresetRow>& presetRows() {
-  static const std::vector<PresetRow> rows = {
-      {{"zbuffer", "k+-buffer (Vasilakis & Fudos 2014), k = 1",
-        "the nearest fragment only: the k+-buffer with k = 1"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::FixedK;
-         m.store = StoreChoice::MaxArray;
-         kPlusCore(m);
-         m.k = 1;
-       }},
-      {{"abuffer", "A-buffer (Carpenter 1984)",
-        "every fragment, sorted per pixel: the exact ground truth (no budget)"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::Unbounded;
-         m.store = StoreChoice::Append;
-       }},
-      {{"fkb", "k-buffer (Bavoil et al. 2007)",
-        "the same k for every pixel, max-array insertion without the k+ test"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::FixedK;
-         m.store = StoreChoice::MaxArray;
-         m.culling = CullingTest::None;
-       }},
-      {{"kplus-array", "k+-buffer (Vasilakis & Fudos 2014)",
-        "fixed k, max-array store, k+ culling test, per-pixel lock"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::FixedK;
-         m.store = StoreChoice::MaxArray;
-         kPlusCore(m);
-       }},
-      {{"kplus-heap", "k+-buffer (Vasilakis & Fudos 2014)",
-        "fixed k, max-heap store, k+ culling test, per-pixel lock"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::FixedK;
-         m.store = StoreChoice::MaxHeap;
-         kPlusCore(m);
-       }},
-      {{"kplus-sb", "k+-buffer K+B-SB (Vasilakis & Fudos 2014)",
-        "count pass, min(n(p), k) slots per pixel at prefix-sum offsets (memory-exact)"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::CountedK;
-         m.store = StoreChoice::PerPixel;
-         kPlusCore(m);
-       }},
-      {{"kplus-dynamic", "k+-buffer, dynamic k (Vasilakis & Fudos 2014)",
-        "k chosen from the depth-complexity histogram, min(n(p), k) slots per pixel"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::DynamicK;
-         m.store = StoreChoice::PerPixel;
-         kPlusCore(m);
-       }},
-      {{"vkb", "variable k-buffer (Vasilakis, Vardis, Papaioannou, Moustakas)",
-        "k(p) from the importance map (depth complexity x periphery x Fresnel + noise)"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::Importance;
-         m.store = StoreChoice::PerPixel;
-         kPlusCore(m);
-       }},
-      {{"vkb-fill", "variable k-buffer + mfr's slot filling",
-        "vkb, with the slots it leaves unused handed to the most important pixels"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::Importance;
-         m.store = StoreChoice::PerPixel;
-         kPlusCore(m);
-         m.fillUnusedSlots = true;
-       }},
-      {{"dkb", "deep k-buffer (DHOIT: Tsopouridis, Fudos, Vasilakis)",
-        "k(p) from the MLP's importance over 12 features; hybrid compositing"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::Importance;
-         m.importanceSource = ImportanceSource::Network;
-         m.store = StoreChoice::PerPixel;
-         kPlusCore(m);
-         m.compositing = Compositing::Hybrid;  // deep hybrid transparency (DHOIT sec. 3.3)
-       }},
-      {{"dkb-fill", "deep k-buffer + mfr's slot filling",
-        "dkb, with the slots it leaves unused handed to the most important pixels"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::Importance;
-         m.importanceSource = ImportanceSource::Network;
-         m.store = StoreChoice::PerPixel;
-         kPlusCore(m);
-         m.compositing = Compositing::Hybrid;
-         m.fillUnusedSlots = true;
-       }},
-      {{"dkb-curve", "mfr: DHOIT's features + the optimal k-buffer's hull allocation",
-        "a network predicts each pixel's error-vs-k curve; k(p) by the oracle's hull allocator"},
-       [](MethodDesc& m) {
-         // beyond the paper (issue 14 sec. 4): the oracle's hull allocation over curves a network
-         // predicts from the deep k-buffer's features (mfr/method/dkb_curve.hpp)
-         m.allocation = AllocationPolicy::Optimal;
-         m.predictedCurves = true;
-         m.store = StoreChoice::PerPixel;
-         kPlusCore(m);
-         m.compositing = Compositing::Hybrid;
-       }},
-      {{"optimal", "optimal k-buffer (DHOIT sec. 3.1.2; mfr's convex-hull allocator)",
-        "exact A-buffer pre-pass, k(p) minimising the summed squared error under the budget"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::Optimal;
-         m.store = StoreChoice::PerPixel;
-         kPlusCore(m);
-         m.compositing = Compositing::Hybrid;  // the oracle minimises the hybrid error
-       }},
-      {{"optimal-greedy", "optimal k-buffer, DHOIT sec. 3.1.2 Algorithm 1 as published",
-        "the paper's greedy min-heap allocation over the exact pre-pass"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::Optimal;
-         m.store = StoreChoice::PerPixel;
-         kPlusCore(m);
-         m.compositing = Compositing::Hybrid;
-         m.publishedGreedy = true;
-       }},
-      // the peer methods (docs/METHODS.md): per-pixel accumulators, no fragment nodes
-      {{"wboit", "weighted blended OIT (McGuire & Bavoil 2013)",
-        "weighted sums and revealage per pixel, no fragment nodes"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::NoNodes;
-         m.store = StoreChoice::None;
-         m.compositing = Compositing::WeightedBlended;
-       }},
-      {{"mboit", "moment-based OIT (Muenstermann et al. 2018)",
-        "4 power moments of ln-transmittance per pixel, no fragment nodes"},
-       [](MethodDesc& m) {
-         m.allocation = AllocationPolicy::NoNodes;
-         m.store = StoreChoice::None;
-         m.compositing = Compositing::MomentBased;
-       }},
-      {{"mlab", "multi-layer alpha blending (Salvi & Vaidyanathan 2014)",
-        "k depth-ordered layers per pixel, the two farthest merged when full"},
-       [](MethodDesc& m) {
-         // k nodes per pixel from the budget like fkb, MLAB's store, the k+ family's lock
-         m.allocation = AllocationPolicy::FixedK;
-         m.store = StoreChoice::MultiLayer;
-         m.perPixelLock = true;
-         m.compositing = Compositing::MultiLayerAlpha;
-       }},
-  };
-  return rows;
+  static const std::vector<PresetRow> table = [] {
+    std::vector<PresetRow> rows = {
+        {{"zbuffer", "k+-buffer (Vasilakis & Fudos 2014), k = 1",
+          "the nearest fragment only: the k+-buffer with k = 1"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::FixedK;
+           m.store = StoreChoice::MaxArray;
+           kPlusCore(m);
+           m.k = 1;
+         }},
+        {{"abuffer", "A-buffer (Carpenter 1984)",
+          "every fragment, sorted per pixel: the exact ground truth (no budget)"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::Unbounded;
+           m.store = StoreChoice::Append;
+         }},
+        {{"fkb", "k-buffer (Bavoil et al. 2007)",
+          "the same k for every pixel, max-array insertion without the k+ test"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::FixedK;
+           m.store = StoreChoice::MaxArray;
+           m.culling = CullingTest::None;
+         }},
+        {{"kplus-array", "k+-buffer (Vasilakis & Fudos 2014)",
+          "fixed k, max-array store, k+ culling test, per-pixel lock"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::FixedK;
+           m.store = StoreChoice::MaxArray;
+           kPlusCore(m);
+         }},
+        {{"kplus-heap", "k+-buffer (Vasilakis & Fudos 2014)",
+          "fixed k, max-heap store, k+ culling test, per-pixel lock"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::FixedK;
+           m.store = StoreChoice::MaxHeap;
+           kPlusCore(m);
+         }},
+        {{"kplus-sb", "k+-buffer K+B-SB (Vasilakis & Fudos 2014)",
+          "count pass, min(n(p), k) slots per pixel at prefix-sum offsets (memory-exact)"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::CountedK;
+           m.store = StoreChoice::PerPixel;
+           kPlusCore(m);
+         }},
+        {{"kplus-dynamic", "k+-buffer, dynamic k (Vasilakis & Fudos 2014)",
+          "k chosen from the depth-complexity histogram, min(n(p), k) slots per pixel"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::DynamicK;
+           m.store = StoreChoice::PerPixel;
+           kPlusCore(m);
+         }},
+        {{"vkb", "variable k-buffer (Vasilakis, Vardis, Papaioannou, Moustakas)",
+          "k(p) from the importance map (depth complexity x periphery x Fresnel + noise)"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::Importance;
+           m.store = StoreChoice::PerPixel;
+           kPlusCore(m);
+         }},
+        {{"vkb-fill", "variable k-buffer + mfr's slot filling",
+          "vkb, with the slots it leaves unused handed to the most important pixels"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::Importance;
+           m.store = StoreChoice::PerPixel;
+           kPlusCore(m);
+           m.fillUnusedSlots = true;
+         }},
+        {{"dkb", "deep k-buffer (DHOIT: Tsopouridis, Fudos, Vasilakis)",
+          "k(p) from the MLP's importance over 12 features; hybrid compositing"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::Importance;
+           m.importanceSource = ImportanceSource::Network;
+           m.store = StoreChoice::PerPixel;
+           kPlusCore(m);
+           m.compositing = Compositing::Hybrid;  // deep hybrid transparency (DHOIT sec. 3.3)
+         }},
+        {{"dkb-fill", "deep k-buffer + mfr's slot filling",
+          "dkb, with the slots it leaves unused handed to the most important pixels"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::Importance;
+           m.importanceSource = ImportanceSource::Network;
+           m.store = StoreChoice::PerPixel;
+           kPlusCore(m);
+           m.compositing = Compositing::Hybrid;
+           m.fillUnusedSlots = true;
+         }},
+        {{"dkb-curve", "mfr: DHOIT's features + the optimal k-buffer's hull allocation",
+          "a network predicts each pixel's error-vs-k curve; k(p) by the oracle's hull allocator"},
+         [](MethodDesc& m) {
+           // beyond the paper (issue 14 sec. 4): the oracle's hull allocation over curves a network
+           // predicts from the deep k-buffer's features (mfr/method/dkb_curve.hpp)
+           m.allocation = AllocationPolicy::Optimal;
+           m.predictedCurves = true;
+           m.store = StoreChoice::PerPixel;
+           kPlusCore(m);
+           m.compositing = Compositing::Hybrid;
+         }},
+        {{"optimal", "optimal k-buffer (DHOIT sec. 3.1.2; mfr's convex-hull allocator)",
+          "exact A-buffer pre-pass, k(p) minimising the summed squared error under the budget"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::Optimal;
+           m.store = StoreChoice::PerPixel;
+           kPlusCore(m);
+           m.compositing = Compositing::Hybrid;  // the oracle minimises the hybrid error
+         }},
+        {{"optimal-greedy", "optimal k-buffer, DHOIT sec. 3.1.2 Algorithm 1 as published",
+          "the paper's greedy min-heap allocation over the exact pre-pass"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::Optimal;
+           m.store = StoreChoice::PerPixel;
+           kPlusCore(m);
+           m.compositing = Compositing::Hybrid;
+           m.publishedGreedy = true;
+         }},
+    };
+    // the peer methods (docs/METHODS.md), each described by its type (peer_method.hpp)
+    PeerMethods::forEach([&]<class Peer>() {
+      rows.push_back({Peer::preset(), configurePeerPreset<Peer>});
+    });
+    return rows;
+  }();
+  return table;
 }
 
 }  // namespace
@@ -258,19 +242,11 @@ const char* toString(CullingTest c) {
   return c == CullingTest::None ? "none" : "kplus";
 }
 const char* toString(Compositing c) {
-  switch (c) {
-    case Compositing::KBuffer:
-      return "kbuffer";
-    case Compositing::Hybrid:
-      return "hybrid";
-    case Compositing::WeightedBlended:
-      return "weighted-blended";
-    case Compositing::MomentBased:
-      return "moment-based";
-    case Compositing::MultiLayerAlpha:
-      return "multi-layer-alpha";
-  }
-  return "?";
+  if (c == Compositing::KBuffer) return "kbuffer";
+  if (c == Compositing::Hybrid) return "hybrid";
+  const char* name = "?";
+  visitPeer(c, [&]<class Peer>() { name = Peer::kRuleName; });
+  return name;
 }
 
 bool kBufferFamilyRule(Compositing c) {

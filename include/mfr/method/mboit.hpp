@@ -30,6 +30,7 @@
 #include <glm/glm.hpp>
 
 #include "mfr/core/color.hpp"
+#include "mfr/method/method.hpp"
 
 namespace mfr {
 
@@ -132,7 +133,12 @@ static_assert(sizeof(MboitPixel) == 36);
 /// mboit as a peer method (peer_method.hpp): the moments pass, then the capture weighting each
 /// fragment by the reconstructed transmittance, 36 bytes per pixel.
 struct MboitMethod {
-  static constexpr const char* kName = "mboit";
+  static constexpr Compositing kRule = Compositing::MomentBased;
+  static constexpr const char* kRuleName = "moment-based";
+  static PresetInfo preset() {
+    return {"mboit", "moment-based OIT (Muenstermann et al. 2018)",
+            "4 power moments of ln-transmittance per pixel, no fragment nodes"};
+  }
   using Slot = MboitPixel;
   static constexpr bool kNodes = false;
   static constexpr std::array<const char*, 1> kExtraPasses{"moments"};

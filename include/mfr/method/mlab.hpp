@@ -21,6 +21,7 @@
 #include <glm/glm.hpp>
 
 #include "mfr/core/color.hpp"
+#include "mfr/method/method.hpp"
 
 namespace mfr {
 
@@ -82,7 +83,12 @@ inline glm::vec3 compositeMlab(const MlabNode* nodes, uint32_t count, glm::vec3 
 /// mlab as a peer method (peer_method.hpp): k(p) blended nodes of 20 bytes at the fixed-k
 /// allocation's offsets; the count is the nodes in use.
 struct MlabMethod {
-  static constexpr const char* kName = "mlab";
+  static constexpr Compositing kRule = Compositing::MultiLayerAlpha;
+  static constexpr const char* kRuleName = "multi-layer-alpha";
+  static PresetInfo preset() {
+    return {"mlab", "multi-layer alpha blending (Salvi & Vaidyanathan 2014)",
+            "k depth-ordered layers per pixel, the two farthest merged when full"};
+  }
   using Slot = MlabNode;
   static constexpr bool kNodes = true;
   static constexpr std::array<const char*, 0> kExtraPasses{};

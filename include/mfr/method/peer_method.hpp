@@ -2,7 +2,8 @@
 // described by one type in its own header beside its per-pixel state and rules (wboit.hpp,
 // mboit.hpp, mlab.hpp). A peer type says
 //
-//   kRule          the Compositing value that names it
+//   kRule          the Compositing value that names it, kRuleName its name (toString)
+//   preset()       its row of the preset table (name, paper, summary)
 //   Slot           its per-pixel state (an accumulator), or one node of its per-pixel nodes
 //   kNodes         false: one Slot per pixel; true: k(p) Slots at the fixed-k allocation's offsets
 //   kExtraPasses   its geometry passes before the capture, by name (mboit: "moments")
@@ -12,9 +13,9 @@
 // and the memory model, the pass plan and the CPU engine's one template (src/cpu/peer_methods.cpp)
 // read everything else from it. visitPeer is the one switch from a rule to its type.
 //
-// A new peer method: its header (state, rules, type), a Compositing value and toString
-// (method.hpp, method.cpp), its preset row (method.cpp), its case below; on the GL engine its
-// shaders and technique.
+// A new peer method: its header (state, rules, type with its preset's name, paper and summary), a
+// Compositing value (method.hpp) and its type in PeerMethods below; on the GL engine its shaders
+// and their dispatch (src/gl/gl_engine.cpp).
 #pragma once
 
 #include <cstdint>
@@ -37,25 +38,43 @@ struct PeerPixel {
   uint32_t capacity;
 };
 
+/// Every peer method, in the preset table's order. A new peer method is one more type here.
+template <class... Peers>
+struct PeerList {
+  template <class F>
+  static void forEach(F&& f) {
+    (f.template operator()<Peers>(), ...);
+  }
+};
+using PeerMethods = PeerList<WboitMethod, MboitMethod, MlabMethod>;
+
 /// Calls `f.template operator()<Peer>()` with the peer type of `rule`; false (and no call) for
 /// the k-buffer family's rules.
 template <class F>
 bool visitPeer(Compositing rule, F&& f) {
-  switch (rule) {
-    case Compositing::WeightedBlended:
-      f.template operator()<WboitMethod>();
-      return true;
-    case Compositing::MomentBased:
-      f.template operator()<MboitMethod>();
-      return true;
-    case Compositing::MultiLayerAlpha:
-      f.template operator()<MlabMethod>();
-      return true;
-    case Compositing::KBuffer:
-    case Compositing::Hybrid:
-      return false;
+  bool found = false;
+  PeerMethods::forEach([&]<class Peer>() {
+    if (!found && Peer::kRule == rule) {
+      found = true;
+      f.template operator()<Peer>();
+    }
+  });
+  return found;
+}
+
+/// The preset of a peer method: its own allocation and store (no nodes for an accumulator; fixed
+/// k, the multi-layer store and the k+ family's lock word for nodes) and its rule.
+template <class Peer>
+void configurePeerPreset(MethodDesc& m) {
+  if constexpr (Peer::kNodes) {
+    m.allocation = AllocationPolicy::FixedK;  // k nodes per pixel from the budget, like fkb
+    m.store = StoreChoice::MultiLayer;
+    m.perPixelLock = true;
+  } else {
+    m.allocation = AllocationPolicy::NoNodes;
+    m.store = StoreChoice::None;
   }
-  return false;
+  m.compositing = Peer::kRule;
 }
 
 }  // namespace mfr

@@ -24,6 +24,7 @@
 #include <glm/glm.hpp>
 
 #include "mfr/core/color.hpp"
+#include "mfr/method/method.hpp"
 
 namespace mfr {
 
@@ -63,7 +64,12 @@ static_assert(sizeof(WboitPixel) == 20);
 
 /// wboit as a peer method (peer_method.hpp): one accumulation pass into 20 bytes per pixel.
 struct WboitMethod {
-  static constexpr const char* kName = "wboit";
+  static constexpr Compositing kRule = Compositing::WeightedBlended;
+  static constexpr const char* kRuleName = "weighted-blended";
+  static PresetInfo preset() {
+    return {"wboit", "weighted blended OIT (McGuire & Bavoil 2013)",
+            "weighted sums and revealage per pixel, no fragment nodes"};
+  }
   using Slot = WboitPixel;
   static constexpr bool kNodes = false;
   static constexpr std::array<const char*, 0> kExtraPasses{};
