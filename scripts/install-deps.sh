@@ -21,6 +21,7 @@ packages=(
   pybind11-dev python3-pybind11 python3-dev python3-numpy  # the Python module mfr (python/)
   python3-pytest        # its tests (python/tests, run by ctest)
   libepoxy-dev libegl-dev libegl-mesa0 libgl1-mesa-dri  # the OpenGL 4.5 engine (headless EGL)
+  glslang-tools         # every GL shader variant validated in the tests (glslangValidator)
   libglfw3-dev libimgui-dev  # mfr view: window and panel (ImGui backends from its examples)
   xvfb xauth xdotool    # mfr view tests under a virtual X server (xvfb-run), real input events
   chromium              # the mfr compare report in headless Chromium (tests/report_chromium_test.sh)

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <string_view>
 #include <utility>
 
 #include "gl/shader_sources.hpp"
@@ -73,6 +74,74 @@ Result<GLuint> compileShader(GLenum stage, const std::string& file, bool fragmen
                              const std::string& prelude) {
   if (embeddedShader(file).empty()) return makeError("--engine gl: no embedded shader " + file);
   return compileShaderSource(stage, file, composeSource(file, fragmentCommon, prelude));
+}
+
+// Every program of the engine, in link order (the first that fails is the error): its shader
+// file (a raster program is raster.vert + raster.geom + this fragment shader) and what its
+// fragment stage is prefixed with.
+enum class Prelude : uint8_t {
+  None,
+  KBufferSync,  // the k-buffer capture's sync: nothing (spin-lock) or the interlock extension
+  Atomic64,     // GL_ARB_gpu_shader_int64 + GL_NV_shader_atomic_int64 (fixed-k 64-bit atomics)
+};
+struct ProgramRow {
+  const char* file;
+  bool raster;
+  Prelude prelude;
+};
+constexpr ProgramRow kPrograms[] = {
+    {"count.frag", true, Prelude::None},
+    {"capture_abuffer.frag", true, Prelude::None},
+    {"capture_kbuffer.frag", true, Prelude::KBufferSync},
+    {"capture_kbuffer_atomic64.frag", true, Prelude::Atomic64},
+    {"swap_node_words.comp", false, Prelude::Atomic64},
+    {"depth_range.frag", true, Prelude::None},
+    {"occupancy_fill.frag", true, Prelude::None},
+    {"nearest_cosine.frag", true, Prelude::None},
+    {"wboit.frag", true, Prelude::None},
+    {"wboit_resolve.comp", false, Prelude::None},
+    {"mboit_moments.frag", true, Prelude::None},
+    {"mboit_color.frag", true, Prelude::None},
+    {"mboit_resolve.comp", false, Prelude::None},
+    {"mlab.frag", true, Prelude::None},
+    {"mlab_resolve.comp", false, Prelude::None},
+    {"dkb_features.frag", true, Prelude::None},
+    {"dkb_infer.comp", false, Prelude::None},
+    {"occupancy_count.comp", false, Prelude::None},
+    {"prefix_sum.comp", false, Prelude::None},
+    {"prefix_sum_add.comp", false, Prelude::None},
+    {"resolve.comp", false, Prelude::None},
+    {"alloc_histogram.comp", false, Prelude::None},
+    {"importance.comp", false, Prelude::None},
+    {"importance_total.comp", false, Prelude::None},
+    {"alloc_k.comp", false, Prelude::None},
+    {"alloc_pack.comp", false, Prelude::None},
+};
+
+constexpr const char* kAtomic64Prelude =
+    "#extension GL_ARB_gpu_shader_int64 : require\n"
+    "#extension GL_NV_shader_atomic_int64 : require\n";
+
+// The k-buffer capture's prelude for a driver's interlock extension (empty: the spin-lock).
+std::string interlockPrelude(const std::string& ext) {
+  if (ext.empty()) return {};
+  std::string prelude = "#extension " + ext + " : require\n";
+  if (ext == "GL_ARB_fragment_shader_interlock")
+    prelude +=
+        "#define MFR_INTERLOCK_BEGIN() beginInvocationInterlockARB()\n"
+        "#define MFR_INTERLOCK_END() endInvocationInterlockARB()\n";
+  else if (ext == "GL_NV_fragment_shader_interlock")
+    prelude +=
+        "#define MFR_INTERLOCK_BEGIN() beginInvocationInterlockNV()\n"
+        "#define MFR_INTERLOCK_END() endInvocationInterlockNV()\n";
+  else  // the ordering lasts to the end of the shader
+    prelude +=
+        "#define MFR_INTERLOCK_BEGIN() beginFragmentShaderOrderingINTEL()\n"
+        "#define MFR_INTERLOCK_END()\n";
+  prelude += "#define MFR_INTERLOCK 1\n";
+  if (ext != "GL_INTEL_fragment_shader_ordering")
+    prelude += "layout(pixel_interlock_ordered) in;\n";
+  return prelude;
 }
 
 struct StageFile {
@@ -343,107 +412,74 @@ struct GlEngine::State {
     ray.w = (1.0f - 1.0f / static_cast<float>(height)) * tanHalf;
   }
 
-  // every program, in this order (the first that fails is the error); the raster programs'
-  // uniforms set
-  Result<void> linkPrograms(const GlContext& context, const std::string& kbufferPrelude) {
-    auto raster = [&](const std::string& frag, const std::string& prelude = "") {
-      return linkProgram(frag,
-                         {{GL_VERTEX_SHADER, "raster.vert"},
-                          {GL_GEOMETRY_SHADER, "raster.geom"},
-                          {GL_FRAGMENT_SHADER, frag}},
-                         prelude);
+  // The member that holds each program of kPrograms.
+  GLuint* programOf(const char* file) {
+    static const std::pair<const char*, GLuint State::*> members[] = {
+        {"count.frag", &State::progCount},
+        {"capture_abuffer.frag", &State::progABuffer},
+        {"capture_kbuffer.frag", &State::progKBuffer},
+        {"capture_kbuffer_atomic64.frag", &State::progKBufferAtomic64},
+        {"swap_node_words.comp", &State::progSwapWords},
+        {"depth_range.frag", &State::progDepthRange},
+        {"occupancy_fill.frag", &State::progOccFill},
+        {"nearest_cosine.frag", &State::progNearest},
+        {"wboit.frag", &State::progWboit},
+        {"wboit_resolve.comp", &State::progWboitResolve},
+        {"mboit_moments.frag", &State::progMboitMoments},
+        {"mboit_color.frag", &State::progMboitColor},
+        {"mboit_resolve.comp", &State::progMboitResolve},
+        {"mlab.frag", &State::progMlab},
+        {"mlab_resolve.comp", &State::progMlabResolve},
+        {"dkb_features.frag", &State::progDkbFeatures},
+        {"dkb_infer.comp", &State::progDkbInfer},
+        {"occupancy_count.comp", &State::progOccCount},
+        {"prefix_sum.comp", &State::progScan},
+        {"prefix_sum_add.comp", &State::progScanAdd},
+        {"resolve.comp", &State::progResolve},
+        {"alloc_histogram.comp", &State::progAllocHistogram},
+        {"importance.comp", &State::progImportance},
+        {"importance_total.comp", &State::progImportanceTotal},
+        {"alloc_k.comp", &State::progAllocK},
+        {"alloc_pack.comp", &State::progAllocPack},
     };
-    auto count = raster("count.frag");
-    if (!count) return count.error();
-    progCount = *count;
-    auto abuffer = raster("capture_abuffer.frag");
-    if (!abuffer) return abuffer.error();
-    progABuffer = *abuffer;
-    auto kbuffer = raster("capture_kbuffer.frag", kbufferPrelude);
-    if (!kbuffer) return kbuffer.error();
-    progKBuffer = *kbuffer;
-    if (hasAtomic64(context)) {
-      auto atomic64 = raster("capture_kbuffer_atomic64.frag",
-                             "#extension GL_ARB_gpu_shader_int64 : require\n"
-                             "#extension GL_NV_shader_atomic_int64 : require\n");
-      auto swap =
-          linkProgram("swap_node_words.comp", {{GL_COMPUTE_SHADER, "swap_node_words.comp"}});
-      // never verified on a driver that offers the extension (llvmpipe does not): a driver that
-      // announces it but does not compile the shaders keeps the lock (engine_counters.atomic64
-      // says per frame which capture ran) instead of losing the whole engine
-      if (atomic64 && swap) {
-        progKBufferAtomic64 = *atomic64;
-        progSwapWords = *swap;
-      } else {
-        if (atomic64) glDeleteProgram(*atomic64);
-        if (swap) glDeleteProgram(*swap);
+    for (const auto& [name, member] : members)
+      if (std::string_view(name) == file) return &(this->*member);
+    MFR_CHECK(false && "a program of kPrograms without its member");
+    return nullptr;
+  }
+
+  // every program of kPrograms, in its order (the first that fails is the error); the raster
+  // programs' uniforms set. The 64-bit atomic capture is linked where the driver offers the
+  // extensions: it was never verified on such a driver (llvmpipe has none), so one that announces
+  // them but does not compile the shaders keeps the lock (engine_counters.atomic64 says per frame
+  // which capture ran) instead of losing the whole engine.
+  Result<void> linkPrograms(const GlContext& context, const std::string& kbufferPrelude) {
+    const bool atomic64 = hasAtomic64(context);
+    bool atomic64Linked = atomic64;
+    for (const ProgramRow& row : kPrograms) {
+      if (row.prelude == Prelude::Atomic64 && !atomic64) continue;
+      const std::string prelude = row.prelude == Prelude::KBufferSync ? kbufferPrelude
+                                  : row.prelude == Prelude::Atomic64  ? kAtomic64Prelude
+                                                                      : "";
+      auto linked = row.raster ? linkProgram(row.file,
+                                             {{GL_VERTEX_SHADER, "raster.vert"},
+                                              {GL_GEOMETRY_SHADER, "raster.geom"},
+                                              {GL_FRAGMENT_SHADER, row.file}},
+                                             prelude)
+                               : linkProgram(row.file, {{GL_COMPUTE_SHADER, row.file}});
+      if (!linked && row.prelude == Prelude::Atomic64) {
+        atomic64Linked = false;
+        continue;
       }
-    }
-    auto depthRange = raster("depth_range.frag");
-    if (!depthRange) return depthRange.error();
-    progDepthRange = *depthRange;
-    auto occFill = raster("occupancy_fill.frag");
-    if (!occFill) return occFill.error();
-    progOccFill = *occFill;
-    auto nearest = raster("nearest_cosine.frag");
-    if (!nearest) return nearest.error();
-    progNearest = *nearest;
-    auto wboit = raster("wboit.frag");
-    if (!wboit) return wboit.error();
-    progWboit = *wboit;
-    auto wboitResolve =
-        linkProgram("wboit_resolve.comp", {{GL_COMPUTE_SHADER, "wboit_resolve.comp"}});
-    if (!wboitResolve) return wboitResolve.error();
-    progWboitResolve = *wboitResolve;
-    auto mboitMoments = raster("mboit_moments.frag");
-    if (!mboitMoments) return mboitMoments.error();
-    progMboitMoments = *mboitMoments;
-    auto mboitColor = raster("mboit_color.frag");
-    if (!mboitColor) return mboitColor.error();
-    progMboitColor = *mboitColor;
-    auto mboitResolve =
-        linkProgram("mboit_resolve.comp", {{GL_COMPUTE_SHADER, "mboit_resolve.comp"}});
-    if (!mboitResolve) return mboitResolve.error();
-    progMboitResolve = *mboitResolve;
-    auto mlab = raster("mlab.frag");
-    if (!mlab) return mlab.error();
-    progMlab = *mlab;
-    auto mlabResolve = linkProgram("mlab_resolve.comp", {{GL_COMPUTE_SHADER, "mlab_resolve.comp"}});
-    if (!mlabResolve) return mlabResolve.error();
-    progMlabResolve = *mlabResolve;
-    auto dkbFeatures = raster("dkb_features.frag");
-    if (!dkbFeatures) return dkbFeatures.error();
-    progDkbFeatures = *dkbFeatures;
-    auto dkbInfer = linkProgram("dkb_infer.comp", {{GL_COMPUTE_SHADER, "dkb_infer.comp"}});
-    if (!dkbInfer) return dkbInfer.error();
-    progDkbInfer = *dkbInfer;
-    auto occCount =
-        linkProgram("occupancy_count.comp", {{GL_COMPUTE_SHADER, "occupancy_count.comp"}});
-    if (!occCount) return occCount.error();
-    progOccCount = *occCount;
-    auto scanProgram = linkProgram("prefix_sum.comp", {{GL_COMPUTE_SHADER, "prefix_sum.comp"}});
-    if (!scanProgram) return scanProgram.error();
-    progScan = *scanProgram;
-    auto scanAdd = linkProgram("prefix_sum_add.comp", {{GL_COMPUTE_SHADER, "prefix_sum_add.comp"}});
-    if (!scanAdd) return scanAdd.error();
-    progScanAdd = *scanAdd;
-    auto resolve = linkProgram("resolve.comp", {{GL_COMPUTE_SHADER, "resolve.comp"}});
-    if (!resolve) return resolve.error();
-    progResolve = *resolve;
-    for (const auto& [file, program] :
-         {std::pair<const char*, GLuint*>{"alloc_histogram.comp", &progAllocHistogram},
-          {"importance.comp", &progImportance},
-          {"importance_total.comp", &progImportanceTotal},
-          {"alloc_k.comp", &progAllocK},
-          {"alloc_pack.comp", &progAllocPack}}) {
-      auto linked = linkProgram(file, {{GL_COMPUTE_SHADER, file}});
       if (!linked) return linked.error();
-      *program = *linked;
+      *programOf(row.file) = *linked;
+      if (row.raster) setRasterUniforms(*linked);
     }
-    if (progKBufferAtomic64) setRasterUniforms(progKBufferAtomic64);
-    for (GLuint p : {progCount, progABuffer, progKBuffer, progDepthRange, progOccFill, progNearest,
-                     progWboit, progMboitMoments, progMboitColor, progMlab, progDkbFeatures})
-      setRasterUniforms(p);
+    if (!atomic64Linked)  // both atomic programs or neither
+      for (GLuint* p : {&progKBufferAtomic64, &progSwapWords}) {
+        if (*p) glDeleteProgram(*p);
+        *p = 0;
+      }
     return {};
   }
 
@@ -684,31 +720,13 @@ Result<void> checkGlLimits(int width, int height) {
 // the capture_kbuffer.frag prelude: with --gl-sync interlock, the driver's interlock extension
 // and its begin / end macros; empty without
 Result<std::string> kbufferInterlockPrelude(const GlContext& context, bool interlock) {
-  std::string kbufferPrelude;
-  if (interlock) {
-    const std::string ext = interlockExtension(context);
-    if (ext.empty())
-      return makeError(
-          "--gl-sync interlock: the driver offers none of GL_ARB_fragment_shader_interlock, "
-          "GL_NV_fragment_shader_interlock, GL_INTEL_fragment_shader_ordering");
-    kbufferPrelude = "#extension " + ext + " : require\n";
-    if (ext == "GL_ARB_fragment_shader_interlock")
-      kbufferPrelude +=
-          "#define MFR_INTERLOCK_BEGIN() beginInvocationInterlockARB()\n"
-          "#define MFR_INTERLOCK_END() endInvocationInterlockARB()\n";
-    else if (ext == "GL_NV_fragment_shader_interlock")
-      kbufferPrelude +=
-          "#define MFR_INTERLOCK_BEGIN() beginInvocationInterlockNV()\n"
-          "#define MFR_INTERLOCK_END() endInvocationInterlockNV()\n";
-    else  // the ordering lasts to the end of the shader
-      kbufferPrelude +=
-          "#define MFR_INTERLOCK_BEGIN() beginFragmentShaderOrderingINTEL()\n"
-          "#define MFR_INTERLOCK_END()\n";
-    kbufferPrelude += "#define MFR_INTERLOCK 1\n";
-    if (ext != "GL_INTEL_fragment_shader_ordering")
-      kbufferPrelude += "layout(pixel_interlock_ordered) in;\n";
-  }
-  return kbufferPrelude;
+  if (!interlock) return std::string();
+  const std::string ext = interlockExtension(context);
+  if (ext.empty())
+    return makeError(
+        "--gl-sync interlock: the driver offers none of GL_ARB_fragment_shader_interlock, "
+        "GL_NV_fragment_shader_interlock, GL_INTEL_fragment_shader_ordering");
+  return interlockPrelude(ext);
 }
 
 }  // namespace
@@ -1565,6 +1583,43 @@ std::string interlockExtension(const GlContext& context) {
   if (e.nvFragmentShaderInterlock) return "GL_NV_fragment_shader_interlock";
   if (e.intelFragmentShaderOrdering) return "GL_INTEL_fragment_shader_ordering";
   return {};
+}
+
+std::vector<ShaderVariant> shaderVariants() {
+  std::vector<ShaderVariant> out;
+  const auto add = [&](const std::string& program, const std::string& file, const char* stage,
+                       bool fragmentCommon, const std::string& prelude) {
+    out.push_back({program, file, stage, composeSource(file, fragmentCommon, prelude)});
+  };
+  for (const ProgramRow& row : kPrograms) {
+    std::vector<std::pair<std::string, std::string>> preludes;  // variant name, prelude
+    switch (row.prelude) {
+      case Prelude::None:
+        preludes = {{"", ""}};
+        break;
+      case Prelude::KBufferSync:
+        preludes = {{" (lock)", ""}};
+        for (const char* ext :
+             {"GL_ARB_fragment_shader_interlock", "GL_NV_fragment_shader_interlock",
+              "GL_INTEL_fragment_shader_ordering"})
+          preludes.push_back({std::string(" (") + ext + ")", interlockPrelude(ext)});
+        break;
+      case Prelude::Atomic64:
+        preludes = {{" (64-bit atomics)", kAtomic64Prelude}};
+        break;
+    }
+    for (const auto& [variant, prelude] : preludes) {
+      const std::string program = std::string(row.file) + variant;
+      if (!row.raster) {
+        add(program, row.file, "comp", false, prelude);
+        continue;
+      }
+      add(program, "raster.vert", "vert", false, "");
+      add(program, "raster.geom", "geom", false, "");
+      add(program, row.file, "frag", true, prelude);
+    }
+  }
+  return out;
 }
 
 }  // namespace mfr::gl

@@ -4,6 +4,7 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "mfr/core/result.hpp"
 
@@ -23,6 +24,20 @@ inline std::string_view embeddedShader(std::string_view name) {
     if (name == kEmbeddedShaders[i].name) return kEmbeddedShaders[i].text;
   return {};
 }
+
+/// One composed shader stage of one program variant, exactly as the engine hands it to the driver.
+struct ShaderVariant {
+  std::string program;  // the program and its variant, e.g. "capture_kbuffer.frag (lock)"
+  std::string file;     // the stage's own file under shaders/
+  std::string stage;    // vert, geom, frag or comp (glslangValidator's stage names)
+  std::string source;   // complete, from #version
+};
+
+/// Every stage of every program in every variant the engine can link (the k-buffer capture's
+/// spin-lock and each interlock extension, the 64-bit atomic capture), whatever the driver
+/// offers: what `glslangValidator` checks in the tests, so variants llvmpipe cannot run still
+/// compile in CI.
+std::vector<ShaderVariant> shaderVariants();
 
 /// Compiles one shader stage (a GLenum) from `source` (complete, with its #version) on the current
 /// context; the error names `name` and carries the info log on one line. The caller owns the

@@ -1,0 +1,107 @@
+// Every shader variant the GL engine can link compiles, also those this machine's driver cannot
+// run (the k-buffer capture under each fragment shader interlock extension, the 64-bit atomic
+// capture): each composed stage (shaderVariants(), exactly the text the engine hands the driver)
+// is validated by glslangValidator (Debian's glslang-tools) as GLSL 4.50 with the extensions the
+// variant enables. Needs no GL context. Without glslangValidator the test skips (fails under
+// CI=true, where scripts/install-deps.sh installs it).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <string>
+
+#include "gl/shader_sources.hpp"
+
+namespace mfr::gl {
+namespace {
+
+std::string run(const std::string& command, int& status) {
+  std::string out;
+  FILE* pipe = popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) {
+    status = -1;
+    return out;
+  }
+  char buffer[4096];
+  while (size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) out.append(buffer, n);
+  status = pclose(pipe);
+  return out;
+}
+
+// glslang (12.0, Debian 12) knows GL_ARB_fragment_shader_interlock but not the NV and INTEL
+// extensions for desktop GLSL: their variants are validated with the ARB extension standing in
+// for the extension line and its functions for theirs; the rest of the text is the variant's own.
+std::string withStandIn(std::string source) {
+  const auto replace = [&](const std::string& from, const std::string& to) {
+    for (size_t at = source.find(from); at != std::string::npos; at = source.find(from, at))
+      source.replace(at, from.size(), to), at += to.size();
+  };
+  const bool intel = source.find("GL_INTEL_fragment_shader_ordering") != std::string::npos;
+  replace("#extension GL_NV_fragment_shader_interlock : require",
+          "#extension GL_ARB_fragment_shader_interlock : require");
+  replace("#extension GL_INTEL_fragment_shader_ordering : require",
+          "#extension GL_ARB_fragment_shader_interlock : require\n"
+          "layout(pixel_interlock_ordered) in;");
+  replace("beginInvocationInterlockNV()", "beginInvocationInterlockARB()");
+  replace("endInvocationInterlockNV()", "endInvocationInterlockARB()");
+  if (intel) {  // the ordering needs no end; ARB's interlock does, at the end of main
+    replace("beginFragmentShaderOrderingINTEL()", "beginInvocationInterlockARB()");
+    replace("#define MFR_INTERLOCK_END()\n",
+            "#define MFR_INTERLOCK_END() endInvocationInterlockARB()\n");
+  }
+  return source;
+}
+
+TEST(GlShaders, EveryVariantValidatesWithGlslang) {
+  int status = 0;
+  run("glslangValidator --version", status);
+  if (status != 0) {
+    const char* ci = std::getenv("CI");
+    if (ci && std::string(ci) == "true") FAIL() << "glslangValidator not found (glslang-tools)";
+    GTEST_SKIP() << "glslangValidator not found (apt-get install glslang-tools)";
+  }
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("mfr_glslang_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  {  // the validator refuses what a driver would: a test of the test
+    std::ofstream(dir / "broken.frag") << "#version 450 core\nvoid main() { undefined(); }\n";
+    run("glslangValidator " + (dir / "broken.frag").string(), status);
+    EXPECT_NE(status, 0);
+  }
+  const std::vector<ShaderVariant> variants = shaderVariants();
+  std::set<std::string> programs;
+  int index = 0;
+  for (const ShaderVariant& v : variants) {
+    SCOPED_TRACE(v.program + ": " + v.file);
+    programs.insert(v.program);
+    // the stage from the extension, as glslangValidator reads it
+    const std::filesystem::path file = dir / (std::to_string(index++) + "." + v.stage);
+    std::ofstream(file) << withStandIn(v.source);
+    const std::string log = run("glslangValidator " + file.string(), status);
+    EXPECT_EQ(status, 0) << log;
+  }
+  std::filesystem::remove_all(dir);
+  // the variants llvmpipe cannot run are among them
+  for (const char* p :
+       {"capture_kbuffer.frag (lock)", "capture_kbuffer.frag (GL_ARB_fragment_shader_interlock)",
+        "capture_kbuffer.frag (GL_NV_fragment_shader_interlock)",
+        "capture_kbuffer.frag (GL_INTEL_fragment_shader_ordering)",
+        "capture_kbuffer_atomic64.frag (64-bit atomics)", "swap_node_words.comp (64-bit atomics)",
+        "resolve.comp", "count.frag"})
+    EXPECT_EQ(programs.count(p), 1u) << p;
+  // every shader file the engine embeds is in some variant
+  std::set<std::string> files;
+  for (const ShaderVariant& v : variants) files.insert(v.file);
+  for (size_t i = 0; i < kEmbeddedShaderCount; ++i) {
+    const std::string name = kEmbeddedShaders[i].name;
+    if (name.ends_with(".glsl") || name.ends_with(".h")) continue;  // included by the others
+    EXPECT_EQ(files.count(name), 1u) << name << " is in no variant";
+  }
+}
+
+}  // namespace
+}  // namespace mfr::gl
