@@ -171,13 +171,17 @@ int run(const RenderArgs& a) {
         if (!a.scene.quiet && !a.scene.json) {
           const RenderStats& s = r.output.stats;
           progress.clear();
+          const std::string skipped =
+              s.primitivesSkipped
+                  ? ", " + std::to_string(s.primitivesSkipped) + " point/line primitives skipped"
+                  : "";
           std::fprintf(stderr,
                        "%s: %s  %llu fragments, %llu captured (%.2f%% lost), k %u-%u, %s, "
-                       "%.1f ms\n",
+                       "%.1f ms%s\n",
                        method->name.c_str(), viewPath(a.out, r.index, views).c_str(),
                        static_cast<unsigned long long>(s.fragmentsGenerated),
                        static_cast<unsigned long long>(s.captured), s.lostPercent(), s.kMin, s.kMax,
-                       formatBytes(s.bytesUsed).c_str(), s.totalMs());
+                       formatBytes(s.bytesUsed).c_str(), s.totalMs(), skipped.c_str());
         }
         progress.set("rendering " + method->name, r.index + 1, views);
         return {};

@@ -26,6 +26,8 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
   app.add_option("--camera", camera,
                  "EX,EY,EZ,TX,TY,TZ[,UX,UY,UZ[,FOV]]: eye, target, up, fov (deg)");
   app.add_option("--view", view, "Use the scene file's camera number N (0-based)");
+  app.add_option("--scene", gltfScene,
+                 "Which of a glTF file's scenes to load, N (0-based; default: the file's own)");
   app.add_option("--orbit", orbit, "Render N views on a circle around the scene");
   app.add_option("--orbit-view", orbitView, "With --orbit N: only view I of the N (0-based)");
   app.add_option("--zoom", zoom,
@@ -98,6 +100,7 @@ SceneRequest SceneOptions::request() const {
   r.alpha = alpha;
   r.background = background;
   r.transmissionFloor = transmissionFloor;
+  if (gltfScene != -1) r.gltfScene = gltfScene;
   return r;
 }
 
@@ -113,6 +116,7 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
   load.transmissionAlphaFloor = static_cast<float>(o.transmissionFloor);
   load.allowOutsideReferences = o.allowOutsideReferences;
   load.memoryLimitBytes = memoryLimit.value();
+  load.sceneIndex = request.gltfScene;
   auto loaded = loadScene(o.source, load);
   if (!loaded) return loaded.error();
   PreparedScene prepared{std::move(loaded.value()), {}, {}};

@@ -28,6 +28,7 @@ struct SceneOptions {
   int height = 1024;
   std::string camera;  // "EX,EY,EZ,TX,TY,TZ[,UX,UY,UZ[,FOV]]" (parseCameraSpec)
   int view = -1;       // camera of the file, by index
+  int gltfScene = -1;  // --scene: which of a glTF file's scenes (-1: the file's own)
   int orbit = 0;       // N views around the scene
   int orbitView = -1;  // with orbit: only this one of the N views
   double zoom = 1.0;   // camera distance to its target divided by this

@@ -58,7 +58,8 @@ from ._mfr import (  # noqa: F401  (re-exported)
 __all__ = [
     "DEFAULT_COMPARE_METHODS", "DKB_LAYERS", "FEATURE_COUNT", "FEATURE_SET", "FLIP_DEFAULT_PPD",
     "TARGET_SCALING", "Dataset", "Error", "Model", "RenderResult", "Scene", "builtin_model",
-    "compare", "decode_srgb", "encode_srgb", "engine_names", "load_dataset", "load_model", "load_scene",
+    "compare", "decode_srgb", "encode_srgb", "engine_names", "load_dataset", "load_model",
+    "load_scene",
     "make_model", "metrics", "parse_bytes", "preset_names", "read_png", "render",
     "save_dataset", "save_model", "write_png",
 ]
@@ -114,8 +115,8 @@ DEFAULT_COMPARE_METHODS = ("fkb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "dk
 def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1024, camera=None,
            view=None, orbit=0, orbit_view=None, zoom=1.0, composite=None, capture="tile",
            threads=0, seed=1, model=None, occupancy_d=None, importance=None, alpha=None,
-           background=None, transmission_floor=0.1, shuffle_draw_order=None, engine="cpu",
-           gl_sync="auto", memory_limit=None, allow_outside_references=False,
+           background=None, transmission_floor=0.1, shuffle_draw_order=None, gltf_scene=None,
+           engine="cpu", gl_sync="auto", memory_limit=None, allow_outside_references=False,
            depth_complexity=True):
     """Renders with one method, exactly as `mfr render` with the same options (the library checks
     both the same way: its errors name the Python argument where the CLI names its flag).
@@ -137,7 +138,8 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
         framing its bounds. zoom: moves the camera zoom times closer to its target. orbit: N views
         on a circle around the camera's target (a list of N results); orbit_view: only view I of
         them (one result; view I - 1 feeds vkb's previous-frame term, as in the full orbit).
-    shuffle_draw_order: submit the triangles in this seed's random order.
+    shuffle_draw_order: submit the triangles in this seed's random order. gltf_scene: which of a
+        glTF file's scenes (`--scene N`; default the file's own).
     engine: "cpu" or "gl" (mfr.engine_names()); gl_sync: the GL k-buffer's "auto", "lock" or
         "interlock".
     threads: worker threads in [0, 1024] (0: all cores; the output does not depend on it).
@@ -158,8 +160,9 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
                    composite=composite, capture=capture, threads=threads, seed=seed, model=model,
                    occupancy_d=occupancy_d, importance=importance, alpha=alpha,
                    background=background, transmission_floor=transmission_floor,
-                   shuffle_draw_order=shuffle_draw_order, engine=engine, gl_sync=gl_sync,
-                   memory_limit=memory_limit, allow_outside_references=allow_outside_references,
+                   shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, engine=engine,
+                   gl_sync=gl_sync, memory_limit=memory_limit,
+                   allow_outside_references=allow_outside_references,
                    depth_complexity=depth_complexity)
 
 
@@ -168,7 +171,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
             zoom=1.0,
             composite=None, capture="tile", threads=0, seed=1, model=None, ppd=FLIP_DEFAULT_PPD,
             alpha=None, background=None, transmission_floor=0.1, shuffle_draw_order=None,
-            engine="cpu", gl_sync="auto", memory_limit=None,
+            gltf_scene=None, engine="cpu", gl_sync="auto", memory_limit=None,
             allow_outside_references=False) -> dict:
     """Writes the folder `mfr compare --out OUT` writes for the same options and returns its
     results.json as a dict.
@@ -183,7 +186,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
     OUT/frame_NNN, the flicker of each method along the path in results.json and report.html;
     orbit_step: degrees between frames, default 360/N); with orbit_view=I only view I of the N
     is compared. scene, camera, view, zoom, width, height, threads, seed, alpha,
-    background, transmission_floor, shuffle_draw_order, engine, gl_sync, memory_limit,
+    background, transmission_floor, shuffle_draw_order, gltf_scene, engine, gl_sync, memory_limit,
     allow_outside_references: as in mfr.render. A method that fails at a budget is recorded with
     its error; bad input raises mfr.Error.
     """
@@ -204,6 +207,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                                  ("alpha", alpha, None), ("background", background, None),
                                  ("transmission_floor", transmission_floor, 0.1),
                                  ("shuffle_draw_order", shuffle_draw_order, None),
+                                 ("gltf_scene", gltf_scene, None),
                                  ("engine", engine, "cpu"), ("gl_sync", gl_sync, "auto"),
                                  ("memory_limit", memory_limit, None),
                                  ("allow_outside_references", allow_outside_references, False)):
@@ -214,10 +218,11 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                     "model=<mfr.Model>")
     return _compare(scene, out, budgets=list(budgets), methods=list(methods), width=width,
                     height=height, camera=camera, view=view, orbit=orbit, orbit_view=orbit_view,
-                    orbit_step=orbit_step, zoom=zoom, composite=composite, capture=capture, threads=threads, seed=seed,
-                    model=model, ppd=ppd, alpha=alpha, background=background,
-                    transmission_floor=transmission_floor, shuffle_draw_order=shuffle_draw_order,
-                    engine=engine, gl_sync=gl_sync, memory_limit=memory_limit,
+                    orbit_step=orbit_step, zoom=zoom, composite=composite, capture=capture,
+                    threads=threads, seed=seed, model=model, ppd=ppd, alpha=alpha,
+                    background=background, transmission_floor=transmission_floor,
+                    shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, engine=engine,
+                    gl_sync=gl_sync, memory_limit=memory_limit,
                     allow_outside_references=allow_outside_references,
                     command_line="mfr.compare(" + ", ".join(call) + ")")
 

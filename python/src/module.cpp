@@ -110,21 +110,19 @@ PyRenderResult renderResult(RenderOutput&& out, nlohmann::json stats, int width,
   return r;
 }
 
-py::object renderScene(const py::object& sceneArg, const std::string& method,
-                       const py::object& budget, const py::object& k, int width, int height,
-                       const py::object& camera, const py::object& view, int orbit,
-                       const py::object& orbitView, double zoom, const py::object& composite,
-                       const std::string& capture, int threads, uint64_t seed,
-                       const py::object& model, const py::object& occupancyD,
-                       const py::object& importance, const py::object& alpha,
-                       const py::object& background, double transmissionFloor,
-                       const py::object& shuffleDrawOrder, const std::string& engineName,
-                       const std::string& glSync, const py::object& memoryLimitArg,
-                       bool allowOutsideReferences, bool wantDepthComplexity) {
+py::object renderScene(
+    const py::object& sceneArg, const std::string& method, const py::object& budget,
+    const py::object& k, int width, int height, const py::object& camera, const py::object& view,
+    int orbit, const py::object& orbitView, double zoom, const py::object& composite,
+    const std::string& capture, int threads, uint64_t seed, const py::object& model,
+    const py::object& occupancyD, const py::object& importance, const py::object& alpha,
+    const py::object& background, double transmissionFloor, const py::object& shuffleDrawOrder,
+    const py::object& gltfScene, const std::string& engineName, const std::string& glSync,
+    const py::object& memoryLimitArg, bool allowOutsideReferences, bool wantDepthComplexity) {
   const std::optional<uint64_t> memoryLimit = memoryLimitArgument(memoryLimitArg);
   const SceneRequest request =
       sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
-                           transmissionFloor, shuffleDrawOrder);
+                           transmissionFloor, shuffleDrawOrder, gltfScene);
   unwrap(checkThreads(threads, "threads"));
   const MethodDesc m = buildMethod(method, k, composite, model, occupancyD, importance, seed);
   RenderOptions options;
@@ -230,6 +228,9 @@ void addSceneAndRender(py::module_& m) {
                                             "A loaded scene (mfr.load_scene): one flat triangle "
                                             "soup in world space with materials and cameras.")
       .def_readonly("name", &Scene::name, "The file path or procedural spec it was loaded from.")
+      .def_readonly("primitives_skipped", &Scene::primitivesSkipped,
+                    "The file's primitives that are not surfaces (glTF points, lines): not "
+                    "rendered.")
       .def_property_readonly("triangle_count", &Scene::triangleCount)
       .def_property_readonly("vertex_count", &Scene::vertexCount)
       .def_property_readonly("material_count", [](const Scene& s) { return s.materials.size(); })
@@ -287,19 +288,23 @@ void addSceneAndRender(py::module_& m) {
   m.def(
       "load_scene",
       [](const py::object& source, uint64_t seed, double transmissionFloor, const py::object& alpha,
-         const py::object& background, const py::object& memoryLimit, bool allowOutsideReferences) {
+         const py::object& background, const py::object& memoryLimit, bool allowOutsideReferences,
+         const py::object& gltfScene) {
         return loadSceneArgument(pathText(source, "source"), seed, transmissionFloor, alpha,
                                  background, memoryLimitArgument(memoryLimit),
-                                 allowOutsideReferences);
+                                 allowOutsideReferences, gltfScene);
       },
       py::arg("source"), py::kw_only(), py::arg("seed") = 1, py::arg("transmission_floor") = 0.1,
       py::arg("alpha") = py::none(), py::arg("background") = py::none(),
       py::arg("memory_limit") = py::none(), py::arg("allow_outside_references") = false,
+      py::arg("gltf_scene") = py::none(),
       R"(Loads a scene: a .gltf/.glb, .obj, .ply or JSON scene file, or "procedural:NAME[?k=v&...]".
 seed: procedural scenes' seed; transmission_floor: glass alpha floor; alpha: override every
 material's alpha (0..1); background: linear RGB; memory_limit: refuse scenes needing more (bytes
 or "8GB"; default 75% of the physical memory); allow_outside_references: let a scene file name
-files outside its folder (`mfr --allow-outside-references`). Raises mfr.Error naming the input.)");
+files outside its folder (`mfr --allow-outside-references`). Raises mfr.Error naming the input.
+gltf_scene: which of a glTF file's scenes (`mfr --scene N`; default the file's own). Points and
+lines are not rendered: Scene.primitives_skipped counts them.)");
 
   py::class_<PyRenderResult>(m, "RenderResult",
                              "What mfr.render returns: images, per-pixel maps and statistics.")
@@ -332,9 +337,10 @@ files outside its folder (`mfr --allow-outside-references`). Raises mfr.Error na
         py::arg("seed") = 1, py::arg("model") = py::none(), py::arg("occupancy_d") = py::none(),
         py::arg("importance") = py::none(), py::arg("alpha") = py::none(),
         py::arg("background") = py::none(), py::arg("transmission_floor") = 0.1,
-        py::arg("shuffle_draw_order") = py::none(), py::arg("engine") = "cpu",
-        py::arg("gl_sync") = "auto", py::arg("memory_limit") = py::none(),
-        py::arg("allow_outside_references") = false, py::arg("depth_complexity") = true,
+        py::arg("shuffle_draw_order") = py::none(), py::arg("gltf_scene") = py::none(),
+        py::arg("engine") = "cpu", py::arg("gl_sync") = "auto",
+        py::arg("memory_limit") = py::none(), py::arg("allow_outside_references") = false,
+        py::arg("depth_complexity") = true,
         R"(Renders a scene (an mfr.Scene, or a source string loaded with `seed`) with one method, as
 `mfr render` does with the same options, and returns an mfr.RenderResult (a list of them for an
 orbit of several views). See mfr.render's Python documentation (python/mfr/__init__.py) for the

@@ -50,7 +50,7 @@ std::shared_ptr<Scene> loadSceneArgument(const std::string& source, uint64_t see
                                          double transmissionFloor, const py::object& alpha,
                                          const py::object& background,
                                          std::optional<uint64_t> memoryLimit,
-                                         bool allowOutsideReferences) {
+                                         bool allowOutsideReferences, const py::object& gltfScene) {
   if (!(transmissionFloor >= 0.0 && transmissionFloor <= 1.0))
     throw LibraryError("transmission_floor: must be in [0, 1]");
   const std::optional<float> alphaOverride = alphaArgument(alpha);
@@ -61,6 +61,11 @@ std::shared_ptr<Scene> loadSceneArgument(const std::string& source, uint64_t see
   load.transmissionAlphaFloor = static_cast<float>(transmissionFloor);
   load.memoryLimitBytes = memoryLimit;
   load.allowOutsideReferences = allowOutsideReferences;
+  if (!gltfScene.is_none()) {
+    const long long n = castArgument<long long>(gltfScene, "gltf_scene");
+    if (n < 0 || n > INT32_MAX) throw LibraryError("gltf_scene: must be a scene index (0-based)");
+    load.sceneIndex = static_cast<int>(n);
+  }
   auto scene = std::make_shared<Scene>();
   {
     py::gil_scoped_release release;
@@ -82,6 +87,7 @@ SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const SceneR
     load.transmissionAlphaFloor = static_cast<float>(request.transmissionFloor);
     load.memoryLimitBytes = memoryLimit;
     load.allowOutsideReferences = allowOutsideReferences;
+    load.sceneIndex = request.gltfScene;
     auto loaded = std::make_shared<Scene>();
     {
       py::gil_scoped_release release;
@@ -96,6 +102,8 @@ SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const SceneR
   if (allowOutsideReferences)
     throw LibraryError(
         "allow_outside_references: applies when the scene is loaded (mfr.load_scene)");
+  if (request.gltfScene)
+    throw LibraryError("gltf_scene: applies when the scene is loaded (mfr.load_scene)");
   auto loaded = scene.cast<std::shared_ptr<Scene>>();
   if (!request.changesScene()) return {loaded, loaded->name};
   auto changed = std::make_shared<Scene>(*loaded);  // the caller's scene stays as it is
@@ -107,7 +115,7 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
                                   const py::object& view, int orbit, const py::object& orbitView,
                                   double zoom, const py::object& alpha,
                                   const py::object& background, double transmissionFloor,
-                                  const py::object& shuffleDrawOrder) {
+                                  const py::object& shuffleDrawOrder, const py::object& gltfScene) {
   SceneRequest r;
   r.width = width;
   r.height = height;
@@ -138,6 +146,10 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
   if (!alpha.is_none()) r.alpha = castArgument<double>(alpha, "alpha");
   if (!background.is_none()) r.background = numbers(background, "background");
   r.transmissionFloor = transmissionFloor;
+  if (!gltfScene.is_none()) {
+    const long long n = castArgument<long long>(gltfScene, "gltf_scene");
+    r.gltfScene = n < 0 ? -1 : static_cast<int>(std::min<long long>(n, INT32_MAX));
+  }
   if (!shuffleDrawOrder.is_none())
     r.shuffleDrawOrder = castArgument<uint64_t>(shuffleDrawOrder, "shuffle_draw_order");
   unwrap(checkSceneRequest(r, Spelling::Python));

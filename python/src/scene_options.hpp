@@ -29,7 +29,8 @@ std::shared_ptr<Scene> loadSceneArgument(const std::string& source, uint64_t see
                                          double transmissionFloor, const py::object& alpha,
                                          const py::object& background,
                                          std::optional<uint64_t> memoryLimit,
-                                         bool allowOutsideReferences = false);
+                                         bool allowOutsideReferences = false,
+                                         const py::object& gltfScene = py::none());
 
 /// An mfr.Scene (copied only when the request changes it: draw order, alpha, background) or a
 /// source string (loaded with `seed`, the request's transmission floor and overrides applied).
@@ -44,7 +45,7 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
                                   const py::object& view, int orbit, const py::object& orbitView,
                                   double zoom, const py::object& alpha,
                                   const py::object& background, double transmissionFloor,
-                                  const py::object& shuffleDrawOrder);
+                                  const py::object& shuffleDrawOrder, const py::object& gltfScene);
 
 /// A budget: bytes as an int, a size ("20MB") or a share of the A-buffer ("25%").
 BudgetSpec budgetSpecArgument(const py::object& budget);

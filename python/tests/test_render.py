@@ -202,6 +202,17 @@ def test_empty_values_are_not_absent_values():
                    transmission_floor=0.5)
 
 
+def test_gltf_scene_and_skipped_primitives():
+    # which of a glTF file's scenes: the CLI's --scene N (tests/test_gltf_scenes.cpp has files)
+    with pytest.raises(mfr.Error, match=r"scene 1: only glTF files hold several scenes"):
+        mfr.render("procedural:bottles", width=W, height=H, gltf_scene=1)
+    with pytest.raises(mfr.Error, match=r"^gltf_scene: must be a scene index"):
+        mfr.load_scene("procedural:bottles", gltf_scene=-1)
+    scene = mfr.load_scene("procedural:bottles")
+    assert scene.primitives_skipped == 0
+    assert mfr.render(scene, width=W, height=H).stats["primitives_skipped"] == 0
+
+
 def test_engine_names_and_bad_engine():
     assert mfr.engine_names()[0] == "cpu"
     with pytest.raises(mfr.Error, match=r"engine"):

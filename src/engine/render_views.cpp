@@ -37,6 +37,7 @@ Result<void> renderViews(Engine& engine, const Scene& scene, const std::string& 
     }
     auto result = engine.render(**view, method, options);
     if (!result) return named(result.error());
+    result->stats.primitivesSkipped = scene.primitivesSkipped;
     previousCosine = result->nearestCosine;
     MFR_TRY(each(RenderedView{static_cast<int>(v), **view, result.value()}));
   }

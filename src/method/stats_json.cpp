@@ -31,6 +31,7 @@ nlohmann::json statsToJson(const RenderStats& s) {
   for (const PassTime& p : s.passes) times[p.name] = p.ms;
   j["time_ms"] = times;
   if (!s.engine.empty()) j["engine"] = s.engine;
+  j["primitives_skipped"] = s.primitivesSkipped;
   if (!s.isa.empty()) j["isa"] = s.isa;
   for (const auto& [name, value] : s.engineCounters) j["engine_counters"][name] = value;
   j["total_ms"] = s.totalMs();

@@ -562,7 +562,14 @@ glm::dmat4 localTransform(const tinygltf::Node& node) {
 /// makes the file invalid.
 Result<void> GltfSceneBuilder::visitNodes() {
   std::vector<int> roots;
-  if (model_.defaultScene >= 0 && static_cast<size_t>(model_.defaultScene) < model_.scenes.size())
+  if (options_.sceneIndex) {
+    const int n = *options_.sceneIndex;
+    if (n < 0 || static_cast<size_t>(n) >= model_.scenes.size())
+      return fail("scene " + std::to_string(n) + ": the file has " +
+                  std::to_string(model_.scenes.size()) + " scene(s)");
+    roots = model_.scenes[static_cast<size_t>(n)].nodes;
+  } else if (model_.defaultScene >= 0 &&
+             static_cast<size_t>(model_.defaultScene) < model_.scenes.size())
     roots = model_.scenes[static_cast<size_t>(model_.defaultScene)].nodes;
   else if (!model_.scenes.empty())
     roots = model_.scenes[0].nodes;
@@ -692,8 +699,10 @@ Result<void> GltfSceneBuilder::addPrimitive(const tinygltf::Primitive& primitive
                                             const glm::dmat4& world, const std::string& what) {
   const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
   if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
-      mode != TINYGLTF_MODE_TRIANGLE_FAN)
-    return {};  // points and lines are not rendered
+      mode != TINYGLTF_MODE_TRIANGLE_FAN) {
+    ++scene_.primitivesSkipped;  // points and lines are not surfaces: counted, not rendered
+    return {};
+  }
   const auto position = primitive.attributes.find("POSITION");
   if (position == primitive.attributes.end()) return {};  // nothing to draw
 

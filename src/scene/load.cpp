@@ -40,6 +40,9 @@ Result<Scene> loadOpenFile(const std::string& path, const OpenFile& file,
                            const LoadOptions& options) {
   const std::string extension = lowercaseExtension(path);
   if (extension == ".gltf" || extension == ".glb") return loadGltf(path, file, options);
+  if (options.sceneIndex)
+    return makeError(path + ": scene " + std::to_string(*options.sceneIndex) +
+                     ": only glTF files hold several scenes");
   if (extension == ".obj") return loadObj(path, file, options);
   if (extension == ".ply") return loadPly(path, file, options);
   if (extension == ".json") return loadJsonScene(path, file, options);
@@ -74,6 +77,9 @@ Result<Scene> loadJsonScene(const std::string& path, const LoadOptions& options)
 
 Result<Scene> loadScene(const std::string& source, const LoadOptions& options) {
   const std::string prefix = kProceduralPrefix;
+  if (options.sceneIndex && source.rfind(prefix, 0) == 0)
+    return makeError(echoPath(source) + ": scene " + std::to_string(*options.sceneIndex) +
+                     ": only glTF files hold several scenes");
   Result<Scene> loaded = source.rfind(prefix, 0) == 0
                              ? makeProceduralScene(source.substr(prefix.size()), options.seed,
                                                    options.maxProceduralTriangles)

@@ -37,6 +37,9 @@ Result<void> checkSceneRequest(const SceneRequest& r, Spelling spelling) {
   if (!(r.transmissionFloor >= 0.0 && r.transmissionFloor <= 1.0))
     return makeError(flag("--transmission-floor") + ": must be in [0, 1]");
   if (r.view < -1) return makeError(flag("--view") + ": must be a camera index (0-based)");
+  if (r.gltfScene && *r.gltfScene < 0)
+    return makeError(spell(spelling, spelling == Spelling::Cli ? "--scene" : "gltf_scene") +
+                     ": must be a scene index (0-based)");
   if (r.hasCamera() && r.view >= 0)
     return makeError(flag("--view") + " and " + flag("--camera") + ": give one camera, not both");
   if (!r.camera.empty()) MFR_TRY(parseCameraSpec(r.camera, flag("--camera")));

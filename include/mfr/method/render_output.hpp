@@ -87,6 +87,7 @@ struct RenderStats {
   std::optional<double> meanDepthComplexity;   // over covered pixels
   std::vector<PassTime> passes;
   std::optional<OracleReport> oracle;  // optimal / optimal-greedy
+  uint64_t primitivesSkipped = 0;      // the scene's points and lines, not rendered
   /// The engine that rendered (Engine::name) and what only it measures (the CPU engine: threads,
   /// tile_workers), beside the shared fields above.
   std::string engine;

@@ -30,6 +30,9 @@ struct LoadOptions {
   /// Memory pre-flight for what a file makes the loader allocate (decoded textures); none:
   /// defaultMemoryLimit() (mfr/core/memory_limit.hpp).
   std::optional<uint64_t> memoryLimitBytes;
+  /// glTF: which of the file's scenes (`--scene N`); none: the file's `scene`, else its first.
+  /// Another format, or an index the file does not have, is an error.
+  std::optional<int> sceneIndex;
 };
 
 /// Loads a scene from a file path or a procedural spec: "procedural:NAME[?key=value&...]"

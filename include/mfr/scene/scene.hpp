@@ -56,6 +56,9 @@ struct Scene {
   /// Mask materials that pass their alpha test (a cutout keeps its shape; what it cuts away stays
   /// away).
   std::optional<float> alphaOverride;
+  /// Primitives of the file that are not surfaces (glTF points and lines): not rendered, and
+  /// reported (RenderStats::primitivesSkipped, the CLI's summary line) instead of dropped silently.
+  uint64_t primitivesSkipped = 0;
 
   size_t triangleCount() const { return indices.size() / 3; }
   size_t vertexCount() const { return positions.size(); }

@@ -28,6 +28,7 @@ struct SceneRequest {
   std::optional<double> alpha;               // --alpha: every material's alpha
   std::vector<double> background;            // --background R,G,B (linear; empty: the scene's)
   double transmissionFloor = 0.1;            // --transmission-floor (glTF transmission glass)
+  std::optional<int> gltfScene;              // --scene N: which of a glTF file's scenes
 
   bool hasCamera() const { return !camera.empty() || !cameraNumbers.empty(); }
   /// True when applyToScene changes a loaded scene.
