@@ -1,3 +1,12 @@
+// Per-pixel memory (pixel p; bindings in shared_layout.h):
+//
+//   offsets (kBindOffsets, uint)    first slot of p: the exclusive prefix sum of n(p)
+//   fill    (kBindFill, uint)       slots of p filled so far (atomicAdd; n(p) when done)
+//   nodes   (kBindNodes, uvec2)     [offsets[p], offsets[p] + n(p)): x = depth bits, y = RGBA8
+//                                   colour, in arrival order (the resolve sorts them)
+//
+// Bytes per pixel: 8 n(p) + 4 (offset) + 4 (counter); no lock (the append is atomic).
+//
 // A-buffer capture: every fragment into its pixel's slots offsets[p] + fill[p]++ (atomic).
 layout(std430, binding = kBindOffsets) readonly buffer Offsets {
   uint offsets[];

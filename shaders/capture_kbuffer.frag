@@ -1,3 +1,20 @@
+// Per-pixel memory (pixel p = y * width + x; bindings in shared_layout.h):
+//
+//   nodes   (kBindNodes, uvec2 = 8 B each)   fixed k: slots [p * k, p * k + k)
+//                                            variable k: [first, first + k(p)) from uAlloc
+//     slot:  x = floatBitsToUint(depth) | y = RGBA8 colour (packFragmentColor)
+//     empty: x = kFarDepthBits (+inf), so a store is always "full" and slot 0 holds its maximum
+//     max-array: slot 0 the maximum, the rest unordered; max-heap: a binary max-heap (root slot 0)
+//   uAlloc  (kBindAllocation, rg32ui texel)  variable k only: (first slot, k(p) | kAllocHeapBit)
+//   uLocks  (kBindLocks, r32ui, 4 B)         kLockFree / kLockHeld (unused with MFR_INTERLOCK)
+//   tails   (kBindTails, kTailWords = 20 B)  hybrid only: sum a r, sum a g, sum a b, sum a (float
+//                                            bits), t (uint)
+//   occupancy (kBindOccupancy, 12 B)         +occupancy only: zn, zf (depth bits), j_k; the
+//                                            bitmaps (4 d B) stay with the occupancy passes
+//
+// Bytes per pixel (MemoryModel): 8 k + 4 (lock) [+ 4 offset for variable k] [+ 20 tail]
+// [+ 12 + 4 d occupancy], plus the count pass's 4-byte counter.
+//
 // Fixed-k k-buffer capture with the k+ culling test (Vasilakis and Fudos, k+-buffer), max-array or
 // max-heap store (uStore): pixel p owns the k nodes nodes[p * k .. p * k + k), initialised to the
 // far node (so the store is always full), with the maximum always in slot 0. Max-array: the

@@ -1,3 +1,13 @@
+// Per-pixel memory (pixel p; bindings in shared_layout.h):
+//
+//   nodes (kBindNodes, uint64 = 8 B)   slots [p * k, p * k + k), kept sorted nearest first
+//     slot:  colour word in the low 32 bits, depth bits high while capturing (the 64-bit order);
+//            swap_node_words.comp then restores the engine's uvec2 (depth, colour) layout
+//     empty: depth bits kFarDepthBits (+inf): the walk ends at the first empty slot
+//
+// Bytes per pixel: 8 k + 4 (the count pass's counter); no lock word is needed, though the memory
+// model charges the fixed-k stores' lock (what the spin-lock capture uses).
+//
 // Fixed-k k-buffer capture with 64-bit atomics (the k-buffer paper's "atomicMin" variant, variable
 // k-buffer paper /work/shared/papers/variable-k-buffer-importance-maps.md sec. 4: the fixed k-buffer
 // "exploits atomicMin hardware instructions" where the others need a spin-lock): compiled only when

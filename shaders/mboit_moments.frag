@@ -1,3 +1,11 @@
+// Per-pixel memory (pixel p; bindings in shared_layout.h), both MBOIT passes:
+//
+//   accum  (kBindAccum, kMboitWords = 9 floats = 36 B)
+//     [9p + 0] b0   [9p + 1..4] b1..b4 (this pass)   [9p + 5..7] sum T a c   [9p + 8] sum T a
+//   uLocks (kBindLocks, r32ui, 4 B)   the per-pixel spin-lock around the update
+//
+// Bytes per pixel: 36 (moments and accumulators) + 4 (lock); no nodes.
+//
 // Moment-based OIT, pass 1 (Muenstermann et al. 2018; mfr::MboitPixel::addMoments): each fragment
 // adds its absorbance A = -ln(1 - min(a, 0.99999)) times 1, z, z^2, z^3, z^4 (z = 2 d - 1) to the
 // pixel's moments under the pixel's spin-lock. Sums in arrival order (see wboit.frag).

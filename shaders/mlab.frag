@@ -1,3 +1,13 @@
+// Per-pixel memory (pixel p; bindings in shared_layout.h):
+//
+//   mlab   (kBindNodes, kMlabWords = 5 floats = 20 B per node)   nodes [p * k, p * k + k)
+//     node: depth, premultiplied r, g, b, transmittance; sorted front to back; slots at and
+//     above fill[p] are unused (never read)
+//   fill   (kBindFill, uint)          nodes in use (at most k)
+//   uLocks (kBindLocks, r32ui, 4 B)   the per-pixel spin-lock around the insertion
+//
+// Bytes per pixel: 20 k + 4 (counter) + 4 (lock).
+//
 // Multi-layer alpha blending (Salvi and Vaidyanathan 2014; mfr::mlabInsert): pixel p owns k nodes
 // (depth, premultiplied r, g, b, transmittance) at p * k, kept sorted front to back, and a count.
 // Under the pixel's spin-lock a fragment is inserted in depth order (after equal depths); when

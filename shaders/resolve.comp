@@ -1,3 +1,11 @@
+// Per-pixel memory read (pixel p; bindings in shared_layout.h):
+//
+//   counts  (kBindCounts, uint)        n(p) from the count pass (the store holds min(n(p), k(p)))
+//   offsets (kBindOffsets, uint)       first slot of p (exact allocations; fixed k: p * k)
+//   nodes   (kBindNodes, uvec2)        the captured nodes, written back sorted front to back
+//   tails   (kBindResolveTails, 20 B)  hybrid: the order-independent tail
+//   image   (kBindImage, 3 floats)     the output: linear RGB, rows top to bottom
+//
 // Resolve: one invocation per pixel sorts the pixel's captured nodes (insertion sort in a local
 // array when they fit in kResolveLocalNodes, else heap sort in place in the node buffer, so any
 // count works),

@@ -1,3 +1,11 @@
+// Per-pixel memory (pixel p; bindings in shared_layout.h):
+//
+//   accum  (kBindAccum, kWboitWords = 5 floats = 20 B)
+//     [5p + 0..2] sum C w (r, g, b)   [5p + 3] sum a w   [5p + 4] revealage (starts at 1)
+//   uLocks (kBindLocks, r32ui, 4 B)   the per-pixel spin-lock around the update
+//
+// Bytes per pixel: 20 (accumulators) + 4 (lock); no nodes.
+//
 // Weighted blended OIT (McGuire and Bavoil 2013; mfr::WboitPixel::add): each fragment adds
 // C w, a w to the pixel's sums and multiplies its revealage by 1 - a, under the pixel's spin-lock
 // (float atomics are not core GL; the CPU engine's fragment-parallel capture locks the same way).
