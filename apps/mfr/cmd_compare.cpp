@@ -20,6 +20,7 @@
 #include "mfr/core/image.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
+#include "mfr/engine/render_views.hpp"
 #include "mfr/method/dkb_model.hpp"
 #include "mfr/method/make_method.hpp"
 
@@ -251,13 +252,12 @@ int run(const CompareArgs& a, const std::string& version) {
   progress.set("setting up " + a.scene.source);
   auto view = (*engine)->prepare(sceneView(*prepared, a.scene, prepared->cameras.front()));
   if (!view) return fail(echoPath(a.scene.source) + ": " + view.error().message);
-  if (prepared->previousCamera) {  // --orbit-view I: view I - 1 precedes it (vkb's Fresnel term)
-    auto previous = (*engine)->prepare(sceneView(*prepared, a.scene, *prepared->previousCamera));
-    if (!previous) return fail(echoPath(a.scene.source) + ": " + previous.error().message);
-    auto cosine = (*engine)->nearestCosine(**previous);
-    if (!cosine) return fail(echoPath(a.scene.source) + ": " + cosine.error().message);
-    options.previousNearestCosine = std::move(cosine.value());
-  }
+  // --orbit-view I: view I - 1 precedes it (vkb's Fresnel term)
+  auto previous = previousViewCosine(**engine, prepared->scene, a.scene.source,
+                                     {prepared->cameras, prepared->previousCamera}, a.scene.width,
+                                     a.scene.height);
+  if (!previous) return fail(previous.error().message);
+  options.previousNearestCosine = std::move(previous.value());
   options.progress = [&progress](const std::string& stage, int done, int total) {
     progress.set(stage, done, total);
   };

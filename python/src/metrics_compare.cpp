@@ -8,6 +8,7 @@
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/engine/engine.hpp"
+#include "mfr/engine/render_views.hpp"
 #include "mfr/method/make_method.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/metrics/flip.hpp"
@@ -179,13 +180,9 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     } else {
       auto view = engine->prepare(View{&*scene.scene, views.cameras.front(), width, height});
       if (!view) throw named(view.error());
-      if (views.previousCamera) {  // orbit_view I: view I - 1 precedes it (vkb's Fresnel term)
-        auto previous = engine->prepare(View{&*scene.scene, *views.previousCamera, width, height});
-        if (!previous) throw named(previous.error());
-        auto cosine = engine->nearestCosine(**previous);
-        if (!cosine) throw named(cosine.error());
-        options.previousNearestCosine = std::move(cosine.value());
-      }
+      // orbit_view I: view I - 1 precedes it (vkb's Fresnel term)
+      options.previousNearestCosine =
+          unwrap(previousViewCosine(*engine, *scene.scene, scene.source, views, width, height));
       auto result = runComparison(*engine, **view, options);
       if (!result) throw named(result.error());
       jsonText = unwrap(writeComparison(result.value(), folder.staging(), MFR_VERSION, info));

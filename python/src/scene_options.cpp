@@ -97,7 +97,7 @@ SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const SceneR
     return {loaded, source};
   }
   // a loaded scene's files are read: its loading options cannot change it now
-  if (request.transmissionFloor != 0.1)
+  if (request.transmissionFloor != SceneRequest{}.transmissionFloor)
     throw LibraryError("transmission_floor: applies when the scene is loaded (mfr.load_scene)");
   if (allowOutsideReferences)
     throw LibraryError(

@@ -6,6 +6,18 @@
 
 namespace mfr {
 
+Result<std::vector<float>> previousViewCosine(Engine& engine, const Scene& scene,
+                                              const std::string& source, const SceneViews& views,
+                                              int width, int height) {
+  if (!views.previousCamera) return std::vector<float>{};
+  const auto named = [&](const Error& e) { return makeError(echoPath(source) + ": " + e.message); };
+  auto previous = engine.prepare(View{&scene, *views.previousCamera, width, height});
+  if (!previous) return named(previous.error());
+  auto cosine = engine.nearestCosine(**previous);
+  if (!cosine) return named(cosine.error());
+  return std::move(cosine.value());
+}
+
 Result<void> renderViews(Engine& engine, const Scene& scene, const std::string& source,
                          const SceneViews& views, int width, int height, const MethodDesc& method,
                          RenderOptions options, const std::optional<BudgetSpec>& budget,
@@ -14,12 +26,10 @@ Result<void> renderViews(Engine& engine, const Scene& scene, const std::string& 
   const auto viewOf = [&](const Camera& camera) { return View{&scene, camera, width, height}; };
   if (budget) options.budgetBytes = budget->bytes;
   std::vector<float> previousCosine;  // importance methods: nearest |n.v| of the previous view
-  if (views.previousCamera && method.allocation == AllocationPolicy::Importance &&
+  if (method.allocation == AllocationPolicy::Importance &&
       method.importanceSource == ImportanceSource::Heuristic) {
-    auto previous = engine.prepare(viewOf(*views.previousCamera));
-    if (!previous) return named(previous.error());
-    auto cosine = engine.nearestCosine(**previous);
-    if (!cosine) return named(cosine.error());
+    auto cosine = previousViewCosine(engine, scene, source, views, width, height);
+    if (!cosine) return cosine.error();
     previousCosine = std::move(cosine.value());
   }
   const std::string size = std::to_string(width) + "x" + std::to_string(height);

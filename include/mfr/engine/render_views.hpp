@@ -22,6 +22,13 @@ struct RenderedView {
   RenderOutput& output;
 };
 
+/// With --orbit-view I > 0: the nearest |n.v| of view I - 1 (SceneViews::previousCamera), the
+/// previous frame the variable k-buffer's Fresnel term reads; empty without a previous camera.
+/// Errors are prefixed with the scene `source`.
+Result<std::vector<float>> previousViewCosine(Engine& engine, const Scene& scene,
+                                              const std::string& source, const SceneViews& views,
+                                              int width, int height);
+
 /// Renders `method` on every view of `views` (at width x height) with `options`; `budget`, when
 /// given, replaces options.budgetBytes (a share resolved per view). `each` receives each output in
 /// view order; its error stops the run. Engine errors are prefixed with the scene `source`.
