@@ -20,7 +20,7 @@ layout(std430, binding = kBindFill) buffer Fill {
 
 void main() {
   FragmentData f;
-  if (!exactCoverage(f)) discard;
+  if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, false, base)) discard;
   const uvec2 node = uvec2(floatBitsToUint(fragmentDepth(f)), shade(f, base));

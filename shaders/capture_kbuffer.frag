@@ -113,9 +113,10 @@ void insertNode(const uint p, const uint first, const uint k, const uint storeKi
 
 void main() {
   FragmentData f;
-  if (!exactCoverage(f)) discard;
+  if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, false, base)) discard;
+  countInCapture(f);
   const float depth = fragmentDepth(f);
   const uint p = uint(f.pixel);
   bool store = true;  // false: culled, to the tail (hybrid) or dropped

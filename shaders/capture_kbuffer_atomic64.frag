@@ -29,9 +29,10 @@ uniform uint uK;
 
 void main() {
   FragmentData f;
-  if (!exactCoverage(f)) discard;
+  if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, false, base)) discard;
+  countInCapture(f);
   const uint first = uint(f.pixel) * uK;
   const uint64_t far = packUint2x32(uvec2(0u, kFarDepthBits));
   uint64_t v = packUint2x32(uvec2(shade(f, base), floatBitsToUint(fragmentDepth(f))));

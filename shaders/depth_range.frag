@@ -6,7 +6,7 @@ layout(std430, binding = kBindOccupancy) coherent buffer Range {
 
 void main() {
   FragmentData f;
-  if (!exactCoverage(f)) discard;
+  if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, true, base)) discard;
   const uint z = floatBitsToUint(fragmentDepth(f));

@@ -48,9 +48,10 @@ float transmittance(uint i, float zf) {
 
 void main() {
   FragmentData f;
-  if (!exactCoverage(f)) discard;
+  if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, false, base)) discard;
+  countInCapture(f);
   const float depth = fragmentDepth(f);
   const uint rgba = shade(f, base);
   precise float a = float(rgba >> 24) * uInv255;

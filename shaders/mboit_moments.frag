@@ -16,7 +16,7 @@ layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
 
 void main() {
   FragmentData f;
-  if (!exactCoverage(f)) discard;
+  if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, false, base)) discard;
   const float depth = fragmentDepth(f);

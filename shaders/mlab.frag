@@ -50,9 +50,10 @@ void mergeBehind(uint at, vec3 rgb, float t) {
 
 void main() {
   FragmentData f;
-  if (!exactCoverage(f)) discard;
+  if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, false, base)) discard;
+  countInCapture(f);
   const float depth = fragmentDepth(f);
   const uint rgba = shade(f, base);
   precise float a = float(rgba >> 24) * uInv255;

@@ -9,7 +9,7 @@ layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
 
 void main() {
   FragmentData f;
-  if (!exactCoverage(f)) discard;
+  if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, false, base)) discard;
   float cosine;

@@ -10,7 +10,7 @@ uniform uint uWords;
 
 void main() {
   FragmentData f;
-  if (!exactCoverage(f)) discard;
+  if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, true, base)) discard;
   const uint p = uint(f.pixel);

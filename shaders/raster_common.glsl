@@ -1,21 +1,8 @@
-// Shared part of the fragment shaders of the geometry passes (prepended to count.frag,
-// capture_abuffer.frag and capture_kbuffer.frag): the CPU engine's exact coverage test,
-// barycentrics, alpha test, depth and shading (include/mfr/cpu/raster_frame_impl.hpp), operation
-// for operation and `precise`, so that both engines produce the same fragments bit for bit.
-flat in ivec3 gX;
-flat in ivec3 gY;
-flat in vec3 gZ;
-flat in vec3 gInvW;
-flat in vec3 gN0;
-flat in vec3 gN1;
-flat in vec3 gN2;
-flat in vec3 gU;
-flat in vec3 gV;
-flat in float gInvArea;
-flat in uint gTopLeft;
-flat in uint gMaterial;
-
-uniform ivec2 uSize;
+// Shared part of the fragment shaders of the geometry passes, after the raster part
+// (raster_exact.glsl or raster_native.glsl, which define FragmentData, rasterFragment,
+// fragmentMaterial, fragmentUv, fragmentNormal and fragmentDepth): the alpha test, texture
+// sampling and shading of the CPU engine (include/mfr/cpu/raster_frame_impl.hpp), operation for
+// operation and `precise`.
 uniform vec4 uRay;       // view ray of pixel (x, y): (x * ray.x + ray.y, y * ray.z + ray.w, -1)
 uniform float uAmbient;  // kAmbient
 uniform float uDiffuse;  // 1 - kAmbient
@@ -31,37 +18,14 @@ layout(std430, binding = kBindTexels) readonly buffer Texels {
   uint texels[];
 };
 
-struct FragmentData {
-  ivec2 px;
-  int pixel;
-  float l0, l1, l2;
-};
+// n(p): the count pass adds every fragment here; so does a capture that runs without a count pass
+// before it (uCountInCapture = 1: fixed k, wboit, mboit, mlab), right after the alpha test, so
+// that the capture's own n(p) is the count pass's
+layout(binding = kBindCounts, r32ui) uniform coherent uimageBuffer uCounts;
+uniform uint uCountInCapture;
 
-// The CPU engine's edge functions at the pixel centre, in double (exact: products below 2^51):
-// false when the centre is not covered under its fill rule.
-bool exactCoverage(out FragmentData f) {
-  f.px = ivec2(gl_FragCoord.xy);
-  f.pixel = f.px.y * uSize.x + f.px.x;
-  const double px0 = double(f.px.x * 256 + 128);
-  const double py0 = double(f.px.y * 256 + 128);
-  double w[3];
-  bool covered = true;
-  for (int i = 0; i < 3; ++i) {
-    const int a = (i + 1) % 3, b = (i + 2) % 3;
-    const double A = double(gY[a] - gY[b]);
-    const double B = double(gX[b] - gX[a]);
-    precise double wi = B * (py0 - double(gY[a])) + A * (px0 - double(gX[a]));
-    const double bias = ((gTopLeft >> uint(i)) & 1u) != 0u ? 0.0lf : -1.0lf;
-    covered = covered && wi + bias >= 0.0lf;
-    w[i] = wi;
-  }
-  precise float l1 = float(w[1]) * gInvArea;
-  precise float l2 = float(w[2]) * gInvArea;
-  precise float l0 = 1.0 - l1 - l2;
-  f.l0 = l0;
-  f.l1 = l1;
-  f.l2 = l2;
-  return covered;
+void countInCapture(FragmentData f) {
+  if (uCountInCapture != 0u) imageAtomicAdd(uCounts, f.pixel, 1u);
 }
 
 float srgb8ToLinear(uint code) {
@@ -106,7 +70,7 @@ vec4 sampleTexture(uint first, int width, int height, vec2 uv) {
 
 // alpha test and base colour (RasterFrame::surface); false when the fragment is discarded
 bool surface(FragmentData f, bool coverageOnly, out vec4 base) {
-  const uint m = gMaterial * kMaterialWords;
+  const uint m = fragmentMaterial() * kMaterialWords;
   const uint mode = materials[m + 7u];
   const bool needsAlphaTest = mode == kAlphaMask;
   base = vec4(0.0);
@@ -115,10 +79,7 @@ bool surface(FragmentData f, bool coverageOnly, out vec4 base) {
               uintBitsToFloat(materials[m + 2u]), uintBitsToFloat(materials[m + 3u]));
   const uint texture = materials[m + 4u];
   if (texture != kNoTexture) {
-    precise float q = gInvW.x * f.l0 + gInvW.y * f.l1 + gInvW.z * f.l2;
-    precise float invQ = 1.0 / q;
-    precise vec2 uvq = vec2(gU.x, gV.x) * f.l0 + vec2(gU.y, gV.y) * f.l1 + vec2(gU.z, gV.z) * f.l2;
-    precise vec2 uv = uvq * invQ;
+    const vec2 uv = fragmentUv(f);
     precise vec4 b = base * sampleTexture(texture, int(materials[m + 5u]),
                                           int(materials[m + 6u]), uv);
     base = b;
@@ -131,13 +92,6 @@ bool surface(FragmentData f, bool coverageOnly, out vec4 base) {
   }
   if (materials[m + 9u] != 0u) base.a = uintBitsToFloat(materials[m + 10u]);
   return true;
-}
-
-float fragmentDepth(FragmentData f) {
-  precise float dz1 = gZ.y - gZ.x;
-  precise float dz2 = gZ.z - gZ.x;
-  precise float z = gZ.x + f.l1 * dz1 + f.l2 * dz2;
-  return z > 0.0 ? (z < 1.0 ? z : 1.0) : 0.0;
 }
 
 float clampUnit(float v) {  // min(max(v, 0), 1) with NaN -> 0
@@ -164,9 +118,8 @@ uint packColor(vec3 rgb, float alpha) {
 
 // headlight shading (RasterFrame::shade): the colour word, and the clamped n.v it used
 uint shadeWithCosine(FragmentData f, vec4 base, out float cosine) {
-  precise float nx = gN0.x * f.l0 + gN1.x * f.l1 + gN2.x * f.l2;
-  precise float ny = gN0.y * f.l0 + gN1.y * f.l1 + gN2.y * f.l2;
-  precise float nz = gN0.z * f.l0 + gN1.z * f.l1 + gN2.z * f.l2;
+  const vec3 n = fragmentNormal(f);
+  const float nx = n.x, ny = n.y, nz = n.z;
   precise float dx = float(f.px.x) * uRay.x + uRay.y;
   precise float dy = float(f.px.y) * uRay.z + uRay.w;
   precise float nn = (nx * nx + ny * ny + nz * nz) * (dx * dx + dy * dy + 1.0);

@@ -63,6 +63,11 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
     app.add_option("--gl-sync", glSync,
                    "GL engine's k-buffer capture: auto (the fragment shader interlock when the "
                    "driver offers it, else the spin-lock), lock or interlock (default auto)");
+    app.add_option("--gl-raster", glRaster,
+                   "GL engine's geometry passes: native (GL's own clipper, rasterizer and "
+                   "interpolation in single precision: what a GPU engine runs) or exact (the CPU "
+                   "engine's raster emulated in a geometry shader, partly in double: "
+                   "bit-identical to --engine cpu, a cross-check) (default native)");
   }
 }
 
@@ -70,6 +75,7 @@ Result<std::unique_ptr<Engine>> makeSceneEngine(const SceneOptions& o) {
   EngineOptions eo;
   eo.threads = o.threads;
   eo.glSync = o.glSync;
+  eo.glRaster = o.glRaster;
   return makeEngine(o.engine, eo);
 }
 

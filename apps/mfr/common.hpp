@@ -44,6 +44,7 @@ struct SceneOptions {
   std::string memoryLimit;              // --memory-limit (empty: defaultMemoryLimit())
   std::string engine = "cpu";           // --engine (render, compare, info)
   std::string glSync = "auto";          // --gl-sync (the GL engine's k-buffer sync)
+  std::string glRaster = "native";      // --gl-raster (the GL engine's geometry passes)
 
   /// Registers the options (and the positional scene unless the command takes several; --engine
   /// for the commands that run on either engine).

@@ -116,8 +116,8 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
            view=None, orbit=0, orbit_view=None, zoom=1.0, composite=None, capture="tile",
            threads=0, seed=1, model=None, occupancy_d=None, importance=None, alpha=None,
            background=None, transmission_floor=0.1, shuffle_draw_order=None, gltf_scene=None,
-           engine="cpu", gl_sync="auto", memory_limit=None, allow_outside_references=False,
-           depth_complexity=True):
+           engine="cpu", gl_sync="auto", gl_raster="native", memory_limit=None,
+           allow_outside_references=False, depth_complexity=True):
     """Renders with one method, exactly as `mfr render` with the same options (the library checks
     both the same way: its errors name the Python argument where the CLI names its flag).
 
@@ -141,7 +141,8 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
     shuffle_draw_order: submit the triangles in this seed's random order. gltf_scene: which of a
         glTF file's scenes (`--scene N`; default the file's own).
     engine: "cpu" or "gl" (mfr.engine_names()); gl_sync: the GL k-buffer's "auto", "lock" or
-        "interlock".
+        "interlock"; gl_raster: the GL geometry passes, "native" (GL's own pipeline) or "exact"
+        (the CPU engine's raster emulated: bit-identical to engine="cpu").
     threads: worker threads in [0, 1024] (0: all cores; the output does not depend on it).
         seed: procedural scenes and vkb's noise.
     memory_limit: refuse runs whose buffers need more (bytes or "8GB"; default 75% of the least
@@ -161,7 +162,7 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
                    occupancy_d=occupancy_d, importance=importance, alpha=alpha,
                    background=background, transmission_floor=transmission_floor,
                    shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, engine=engine,
-                   gl_sync=gl_sync, memory_limit=memory_limit,
+                   gl_sync=gl_sync, gl_raster=gl_raster, memory_limit=memory_limit,
                    allow_outside_references=allow_outside_references,
                    depth_complexity=depth_complexity)
 
@@ -171,7 +172,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
             zoom=1.0,
             composite=None, capture="tile", threads=0, seed=1, model=None, ppd=FLIP_DEFAULT_PPD,
             alpha=None, background=None, transmission_floor=0.1, shuffle_draw_order=None,
-            gltf_scene=None, engine="cpu", gl_sync="auto", memory_limit=None,
+            gltf_scene=None, engine="cpu", gl_sync="auto", gl_raster="native", memory_limit=None,
             allow_outside_references=False) -> dict:
     """Writes the folder `mfr compare --out OUT` writes for the same options and returns its
     results.json as a dict.
@@ -186,8 +187,8 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
     OUT/frame_NNN, the flicker of each method along the path in results.json and report.html;
     orbit_step: degrees between frames, default 360/N); with orbit_view=I only view I of the N
     is compared. scene, camera, view, zoom, width, height, threads, seed, alpha,
-    background, transmission_floor, shuffle_draw_order, gltf_scene, engine, gl_sync, memory_limit,
-    allow_outside_references: as in mfr.render. A method that fails at a budget is recorded with
+    background, transmission_floor, shuffle_draw_order, gltf_scene, engine, gl_sync, gl_raster,
+    memory_limit, allow_outside_references: as in mfr.render. A method that fails at a budget is recorded with
     its error; bad input raises mfr.Error.
     """
     if isinstance(budgets, (str, int)):
@@ -209,6 +210,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                                  ("shuffle_draw_order", shuffle_draw_order, None),
                                  ("gltf_scene", gltf_scene, None),
                                  ("engine", engine, "cpu"), ("gl_sync", gl_sync, "auto"),
+                                 ("gl_raster", gl_raster, "native"),
                                  ("memory_limit", memory_limit, None),
                                  ("allow_outside_references", allow_outside_references, False)):
         if value != default:
@@ -222,7 +224,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                     threads=threads, seed=seed, model=model, ppd=ppd, alpha=alpha,
                     background=background, transmission_floor=transmission_floor,
                     shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, engine=engine,
-                    gl_sync=gl_sync, memory_limit=memory_limit,
+                    gl_sync=gl_sync, gl_raster=gl_raster, memory_limit=memory_limit,
                     allow_outside_references=allow_outside_references,
                     command_line="mfr.compare(" + ", ".join(call) + ")")
 

@@ -83,8 +83,8 @@ py::object compare(const py::object& sceneArg, const std::string& out,
                    const py::object& background, double transmissionFloor,
                    const py::object& shuffleDrawOrder, const py::object& gltfScene,
                    const std::string& engineName, const std::string& glSync,
-                   const py::object& memoryLimitArg, bool allowOutsideReferences,
-                   const std::string& commandLine) {
+                   const std::string& glRaster, const py::object& memoryLimitArg,
+                   bool allowOutsideReferences, const std::string& commandLine) {
   if (out.empty()) throw LibraryError("out: an output folder is required");
   const bool temporal = orbit != 0 && orbitView.is_none();  // every view of the orbit
   if (temporal && orbit < 2)
@@ -154,6 +154,7 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     EngineOptions eo;
     eo.threads = threads;
     eo.glSync = glSync;
+    eo.glRaster = glRaster;
     auto engine = unwrap(makeEngine(engineName, eo));
     const auto named = [&](const Error& e) {
       return LibraryError(echoPath(scene.source) + ": " + e.message);
@@ -209,7 +210,7 @@ flip_map (LDR-FLIP per pixel, float32 (h, w) in [0, 1]).)");
         py::arg("composite"), py::arg("capture"), py::arg("threads"), py::arg("seed"),
         py::arg("model"), py::arg("ppd"), py::arg("alpha"), py::arg("background"),
         py::arg("transmission_floor"), py::arg("shuffle_draw_order"), py::arg("gltf_scene"),
-        py::arg("engine"), py::arg("gl_sync"), py::arg("memory_limit"),
+        py::arg("engine"), py::arg("gl_sync"), py::arg("gl_raster"), py::arg("memory_limit"),
         py::arg("allow_outside_references"), py::arg("command_line"),
         "mfr.compare's work (see python/mfr/__init__.py).");
 }

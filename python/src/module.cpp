@@ -110,15 +110,18 @@ PyRenderResult renderResult(RenderOutput&& out, nlohmann::json stats, int width,
   return r;
 }
 
-py::object renderScene(
-    const py::object& sceneArg, const std::string& method, const py::object& budget,
-    const py::object& k, int width, int height, const py::object& camera, const py::object& view,
-    int orbit, const py::object& orbitView, double zoom, const py::object& composite,
-    const std::string& capture, int threads, uint64_t seed, const py::object& model,
-    const py::object& occupancyD, const py::object& importance, const py::object& alpha,
-    const py::object& background, double transmissionFloor, const py::object& shuffleDrawOrder,
-    const py::object& gltfScene, const std::string& engineName, const std::string& glSync,
-    const py::object& memoryLimitArg, bool allowOutsideReferences, bool wantDepthComplexity) {
+py::object renderScene(const py::object& sceneArg, const std::string& method,
+                       const py::object& budget, const py::object& k, int width, int height,
+                       const py::object& camera, const py::object& view, int orbit,
+                       const py::object& orbitView, double zoom, const py::object& composite,
+                       const std::string& capture, int threads, uint64_t seed,
+                       const py::object& model, const py::object& occupancyD,
+                       const py::object& importance, const py::object& alpha,
+                       const py::object& background, double transmissionFloor,
+                       const py::object& shuffleDrawOrder, const py::object& gltfScene,
+                       const std::string& engineName, const std::string& glSync,
+                       const std::string& glRaster, const py::object& memoryLimitArg,
+                       bool allowOutsideReferences, bool wantDepthComplexity) {
   const std::optional<uint64_t> memoryLimit = memoryLimitArgument(memoryLimitArg);
   const SceneRequest request =
       sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
@@ -155,6 +158,7 @@ py::object renderScene(
     EngineOptions eo;
     eo.threads = threads;
     eo.glSync = glSync;
+    eo.glRaster = glRaster;
     auto engine = unwrap(makeEngine(engineName, eo));
     if (spec) options.budgetBytes = spec->bytes;
     if (auto fits = engine->preflight(width, height, m, options); !fits)
@@ -338,7 +342,7 @@ lines are not rendered: Scene.primitives_skipped counts them.)");
         py::arg("importance") = py::none(), py::arg("alpha") = py::none(),
         py::arg("background") = py::none(), py::arg("transmission_floor") = 0.1,
         py::arg("shuffle_draw_order") = py::none(), py::arg("gltf_scene") = py::none(),
-        py::arg("engine") = "cpu", py::arg("gl_sync") = "auto",
+        py::arg("engine") = "cpu", py::arg("gl_sync") = "auto", py::arg("gl_raster") = "native",
         py::arg("memory_limit") = py::none(), py::arg("allow_outside_references") = false,
         py::arg("depth_complexity") = true,
         R"(Renders a scene (an mfr.Scene, or a source string loaded with `seed`) with one method, as

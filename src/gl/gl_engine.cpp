@@ -54,14 +54,38 @@ std::string oneLine(std::string text) {
   return out;
 }
 
-// "#version", the shared layout, [the fragment shaders' common part,] the shader's own text
-std::string composeSource(const std::string& file, bool fragmentCommon,
-                          const std::string& prelude) {
+// the fragment stage's raster part (raster_exact.glsl or raster_native.glsl)
+const char* rasterPart(GlRaster raster) {
+  switch (raster) {
+    case GlRaster::Native:
+      return "raster_native.glsl";
+    case GlRaster::Exact:
+      return "raster_exact.glsl";
+  }
+  return "raster_native.glsl";
+}
+
+// the vertex [and geometry] stages of a raster program
+std::vector<std::pair<GLenum, const char*>> rasterStages(GlRaster raster) {
+  switch (raster) {
+    case GlRaster::Native:
+      return {{GL_VERTEX_SHADER, "raster_native.vert"}};
+    case GlRaster::Exact:
+      return {{GL_VERTEX_SHADER, "raster.vert"}, {GL_GEOMETRY_SHADER, "raster.geom"}};
+  }
+  return {};
+}
+
+// "#version", the prelude, the shared layout, [a raster fragment stage's raster part and the
+// common part,] the shader's own text
+std::string composeSource(const std::string& file, const char* raster, const std::string& prelude) {
   std::string s = "#version 450 core\n";
   s += prelude;
   s += embeddedShader("shared_layout.h");
   s += "\n";
-  if (fragmentCommon) {
+  if (raster) {
+    s += embeddedShader(raster);
+    s += "\n";
     s += embeddedShader("raster_common.glsl");
     s += "\n";
   }
@@ -70,14 +94,14 @@ std::string composeSource(const std::string& file, bool fragmentCommon,
   return s;
 }
 
-Result<GLuint> compileShader(GLenum stage, const std::string& file, bool fragmentCommon,
+Result<GLuint> compileShader(GLenum stage, const std::string& file, const char* raster,
                              const std::string& prelude) {
   if (embeddedShader(file).empty()) return makeError("--engine gl: no embedded shader " + file);
-  return compileShaderSource(stage, file, composeSource(file, fragmentCommon, prelude));
+  return compileShaderSource(stage, file, composeSource(file, raster, prelude));
 }
 
 // Every program of the engine, in link order (the first that fails is the error): its shader
-// file (a raster program is raster.vert + raster.geom + this fragment shader) and what its
+// file (a raster program is rasterStages() + this fragment shader) and what its
 // fragment stage is prefixed with.
 enum class Prelude : uint8_t {
   None,
@@ -149,16 +173,18 @@ struct StageFile {
   std::string file;
 };
 
-// `prelude`: lines after "#version" in the fragment shader (the interlock's #extension, #define)
+// `prelude`: lines after "#version" in the fragment shader (the interlock's #extension, #define);
+// `raster`: the fragment stage's raster part (nullptr: none)
 Result<GLuint> linkProgram(const std::string& name, const std::vector<StageFile>& stages,
-                           const std::string& prelude = "") {
+                           const std::string& prelude = "", const char* raster = nullptr) {
   std::vector<GLuint> shaders;
   auto cleanup = [&] {
     for (GLuint s : shaders) glDeleteShader(s);
   };
   for (const StageFile& sf : stages) {
     const bool fragment = sf.stage == GL_FRAGMENT_SHADER;
-    auto shader = compileShader(sf.stage, sf.file, fragment, fragment ? prelude : std::string());
+    auto shader = compileShader(sf.stage, sf.file, fragment ? raster : nullptr,
+                                fragment ? prelude : std::string());
     if (!shader) {
       cleanup();
       return shader.error();
@@ -341,6 +367,7 @@ struct GlEngine::State {
   uint64_t deviceSlots = 0, deviceReservedSlots = 0;
   bool deviceByImportance = false;
   uint64_t maxBlockBytes = 0;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
+  GlRaster raster = GlRaster::Native;
   std::map<std::string, uint64_t> sceneBytes;
 
   ~State() {
@@ -454,6 +481,8 @@ struct GlEngine::State {
   // them but does not compile the shaders keeps the lock (engine_counters.atomic64 says per frame
   // which capture ran) instead of losing the whole engine.
   Result<void> linkPrograms(const GlContext& context, const std::string& kbufferPrelude) {
+    // (raster programs: raster_native.vert, or raster.vert + raster.geom, and the fragment shader
+    // with its raster part)
     const bool atomic64 = hasAtomic64(context);
     bool atomic64Linked = atomic64;
     for (const ProgramRow& row : kPrograms) {
@@ -461,12 +490,15 @@ struct GlEngine::State {
       const std::string prelude = row.prelude == Prelude::KBufferSync ? kbufferPrelude
                                   : row.prelude == Prelude::Atomic64  ? kAtomic64Prelude
                                                                       : "";
-      auto linked = row.raster ? linkProgram(row.file,
-                                             {{GL_VERTEX_SHADER, "raster.vert"},
-                                              {GL_GEOMETRY_SHADER, "raster.geom"},
-                                              {GL_FRAGMENT_SHADER, row.file}},
-                                             prelude)
-                               : linkProgram(row.file, {{GL_COMPUTE_SHADER, row.file}});
+      std::vector<StageFile> stages;
+      if (row.raster) {
+        for (const auto& [stage, file] : rasterStages(raster)) stages.push_back({stage, file});
+        stages.push_back({GL_FRAGMENT_SHADER, row.file});
+      } else {
+        stages.push_back({GL_COMPUTE_SHADER, row.file});
+      }
+      auto linked =
+          linkProgram(row.file, stages, prelude, row.raster ? rasterPart(raster) : nullptr);
       if (!linked && row.prelude == Prelude::Atomic64) {
         atomic64Linked = false;
         continue;
@@ -674,6 +706,25 @@ GlEngine::GlEngine(GlEngine&&) noexcept = default;
 GlEngine& GlEngine::operator=(GlEngine&&) noexcept = default;
 GlEngine::~GlEngine() = default;
 
+const char* toString(GlRaster raster) {
+  switch (raster) {
+    case GlRaster::Native:
+      return "native";
+    case GlRaster::Exact:
+      return "exact";
+  }
+  return "native";
+}
+
+Result<GlRaster> parseGlRaster(std::string_view text) {
+  if (text == "native") return GlRaster::Native;
+  if (text == "exact") return GlRaster::Exact;
+  return makeError("--gl-raster '" + std::string(text) + "': expected native or exact");
+}
+
+GlRaster GlEngine::raster() const {
+  return state_->raster;
+}
 int GlEngine::width() const {
   return state_->width;
 }
@@ -732,7 +783,8 @@ Result<std::string> kbufferInterlockPrelude(const GlContext& context, bool inter
 }  // namespace
 
 Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
-                                  const Camera& cameraIn, int width, int height, bool interlock) {
+                                  const Camera& cameraIn, int width, int height, bool interlock,
+                                  GlRaster raster) {
   MFR_TRY(checkCreateArgs(scene, cameraIn, width, height));
   context.makeCurrent();
   MFR_TRY(checkGlLimits(width, height));
@@ -744,6 +796,7 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   s->width = width;
   s->height = height;
   s->placeCamera(cameraIn, scene);
+  s->raster = raster;
   auto kbufferPrelude = kbufferInterlockPrelude(context, interlock);
   if (!kbufferPrelude) return kbufferPrelude.error();
   MFR_TRY(s->linkPrograms(context, *kbufferPrelude));
@@ -769,6 +822,14 @@ struct GlEngine::State::FrameRun {
   FrameBuffers fb;
   GLuint counts = 0, offsets = 0, nodes = 0, tails = 0, accum = 0, image = 0;
   uint64_t nodeCount = 0;
+  bool countInCapture = false;  // the capture adds n(p) (no count pass ran)
+
+  // a capture program: whether it counts n(p), and the counts' image unit
+  void useCapture(GLuint program) {
+    glUseProgram(program);
+    glProgramUniform1ui(program, loc(program, "uCountInCapture"), countInCapture ? 1u : 0u);
+    fb.bindImage(counts, kBindCounts);
+  }
 
   FrameRun(State& state, const RenderPlan& p, GlRenderOutput& output)
       : s(state), plan(p), out(output) {
@@ -820,7 +881,8 @@ struct GlEngine::State::FrameRun {
     }
   }
 
-  // count: n(p) by imageAtomicAdd (or the counts given, or those on the device)
+  // n(p): the counts given, those on the device, a count pass (the A-buffer needs n(p) before
+  // its capture), or counted by the capture itself (countInCapture: no pass of its own)
   void countFragments() {
     const GlRenderOptions& options = plan.options;
     const uint32_t pixels = plan.pixels;
@@ -830,7 +892,9 @@ struct GlEngine::State::FrameRun {
                      counted && !device ? options.counts->data() : nullptr);
     if (device)  // n(p) of countOnDevice, copied on the GPU
       glCopyNamedBufferSubData(s.deviceCounts, counts, 0, 0, uint64_t{pixels} * 4);
-    if (!counted) {
+    countInCapture = !counted && !plan.isABuffer;
+    if (countInCapture) clearUint(counts, 0);
+    if (!counted && plan.isABuffer) {
       clearUint(counts, 0);
       pass("count", [&] {
         glUseProgram(s.progCount);
@@ -856,15 +920,19 @@ struct GlEngine::State::FrameRun {
     }
     const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
     clearUint(locks, kLockFree);
-    auto accumulate = [&](GLuint program) {
-      glUseProgram(program);
+    auto accumulate = [&](GLuint program, bool capture) {
+      if (capture) {
+        useCapture(program);
+      } else {
+        glUseProgram(program);
+      }
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       fb.bindImage(locks, kBindLocks);
       s.drawScene();
-      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     };
-    if (!isWboit) pass("moments", [&] { accumulate(s.progMboitMoments); });
-    pass("capture", [&] { accumulate(isWboit ? s.progWboit : s.progMboitColor); });
+    if (!isWboit) pass("moments", [&] { accumulate(s.progMboitMoments, false); });
+    pass("capture", [&] { accumulate(isWboit ? s.progWboit : s.progMboitColor, true); });
   }
 
   // mlab: k nodes per pixel merged in place, their count per pixel
@@ -878,13 +946,13 @@ struct GlEngine::State::FrameRun {
     clearUint(locks, kLockFree);
     pass("capture", [&] {
       const GLuint p = s.progMlab;
-      glUseProgram(p);
+      useCapture(p);
       glProgramUniform1ui(p, loc(p, "uK"), k);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, accum);
       fb.bindImage(locks, kBindLocks);
       s.drawScene();
-      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     });
   }
 
@@ -994,7 +1062,7 @@ struct GlEngine::State::FrameRun {
     glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
     glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
     pass("capture", [&] {
-      glUseProgram(p);
+      useCapture(p);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTails, tails);
@@ -1588,8 +1656,8 @@ std::string interlockExtension(const GlContext& context) {
 std::vector<ShaderVariant> shaderVariants() {
   std::vector<ShaderVariant> out;
   const auto add = [&](const std::string& program, const std::string& file, const char* stage,
-                       bool fragmentCommon, const std::string& prelude) {
-    out.push_back({program, file, stage, composeSource(file, fragmentCommon, prelude)});
+                       const char* raster, const std::string& prelude) {
+    out.push_back({program, file, stage, composeSource(file, raster, prelude)});
   };
   for (const ProgramRow& row : kPrograms) {
     std::vector<std::pair<std::string, std::string>> preludes;  // variant name, prelude
@@ -1611,12 +1679,15 @@ std::vector<ShaderVariant> shaderVariants() {
     for (const auto& [variant, prelude] : preludes) {
       const std::string program = std::string(row.file) + variant;
       if (!row.raster) {
-        add(program, row.file, "comp", false, prelude);
+        add(program, row.file, "comp", nullptr, prelude);
         continue;
       }
-      add(program, "raster.vert", "vert", false, "");
-      add(program, "raster.geom", "geom", false, "");
-      add(program, row.file, "frag", true, prelude);
+      for (const GlRaster raster : {GlRaster::Native, GlRaster::Exact}) {
+        const std::string named = program + " [" + toString(raster) + "]";
+        for (const auto& [stage, file] : rasterStages(raster))
+          add(named, file, stage == GL_VERTEX_SHADER ? "vert" : "geom", nullptr, "");
+        add(named, row.file, "frag", rasterPart(raster), prelude);
+      }
     }
   }
   return out;

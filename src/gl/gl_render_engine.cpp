@@ -300,6 +300,8 @@ class GlFrame {
       s.engineCounters["gpu_ms_" + t.name] = t.gpuMs;
     }
     s.engineCounters["sync_interlock"] = interlock ? 1 : 0;  // the k-buffer capture's sync
+    // the geometry passes: 1 GL's own pipeline (--gl-raster native), 0 the emulated (exact)
+    s.engineCounters["raster_native"] = gv_.engine().raster() == GlRaster::Native ? 1 : 0;
     // the fixed-k capture with 64-bit atomicMin instead of the lock (where the driver has them)
     s.engineCounters["atomic64"] = g.atomic64 ? 1 : 0;
   }
@@ -317,8 +319,8 @@ class GlFrame {
 
 class GlRenderEngine final : public Engine {
  public:
-  GlRenderEngine(GlContext context, bool interlock)
-      : context_(std::move(context)), interlock_(interlock) {}
+  GlRenderEngine(GlContext context, bool interlock, GlRaster raster)
+      : context_(std::move(context)), interlock_(interlock), raster_(raster) {}
 
   std::string_view name() const override { return "gl"; }
 
@@ -330,6 +332,8 @@ class GlRenderEngine final : public Engine {
             {"version", context_.version()},
             {"vendor", context_.vendor()},
             {"egl_platform", context_.eglPlatform()},
+            // the geometry passes: GL's own pipeline or the CPU engine's emulated (--gl-raster)
+            {"raster", toString(raster_)},
             // the k-buffer capture: per-pixel spin-lock (imageAtomicExchange loop) or interlock
             {"sync", interlock_ ? "interlock (" + interlockExtension(context_) + ")" : "lock"},
             {"GL_ARB_fragment_shader_interlock", yes(c.arbFragmentShaderInterlock)},
@@ -347,8 +351,8 @@ class GlRenderEngine final : public Engine {
 
   Result<std::unique_ptr<PreparedView>> prepare(const View& view) override {
     if (!view.scene) return makeError("--engine gl: a view without a scene");
-    auto engine =
-        GlEngine::create(context_, *view.scene, view.camera, view.width, view.height, interlock_);
+    auto engine = GlEngine::create(context_, *view.scene, view.camera, view.width, view.height,
+                                   interlock_, raster_);
     if (!engine) return engine.error();
     return std::unique_ptr<PreparedView>(std::make_unique<GlView>(std::move(engine.value()), view));
   }
@@ -377,13 +381,16 @@ class GlRenderEngine final : public Engine {
  private:
   GlContext context_;
   bool interlock_ = false;
+  GlRaster raster_ = GlRaster::Native;
 };
 
 }  // namespace
 
-Result<std::unique_ptr<Engine>> makeGlEngine(const std::string& sync) {
+Result<std::unique_ptr<Engine>> makeGlEngine(const std::string& sync, const std::string& raster) {
   if (sync != "auto" && sync != "lock" && sync != "interlock")
     return makeError("--gl-sync '" + sync + "': expected auto, lock or interlock");
+  auto rasterMode = parseGlRaster(raster);
+  if (!rasterMode) return rasterMode.error();
   auto context = GlContext::create();
   if (!context) return context.error();
   const bool offered = !interlockExtension(context.value()).empty();
@@ -394,11 +401,11 @@ Result<std::unique_ptr<Engine>> makeGlEngine(const std::string& sync) {
         context->renderer() + ")");
   const bool interlock = sync == "interlock" || (sync == "auto" && offered);
   return std::unique_ptr<Engine>(
-      std::make_unique<GlRenderEngine>(std::move(context.value()), interlock));
+      std::make_unique<GlRenderEngine>(std::move(context.value()), interlock, *rasterMode));
 }
 
 void registerGlEngine() {
-  registerEngine("gl", [](const EngineOptions& o) { return makeGlEngine(o.glSync); });
+  registerEngine("gl", [](const EngineOptions& o) { return makeGlEngine(o.glSync, o.glRaster); });
 }
 
 }  // namespace mfr::gl

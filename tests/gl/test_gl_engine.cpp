@@ -126,7 +126,7 @@ class GlVsCpu : public testing::TestWithParam<Case> {
     ASSERT_TRUE(frame.ok()) << frame.error().message;
     frame_ = std::make_unique<RasterFrame>(std::move(frame.value()));
     auto engine = GlEngine::create(sharedContext().value(), *scene_, camera_, GetParam().width,
-                                   GetParam().height);
+                                   GetParam().height, false, GlRaster::Exact);
     ASSERT_TRUE(engine.ok()) << engine.error().message;
     engine_ = std::make_unique<GlEngine>(std::move(engine.value()));
   }
@@ -370,8 +370,8 @@ TEST(GlEngine, TexturedMaskedQuadsEqualTheCpuEngine) {
     auto frame =
         RasterFrame::build(scene, *scene.defaultCamera, RasterOptions{width, height, 16, 0});
     ASSERT_TRUE(frame.ok()) << frame.error().message;
-    auto engine =
-        GlEngine::create(sharedContext().value(), scene, *scene.defaultCamera, width, height);
+    auto engine = GlEngine::create(sharedContext().value(), scene, *scene.defaultCamera, width,
+                                   height, false, GlRaster::Exact);
     ASSERT_TRUE(engine.ok()) << engine.error().message;
     const MethodDesc method = methodPreset("abuffer").value();
     RenderOptions cpuOptions;
@@ -398,7 +398,8 @@ TEST(GlEngine, ABufferAboveTheStorageBlockLimitIsAnError) {
   MFR_REQUIRE_GL();
   auto scene = loadScene("procedural:layers");
   ASSERT_TRUE(scene.ok());
-  auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 768, 768);
+  auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 768, 768,
+                                 false, GlRaster::Exact);
   ASSERT_TRUE(engine.ok()) << engine.error().message;
   GlRenderOptions options;
   options.warmUp = false;
@@ -432,7 +433,8 @@ TEST(GlEngine, OutOfMemoryNamesTheBufferAndItsBytes) {
   // the engine still renders afterwards
   auto scene = loadScene("procedural:layers");
   ASSERT_TRUE(scene.ok());
-  auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 16, 16);
+  auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 16, 16,
+                                 false, GlRaster::Exact);
   ASSERT_TRUE(engine.ok()) << engine.error().message;
   EXPECT_TRUE(engine->render(methodPreset("abuffer").value()).ok());
 }
@@ -477,7 +479,8 @@ TEST(GlEngine, UnsupportedMethodIsAnError) {
   MFR_REQUIRE_GL();
   auto scene = loadScene("procedural:layers");
   ASSERT_TRUE(scene.ok());
-  auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 32, 32);
+  auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 32, 32,
+                                 false, GlRaster::Exact);
   ASSERT_TRUE(engine.ok()) << engine.error().message;
   auto out = engine->render(methodPreset("dkb").value());
   ASSERT_FALSE(out.ok());
@@ -506,7 +509,8 @@ TEST_P(GlVsCpuRealScene, CountsNodesAndImagesEqualTheCpuEngine) {
   const int size = 128;
   auto frame = RasterFrame::build(scene, camera, RasterOptions{size, size, 16, 0});
   ASSERT_TRUE(frame.ok()) << frame.error().message;
-  auto engine = GlEngine::create(sharedContext().value(), scene, camera, size, size);
+  auto engine =
+      GlEngine::create(sharedContext().value(), scene, camera, size, size, false, GlRaster::Exact);
   ASSERT_TRUE(engine.ok()) << engine.error().message;
   const std::vector<uint32_t> counts = countFragments(*frame);
   size_t covered = 0, differ = 0;
@@ -571,8 +575,8 @@ TEST(GlEngine, InterlockVariantCompiles) {
   auto scene = loadScene("procedural:layers");
   ASSERT_TRUE(scene.ok());
   const std::string ext = interlockExtension(sharedContext().value());
-  auto engine =
-      GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 32, 32, true);
+  auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 32, 32,
+                                 true, GlRaster::Exact);
   if (ext.empty()) {
     ASSERT_FALSE(engine.ok());
     const std::string m = engine.error().message;
@@ -585,7 +589,8 @@ TEST(GlEngine, InterlockVariantCompiles) {
                  << ") offers no fragment shader interlock: the interlock variant is not compiled";
   }
   ASSERT_TRUE(engine.ok()) << engine.error().message;
-  auto lock = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 32, 32);
+  auto lock = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, 32, 32,
+                               false, GlRaster::Exact);
   ASSERT_TRUE(lock.ok()) << lock.error().message;
   for (const char* preset : {"kplus-array", "kplus-heap"}) {
     GlRenderOptions o;
@@ -606,8 +611,8 @@ TEST(GlEngine, DISABLED_PassTimes) {
     auto scene = loadScene(name);
     ASSERT_TRUE(scene.ok());
     for (int size : {128, 512}) {
-      auto engine =
-          GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, size, size);
+      auto engine = GlEngine::create(sharedContext().value(), *scene, *scene->defaultCamera, size,
+                                     size, false, GlRaster::Exact);
       ASSERT_TRUE(engine.ok()) << engine.error().message;
       for (const char* preset : {"abuffer", "kplus-array"}) {
         MethodDesc method = methodPreset(preset).value();

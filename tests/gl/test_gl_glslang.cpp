@@ -86,12 +86,15 @@ TEST(GlShaders, EveryVariantValidatesWithGlslang) {
   }
   std::filesystem::remove_all(dir);
   // the variants llvmpipe cannot run are among them
-  for (const char* p :
-       {"capture_kbuffer.frag (lock)", "capture_kbuffer.frag (GL_ARB_fragment_shader_interlock)",
-        "capture_kbuffer.frag (GL_NV_fragment_shader_interlock)",
-        "capture_kbuffer.frag (GL_INTEL_fragment_shader_ordering)",
-        "capture_kbuffer_atomic64.frag (64-bit atomics)", "swap_node_words.comp (64-bit atomics)",
-        "resolve.comp", "count.frag"})
+  // (each raster program in both rasters: native and exact)
+  for (const char* raster : {" [native]", " [exact]"})
+    for (const char* p :
+         {"capture_kbuffer.frag (lock)", "capture_kbuffer.frag (GL_ARB_fragment_shader_interlock)",
+          "capture_kbuffer.frag (GL_NV_fragment_shader_interlock)",
+          "capture_kbuffer.frag (GL_INTEL_fragment_shader_ordering)",
+          "capture_kbuffer_atomic64.frag (64-bit atomics)", "count.frag"})
+      EXPECT_EQ(programs.count(p + std::string(raster)), 1u) << p << raster;
+  for (const char* p : {"swap_node_words.comp (64-bit atomics)", "resolve.comp"})
     EXPECT_EQ(programs.count(p), 1u) << p;
   // every shader file the engine embeds is in some variant
   std::set<std::string> files;
@@ -100,6 +103,13 @@ TEST(GlShaders, EveryVariantValidatesWithGlslang) {
     const std::string name = kEmbeddedShaders[i].name;
     if (name.ends_with(".glsl") || name.ends_with(".h")) continue;  // included by the others
     EXPECT_EQ(files.count(name), 1u) << name << " is in no variant";
+  }
+  // and every raster part is composed into some fragment stage
+  for (const char* part : {"raster_native.glsl", "raster_exact.glsl", "raster_common.glsl"}) {
+    size_t composed = 0;
+    for (const ShaderVariant& v : variants)
+      composed += v.stage == "frag" && v.source.find(embeddedShader(part)) != std::string::npos;
+    EXPECT_GT(composed, 0u) << part;
   }
 }
 

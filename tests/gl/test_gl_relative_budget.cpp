@@ -21,7 +21,7 @@ namespace mfr::gl {
 namespace {
 
 #define MFR_GL_ENGINE_OR_SKIP(name)                                            \
-  auto name##Made = makeGlEngine();                                            \
+  auto name##Made = makeGlEngine("auto", "exact");                             \
   if (!name##Made) {                                                           \
     const char* ci = std::getenv("CI");                                        \
     if (ci && std::string(ci) == "true") FAIL() << name##Made.error().message; \

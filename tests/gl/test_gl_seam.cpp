@@ -26,8 +26,10 @@
 namespace mfr::gl {
 namespace {
 
+// --gl-raster exact: the CPU engine's raster, so the statistics and images are the CPU engine's
+// bit for bit (test_gl_native.cpp checks the native pipeline's agreement)
 std::unique_ptr<Engine> glEngineOrSkipReason(std::string& reason) {
-  auto engine = makeGlEngine();
+  auto engine = makeGlEngine("auto", "exact");
   if (!engine) {
     reason = engine.error().message;
     return nullptr;
@@ -475,7 +477,8 @@ TEST(GlSeamCli, CompareOnTheGlEngine) {
       std::filesystem::temp_directory_path() / ("mfr_gl_compare_" + std::to_string(::getpid()));
   std::filesystem::remove_all(dir);
   const std::string cmd = std::string(MFR_CLI_PATH) +
-                          " compare procedural:layers --engine gl --methods fkb,kplus-array,dkb "
+                          " compare procedural:layers --engine gl --gl-raster exact --methods "
+                          "fkb,kplus-array,dkb "
                           "--budget 200KB,400KB --width 64 --height 64 --quiet --out " +
                           dir.string() + " 2>&1";
   ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;

@@ -39,6 +39,10 @@ struct EngineOptions {
   /// GL engine only: the k-buffer capture's synchronisation, "auto" (the fragment shader interlock
   /// when the driver offers it, else the spin-lock), "lock" or "interlock" (--gl-sync).
   std::string glSync = "auto";
+  /// GL engine only: how the geometry passes make fragments, "native" (GL's own pipeline) or
+  /// "exact" (the CPU engine's raster emulated, bit-identical to it) (--gl-raster,
+  /// mfr::gl::GlRaster).
+  std::string glRaster = "native";
 };
 
 /// A view set up by one engine for any number of renders. Owned by the caller; render() takes it

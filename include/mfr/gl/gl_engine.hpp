@@ -13,6 +13,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -72,6 +73,19 @@ struct GlRenderOutput {
   std::vector<GlPassTime> passes;  // count, prefix sum, capture, resolve (timed run)
 };
 
+/// How the geometry passes make fragments (--gl-raster).
+///  - Native: vertex shader, GL's clipper and rasterizer, fragment shader, single precision
+///    (shaders/raster_native.vert, raster_native.glsl): what a GPU engine runs; its fragments are
+///    the CPU engine's except where a pixel centre lies on a triangle edge (GL's fill rule and
+///    sub-pixel snapping decide there) and its attributes agree within float rounding.
+///  - Exact: the CPU engine's clipping, 1/256-pixel snapping, fill rule and interpolation in a
+///    geometry and fragment shader, partly in double (raster.vert, raster.geom,
+///    raster_exact.glsl): bit-identical to the CPU engine, a cross-check rather than a timing.
+enum class GlRaster : uint8_t { Native, Exact };
+const char* toString(GlRaster raster);
+/// "native" or "exact"; anything else is one line naming --gl-raster.
+Result<GlRaster> parseGlRaster(std::string_view text);
+
 /// One scene and view uploaded to GL once; render() runs a method on it any number of times.
 /// Supported methods: `abuffer` (unbounded, append), fixed-k max-array or max-heap
 /// k-buffers with an explicit k, and any k-buffer with a per-pixel allocation
@@ -86,8 +100,10 @@ class GlEngine {
   /// validateScene, a shader that does not compile or link (its name and info log).
   /// `interlock`: the k-buffer capture orders a pixel's fragments with the driver's fragment
   /// shader interlock (interlockExtension(context) must name one) instead of the spin-lock.
+  /// `raster`: GL's own pipeline (native) or the CPU engine's emulated (exact), see GlRaster.
   static Result<GlEngine> create(const GlContext& context, const Scene& scene, const Camera& camera,
-                                 int width, int height, bool interlock = false);
+                                 int width, int height, bool interlock = false,
+                                 GlRaster raster = GlRaster::Native);
 
   GlEngine(GlEngine&&) noexcept;
   GlEngine& operator=(GlEngine&&) noexcept;
@@ -130,6 +146,7 @@ class GlEngine {
   Result<ImportanceMaps> readImportance();
   Result<std::vector<float>> readNearestCosine();
 
+  GlRaster raster() const;
   int width() const;
   int height() const;
   /// The camera with the fitted clip planes (what RasterFrame::build uses).

@@ -15,10 +15,12 @@ namespace mfr::gl {
 
 /// A GL engine on a new headless GL 4.5 core context. Errors (one line): no such context
 /// ("--engine gl: no OpenGL 4.5 core context (EGL: ...)"); `sync` not auto, lock or interlock;
+/// `raster` not native or exact (GlRaster);
 /// interlock asked for on a driver without GL_ARB_fragment_shader_interlock,
 /// GL_NV_fragment_shader_interlock or GL_INTEL_fragment_shader_ordering. Use it on the thread that
 /// made it.
-Result<std::unique_ptr<Engine>> makeGlEngine(const std::string& sync = "auto");
+Result<std::unique_ptr<Engine>> makeGlEngine(const std::string& sync = "auto",
+                                             const std::string& raster = "native");
 
 /// Adds "gl" to makeEngine's engines (registerEngine).
 void registerGlEngine();
