@@ -1,8 +1,10 @@
-// bench_engines: the same frames on both engines, in one run so the ratio is meaningful (issue
-// "OpenGL 4.5 engine", benchmark section). The CPU engine (tile-owned capture, --threads workers)
-// against the GL engine (OpenGL 4.5 through headless EGL; on a machine without a GPU, Mesa's
-// llvmpipe on the same cores) for the k+-buffer with a max-array store and k = 8 (k+-buffer
-// paper, Algorithm 3), kbuffer compositing:
+// bench_engines: the same frames on every engine, in one run so the ratios are meaningful. The CPU
+// engine (tile-owned capture, --threads workers) against the GL engine (OpenGL 4.5 through headless
+// EGL; on a machine without a GPU, Mesa's llvmpipe on the same cores) on its native raster
+// (--gl-raster native) and its exact one (the CPU engine's raster emulated), and the plain GL
+// k-buffer of ../shared/anchors/gl-kbuffer (built from there where it exists; K = 8, 16 quads,
+// about the layers frame's 9.1 M fragments) as the yardstick for the driver, for the k+-buffer with
+// a max-array store and k = 8 (k+-buffer paper, Algorithm 3), kbuffer compositing:
 //   layers    procedural:layers?k=8&r=2&pd=0.55 (16 layers; 9.24 M fragments at 1024x1024)
 //   hairball  procedural:hairball
 //   Dish      IridescentDishWithOlives from ../shared/scenes, alpha 0.5, zoom 1.6 (skipped when
@@ -10,10 +12,11 @@
 // Per engine: each pass's median wall time over --reps runs (the GL engine warms up once per
 // render and reports wall time: llvmpipe's GL_TIME_ELAPSED is not usable), the whole frame
 // (prepare and one untimed warm-up render excluded), fragments per second through the frame, and
-// the largest per-channel difference between the two engines' images (0: the engines agree bit for
-// bit). CSV: engines.csv, one row per scene and engine.
+// the largest per-channel difference from the CPU engine's image (0: bit for bit), and each frame
+// over the CPU engine's and over the anchor's. CSV: engines.csv, one row per scene and engine.
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -57,6 +60,28 @@ void measure(Engine& engine, const PreparedView& view, const MethodDesc& method,
   }
 }
 
+// The anchor's best frame in ms ("draw timing: best X ms, ..."), or an error.
+Result<double> runAnchor(int size, int reps) {
+#ifdef MFR_ANCHOR_KBUFFER_PATH
+  const std::string cmd = std::string(MFR_ANCHOR_KBUFFER_PATH) + " lock " + std::to_string(size) +
+                          " " + std::to_string(size) + " 8 16 " + std::to_string(reps) + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return makeError("cannot run " + cmd);
+  std::string out;
+  char buffer[4096];
+  while (size_t n = std::fread(buffer, 1, sizeof buffer, pipe)) out.append(buffer, n);
+  const int status = pclose(pipe);
+  const size_t at = out.find("draw timing: best ");
+  if (status != 0 || at == std::string::npos)
+    return makeError("the anchor failed: " + out.substr(0, 300));
+  return std::strtod(out.c_str() + at + 18, nullptr);
+#else
+  (void)size;
+  (void)reps;
+  return makeError("not built (../shared/anchors/gl-kbuffer/ absent at configure time)");
+#endif
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -64,18 +89,32 @@ int main(int argc, char** argv) {
   Csv csv = openCsv(kProgram, args,
                     "scene,engine,renderer,width,height,threads,reps,fragments,count_ms,"
                     "prefix_sum_ms,capture_ms,resolve_ms,other_ms,frame_ms,mfrag_s,"
-                    "cpu_speedup,image_max_diff,error");
-  std::printf("bench_engines: CPU engine vs GL engine, kplus-array k = %u, kbuffer, %s\n", kK,
-              runDescription(args, resolveThreads(args.threads)).c_str());
+                    "over_cpu,over_anchor,image_max_diff,error");
+  std::printf(
+      "bench_engines: CPU engine vs GL engine (native, exact) vs the plain GL k-buffer, "
+      "kplus-array k = %u, kbuffer, %s\n",
+      kK, runDescription(args, resolveThreads(args.threads)).c_str());
 
-  auto gl = gl::makeGlEngine();
-  if (!gl) {
-    printError(kProgram, gl.error().message);
+  auto gl = gl::makeGlEngine("auto", "native");
+  auto glExact = gl::makeGlEngine("auto", "exact");
+  if (!gl || !glExact) {
+    printError(kProgram, (gl ? glExact : gl).error().message);
     return 1;
   }
   CpuEngine cpu(EngineOptions{args.threads, 32});
   const std::string renderer = (*gl)->describe().at("renderer");
   std::printf("GL renderer: %s\n\n", renderer.c_str());
+  // the anchor once per run, before the scenes (its frame is the layers frame's order)
+  const Result<double> anchor = runAnchor(args.size, std::max(args.reps, 2));
+  if (anchor)
+    std::printf("anchor (../shared/anchors/gl-kbuffer, lock %d x %d, K 8, 16 quads): %.1f ms\n",
+                args.size, args.size, *anchor);
+  else
+    std::printf("anchor: %s\n", anchor.error().message.c_str());
+  csv.row({"anchor (K 8, 16 quads)", "gl-kbuffer", renderer, std::to_string(args.size),
+           std::to_string(args.size), "", std::to_string(std::max(args.reps, 2)), "", "", "", "",
+           "", "", anchor ? fixed(*anchor, 3) : "", "", "", "", "",
+           anchor ? "" : anchor.error().message});
 
   const std::string dish = std::string(MFR_SCENES_DIR) +
                            "/khronos/IridescentDishWithOlives/glTF/IridescentDishWithOlives.gltf";
@@ -87,7 +126,7 @@ int main(int argc, char** argv) {
   method.compositing = Compositing::KBuffer;
 
   Table table({"scene", "engine", "fragments", "count", "prefix sum", "capture", "resolve", "other",
-               "frame ms", "M frag/s", "CPU x", "max diff"});
+               "frame ms", "M frag/s", "/ CPU", "/ anchor", "max diff"});
   table.leftAlign(0);
   table.leftAlign(1);
   bool failed = false;
@@ -110,10 +149,12 @@ int main(int argc, char** argv) {
       camera.eye = camera.target + (camera.eye - camera.target) / 1.6f;
     }
     const View view{&scene, camera, args.size, args.size};
-    Measured results[2];
-    Engine* engines[2] = {&cpu, gl->get()};
-    std::unique_ptr<PreparedView> views[2];
-    for (int e = 0; e < 2; ++e) {
+    constexpr int kEngines = 3;
+    Measured results[kEngines];
+    Engine* engines[kEngines] = {&cpu, gl->get(), glExact->get()};
+    const char* names[kEngines] = {"cpu", "gl native", "gl exact"};
+    std::unique_ptr<PreparedView> views[kEngines];
+    for (int e = 0; e < kEngines; ++e) {
       auto prepared = engines[e]->prepare(view);
       if (!prepared) {
         results[e].error = prepared.error().message;
@@ -121,7 +162,8 @@ int main(int argc, char** argv) {
       }
       views[e] = std::move(prepared.value());
     }
-    for (int e = 0; e < 2; ++e) {  // untimed warm-up (GL: shader compilation, first-frame timers)
+    for (int e = 0; e < kEngines;
+         ++e) {  // untimed warm-up (GL: shader compilation, first-frame timers)
       if (!views[e]) continue;
       auto warm = engines[e]->render(*views[e], method, RenderOptions{});
       if (!warm) {
@@ -131,21 +173,18 @@ int main(int argc, char** argv) {
     }
     // interleaved rounds: a slow period of the shared machine hits both engines alike
     for (int r = 0; r < args.reps; ++r)
-      for (int e = 0; e < 2; ++e)
+      for (int e = 0; e < kEngines; ++e)
         if (views[e]) measure(*engines[e], *views[e], method, 1, results[e]);
-    const bool bothOk = !results[0].error && !results[1].error;
-    const float diff = bothOk ? maxAbsDiff(results[0].image, results[1].image) : -1.0f;
     const double cpuFrame = results[0].error ? 0.0 : median(results[0].frame);
-    const double glFrame = results[1].error ? 0.0 : median(results[1].frame);
-    for (int e = 0; e < 2; ++e) {
+    for (int e = 0; e < kEngines; ++e) {
       const Measured& m = results[e];
-      const std::string name = e == 0 ? "cpu" : "gl";
+      const std::string name = names[e];
       if (m.error) {
         failed = true;
         printError(kProgram, sc.label + " on " + name + ": " + *m.error);
         csv.row({sc.label, name, e ? renderer : "", std::to_string(args.size),
                  std::to_string(args.size), std::to_string(resolveThreads(args.threads)),
-                 std::to_string(args.reps), "", "", "", "", "", "", "", "", "", "", *m.error});
+                 std::to_string(args.reps), "", "", "", "", "", "", "", "", "", "", "", *m.error});
         continue;
       }
       const auto pass = [&](const char* p) {
@@ -158,23 +197,27 @@ int main(int argc, char** argv) {
           other += median(samples);
       const double frame = median(m.frame);
       const uint64_t fragments = m.stats.fragmentsGenerated;
-      const double speedup = e == 0 && cpuFrame > 0.0 ? glFrame / cpuFrame : 0.0;
+      const bool bothOk = !results[0].error;
+      const float diff = bothOk ? maxAbsDiff(results[0].image, m.image) : -1.0f;
+      const std::string overCpu = e > 0 && cpuFrame > 0.0 ? fixed(frame / cpuFrame, 2) : "";
+      const std::string overAnchor = anchor && *anchor > 0.0 ? fixed(frame / *anchor, 2) : "";
       table.add({sc.label, name, num(fragments), fixed(pass("count"), 1),
                  fixed(pass("prefix sum"), 1), fixed(pass("capture"), 1), fixed(pass("resolve"), 1),
-                 fixed(other, 1), fixed(frame, 1), fixed(mfragPerS(fragments, frame), 1),
-                 e == 0 ? fixed(speedup, 2) : "", bothOk ? fixed(diff, 6) : "-"});
+                 fixed(other, 1), fixed(frame, 1), fixed(mfragPerS(fragments, frame), 1), overCpu,
+                 overAnchor, bothOk ? fixed(diff, 6) : "-"});
       csv.row({sc.label, name, e ? renderer : "cpu", std::to_string(args.size),
                std::to_string(args.size), std::to_string(resolveThreads(args.threads)),
                std::to_string(args.reps), std::to_string(fragments), fixed(pass("count"), 3),
                fixed(pass("prefix sum"), 3), fixed(pass("capture"), 3), fixed(pass("resolve"), 3),
-               fixed(other, 3), fixed(frame, 3), fixed(mfragPerS(fragments, frame), 3),
-               e == 0 ? fixed(speedup, 3) : "", bothOk ? fixed(diff, 8) : "", ""});
+               fixed(other, 3), fixed(frame, 3), fixed(mfragPerS(fragments, frame), 3), overCpu,
+               overAnchor, bothOk ? fixed(diff, 8) : "", ""});
     }
   }
   table.print();
   std::printf(
-      "\nCPU x: GL frame time / CPU frame time. Passes in ms (medians of %d runs; "
-      "\"other\": the CPU engine's allocate and clear).\n",
+      "\n/ CPU, / anchor: the frame time over the CPU engine's and over the plain GL k-buffer's "
+      "(the anchor draws about the layers frame's fragments: read that row). Passes in ms "
+      "(medians of %d runs; \"other\": the CPU engine's allocate and clear).\n",
       args.reps);
   return failed ? 1 : 0;
 }

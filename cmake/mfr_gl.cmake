@@ -54,4 +54,17 @@ if(MFR_BUILD_BENCH)
   target_compile_options(bench_engines PRIVATE ${MFR_WARNINGS})
   target_compile_definitions(bench_engines PRIVATE MFR_SCENES_DIR="${MFR_SCENES_DIR}")
   target_link_libraries(bench_engines PRIVATE mfr_gl)
+  # the plain GL k-buffer of ../shared/anchors/gl-kbuffer (the yardstick for GL speed on a driver),
+  # built from that folder where it exists; bench_engines runs it in the same run. Not mfr's code:
+  # compiled as its README says, without mfr's warning flags.
+  set(MFR_ANCHOR_KBUFFER "${CMAKE_CURRENT_SOURCE_DIR}/../shared/anchors/gl-kbuffer/kbuf_test.cpp")
+  if(EXISTS "${MFR_ANCHOR_KBUFFER}")
+    add_executable(gl_kbuffer_anchor "${MFR_ANCHOR_KBUFFER}")
+    set_target_properties(gl_kbuffer_anchor PROPERTIES CXX_STANDARD 17 COMPILE_WARNING_AS_ERROR OFF)
+    target_compile_options(gl_kbuffer_anchor PRIVATE -w)
+    target_link_libraries(gl_kbuffer_anchor PRIVATE PkgConfig::EPOXY)
+    target_compile_definitions(bench_engines PRIVATE
+                               MFR_ANCHOR_KBUFFER_PATH="$<TARGET_FILE:gl_kbuffer_anchor>")
+    add_dependencies(bench_engines gl_kbuffer_anchor)
+  endif()
 endif()

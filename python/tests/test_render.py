@@ -137,6 +137,9 @@ CASES = [
      ["-m", "kplus-array", "--k", "3", "--engine", "gl"]),
     (dict(method="wboit", budget="50%", engine="gl"),
      ["-m", "wboit", "-M", "50%", "--engine", "gl"]),
+    (dict(method="kplus-heap", k=2, composite="hybrid", engine="gl", gl_raster="exact"),
+     ["-m", "kplus-heap", "--k", "2", "--composite", "hybrid", "--engine", "gl", "--gl-raster",
+      "exact"]),
 ]
 
 
@@ -184,6 +187,25 @@ def test_orbit_renders_every_view_as_the_cli(tmp_path, run_cli):
             without_times(r.stats)
         budgets.add(r.stats["budget_bytes"])
     assert len(budgets) > 1  # each view's own A-buffer
+
+
+def test_gl_raster_exact_is_the_cpu_engine_and_unknown_rasters_are_errors():
+    scene = "procedural:bottles?count=3"
+    try:
+        exact = mfr.render(scene, width=W, height=H, method="kplus-array", k=3, engine="gl",
+                           gl_raster="exact", capture="parallel")
+    except mfr.Error as e:  # no GL 4.5 context on this machine
+        if os.environ.get("CI") == "true":
+            raise
+        pytest.skip(str(e))
+    cpu = mfr.render(scene, width=W, height=H, method="kplus-array", k=3, capture="parallel")
+    assert np.array_equal(exact.srgb, cpu.srgb)
+    assert exact.stats["engine_counters"]["raster_native"] == 0
+    native = mfr.render(scene, width=W, height=H, method="kplus-array", k=3, engine="gl")
+    assert native.stats["engine_counters"]["raster_native"] == 1
+    assert native.stats["fragments_generated"] == cpu.stats["fragments_generated"]
+    with pytest.raises(mfr.Error, match=r"^--gl-raster 'fast': expected native or exact$"):
+        mfr.render(scene, width=W, height=H, method="fkb", k=2, engine="gl", gl_raster="fast")
 
 
 def test_an_orbit_of_arrays_beyond_the_memory_limit_is_refused():

@@ -28,7 +28,13 @@ namespace {
 
 class GlView final : public PreparedView {
  public:
-  GlView(GlEngine engine, const View& view) : engine_(std::move(engine)), view_(view) {}
+  GlView(GlEngine engine, const View& view, const GlContext& context)
+      : engine_(std::move(engine)), view_(view), context_(&context) {}
+  // the view's GL objects are deleted in its own context, whichever another GL engine on this
+  // thread made current since (the view must not outlive its engine)
+  ~GlView() override { context_->makeCurrent(); }
+  GlView(const GlView&) = delete;
+  GlView& operator=(const GlView&) = delete;
   int width() const override { return engine_.width(); }
   int height() const override { return engine_.height(); }
   GlEngine& engine() const { return engine_; }
@@ -40,6 +46,7 @@ class GlView final : public PreparedView {
  private:
   mutable GlEngine engine_;  // rendering changes GL state, not the view
   View view_;
+  const GlContext* context_;
   mutable bool first_ = true;
 };
 
@@ -354,13 +361,15 @@ class GlRenderEngine final : public Engine {
     auto engine = GlEngine::create(context_, *view.scene, view.camera, view.width, view.height,
                                    interlock_, raster_);
     if (!engine) return engine.error();
-    return std::unique_ptr<PreparedView>(std::make_unique<GlView>(std::move(engine.value()), view));
+    return std::unique_ptr<PreparedView>(
+        std::make_unique<GlView>(std::move(engine.value()), view, context_));
   }
 
   Result<RenderOutput> render(const PreparedView& view, const MethodDesc& method,
                               const RenderOptions& options) override {
     const auto* gv = dynamic_cast<const GlView*>(&view);
     if (!gv) return makeError("--engine gl: the view was prepared by another engine");
+    context_.makeCurrent();  // (another GL engine on this thread may have made its own current)
     auto plan = planPasses(method, options);
     if (!plan) return plan.error();
     return GlFrame(*gv, method, plan.value(), options).run(interlock_);
@@ -375,6 +384,7 @@ class GlRenderEngine final : public Engine {
   Result<std::vector<float>> nearestCosine(const PreparedView& view) override {
     const auto* gv = dynamic_cast<const GlView*>(&view);
     if (!gv) return makeError("--engine gl: the view was prepared by another engine");
+    context_.makeCurrent();
     return gv->engine().nearestCosine();
   }
 
