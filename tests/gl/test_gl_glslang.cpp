@@ -11,7 +11,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <regex>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include "gl/shader_sources.hpp"
@@ -111,6 +114,51 @@ TEST(GlShaders, EveryVariantValidatesWithGlslang) {
       composed += v.stage == "frag" && v.source.find(embeddedShader(part)) != std::string::npos;
     EXPECT_GT(composed, 0u) << part;
   }
+}
+
+// shared_layout.h's list of the bindings per shader file names exactly the kBind* points each
+// embedded shader declares (its own text), and every shader that declares one is listed.
+TEST(GlShaders, BindingsListedPerShader) {
+  const std::string layout(embeddedShader("shared_layout.h"));
+  const size_t begin = layout.find("// Bindings per shader file");
+  const size_t end = layout.find("// (end of the bindings per shader file)");
+  ASSERT_NE(begin, std::string::npos);
+  ASSERT_NE(end, std::string::npos);
+  std::map<std::string, std::set<std::string>> listed;
+  std::string current;
+  std::istringstream lines(layout.substr(begin, end - begin));
+  for (std::string line; std::getline(lines, line);) {
+    if (line.rfind("//   ", 0) != 0) continue;
+    std::string rest;
+    if (line.rfind("//       ", 0) == 0) {  // continuation
+      rest = line.substr(9);
+    } else {
+      const size_t colon = line.find(": ");
+      ASSERT_NE(colon, std::string::npos) << line;
+      current = line.substr(5, colon - 5);
+      rest = line.substr(colon + 2);
+      listed[current];
+    }
+    std::istringstream words(rest);
+    for (std::string w; words >> w;)
+      if (w != "-") listed[current].insert(w.substr(0, w.find('(')));
+  }
+  const std::regex binding(R"(binding = (kBind\w+))");
+  size_t declaring = 0;
+  for (size_t i = 0; i < kEmbeddedShaderCount; ++i) {
+    const std::string name = kEmbeddedShaders[i].name;
+    if (name == "shared_layout.h") continue;
+    const std::string text = kEmbeddedShaders[i].text;
+    std::set<std::string> declared;
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), binding);
+         it != std::sregex_iterator(); ++it)
+      declared.insert((*it)[1].str());
+    if (declared.empty() && !listed.contains(name)) continue;  // (raster.vert: no bindings)
+    declaring += !declared.empty();
+    ASSERT_TRUE(listed.contains(name)) << name << " is not in shared_layout.h's list";
+    EXPECT_EQ(listed[name], declared) << name;
+  }
+  EXPECT_GE(declaring, 25u);
 }
 
 }  // namespace

@@ -111,6 +111,44 @@ MFR_GL_CONST(uint, kTableCoarseBase, 256u)
 MFR_GL_CONST(uint, kTableBoundBase, 4352u)
 MFR_GL_CONST(uint, kTableWords, 4609u)
 
+// Bindings per shader file: the kBind* points each file declares (SSBO unless marked; image:
+// an imageBuffer unit, texture: a texture unit). A raster program also has its raster part's
+// and raster_common.glsl's; the GL engine binds what a pass reads before its draw or dispatch.
+// GlShaders.BindingsListedPerShader checks this list against the shaders.
+//   capture_abuffer.frag: kBindOffsets kBindNodes kBindFill
+//   capture_kbuffer.frag: kBindNodes kBindLocks(image) kBindAllocation(texture) kBindOccupancy
+//       kBindTails kBindCaptureStats
+//   capture_kbuffer_atomic64.frag: kBindNodes kBindCaptureStats
+//   count.frag: -
+//   depth_range.frag: kBindOccupancy
+//   dkb_features.frag: kBindDkbAcc kBindLocks(image)
+//   mboit_color.frag: kBindAccum kBindLocks(image)
+//   mboit_moments.frag: kBindAccum kBindLocks(image)
+//   mlab.frag: kBindNodes kBindFill kBindLocks(image)
+//   nearest_cosine.frag: kBindNearest kBindLocks(image)
+//   occupancy_fill.frag: kBindOccupancy kBindOccBits
+//   wboit.frag: kBindAccum kBindLocks(image)
+//   alloc_histogram.comp: kBindAllocCounts kBindAllocSummary
+//   alloc_k.comp: kBindAllocCounts kBindAllocSummary kBindAllocK kBindAllocReserved kBindImportance
+//       kBindImportanceTotal
+//   alloc_pack.comp: kBindAllocCounts kBindAllocK kBindAllocOffsets kBindAllocWords
+//   dkb_infer.comp: kBindDkbAcc kBindDkbWeights kBindDkbImportance kBindColorTables
+//   importance.comp: kBindAllocCounts kBindImportance kBindCosine
+//   importance_total.comp: kBindImportance kBindImportanceTotal
+//   mboit_resolve.comp: kBindAccum kBindImage
+//   mlab_resolve.comp: kBindNodes kBindFill kBindImage2
+//   occupancy_count.comp: kBindOccBits kBindOccupancy kBindAllocation(texture)
+//   prefix_sum.comp: kBindScanIn kBindScanOut kBindScanSums
+//   prefix_sum_add.comp: kBindScanOut kBindScanSums
+//   resolve.comp: kBindCounts kBindOffsets kBindNodes kBindImage kBindColorTables kBindResolveTails
+//       kBindAllocation(texture)
+//   swap_node_words.comp: kBindNodes
+//   wboit_resolve.comp: kBindAccum kBindImage
+//   raster_common.glsl: kBindMaterials kBindColorTables kBindTexels kBindCounts(image)
+//   raster_native.glsl: kBindTriMaterial
+//   raster.geom: kBindTriMaterial
+// (end of the bindings per shader file)
+
 #ifdef __cplusplus
 }  // namespace mfr::gl
 #else
