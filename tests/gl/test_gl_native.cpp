@@ -7,6 +7,7 @@
 // tests skip (fail under CI=true).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -15,9 +16,9 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <sstream>
 #include <string>
 
+#include "gl_engine_or_skip.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/gl/gl_render_engine.hpp"
@@ -26,15 +27,6 @@
 
 namespace mfr::gl {
 namespace {
-
-#define MFR_GL_ENGINE_RASTER(name, raster)                                     \
-  auto name##Made = makeGlEngine("auto", raster);                              \
-  if (!name##Made) {                                                           \
-    const char* ci = std::getenv("CI");                                        \
-    if (ci && std::string(ci) == "true") FAIL() << name##Made.error().message; \
-    GTEST_SKIP() << name##Made.error().message;                                \
-  }                                                                            \
-  std::unique_ptr<Engine> name = std::move(name##Made.value())
 
 struct NativeCase {
   const char* scene;
@@ -45,7 +37,7 @@ struct NativeCase {
 class GlNative : public ::testing::TestWithParam<NativeCase> {};
 
 TEST_P(GlNative, AgreesWithTheCpuEngineOnEveryPreset) {
-  MFR_GL_ENGINE_RASTER(gl, "native");
+  MFR_GL_ENGINE_OR_SKIP(gl, "auto", "native");
   EXPECT_EQ(gl->describe().at("raster"), "native");
   const NativeCase& c = GetParam();
   const Scene scene = loadScene(c.scene).value();
@@ -144,7 +136,7 @@ INSTANTIATE_TEST_SUITE_P(
 // --gl-raster: native is the default (describe() and the stats say which ran); an unknown value is
 // one line naming the option.
 TEST(GlRaster, NativeIsTheDefaultAndUnknownValuesAreErrors) {
-  MFR_GL_ENGINE_RASTER(native, "native");
+  MFR_GL_ENGINE_OR_SKIP(native, "auto", "native");
   native.reset();
   auto byDefault = makeGlEngine();
   ASSERT_TRUE(byDefault.ok()) << byDefault.error().message;
@@ -168,7 +160,7 @@ TEST(GlRaster, NativeIsTheDefaultAndUnknownValuesAreErrors) {
 // The CLI: `--gl-raster exact` writes the CPU engine's PNG byte for byte; the default (native)
 // writes an image within the agreement bound; a bad value is one line on stderr and exit 1.
 TEST(GlRasterCli, ExactIsTheCpuEnginesPngAndNativeIsClose) {
-  MFR_GL_ENGINE_RASTER(gl, "native");
+  MFR_GL_ENGINE_OR_SKIP(gl, "auto", "native");
   gl.reset();  // the CLI makes its own context
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("mfr_gl_raster_" + std::to_string(::getpid()));
@@ -177,12 +169,6 @@ TEST(GlRasterCli, ExactIsTheCpuEnginesPngAndNativeIsClose) {
   const std::string base = std::string(MFR_CLI_PATH) +
                            " render procedural:bottles?count=4 -m kplus-heap --k 4 --width 96 "
                            "--height 80 --quiet --capture parallel";
-  auto slurp = [](const std::filesystem::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
   const auto run = [&](const std::string& options, const char* png) {
     const std::string cmd = base + " " + options + " -o " + (dir / png).string() + " 2>&1";
     return std::system(cmd.c_str());
@@ -190,8 +176,8 @@ TEST(GlRasterCli, ExactIsTheCpuEnginesPngAndNativeIsClose) {
   ASSERT_EQ(run("--engine cpu", "cpu.png"), 0);
   ASSERT_EQ(run("--engine gl --gl-raster exact", "exact.png"), 0);
   ASSERT_EQ(run("--engine gl", "native.png"), 0);
-  EXPECT_FALSE(slurp(dir / "cpu.png").empty());
-  EXPECT_EQ(slurp(dir / "exact.png"), slurp(dir / "cpu.png"));
+  EXPECT_FALSE(test::fileBytes(dir / "cpu.png").empty());
+  EXPECT_EQ(test::fileBytes(dir / "exact.png"), test::fileBytes(dir / "cpu.png"));
   auto cpuImage = readPng((dir / "cpu.png").string());
   auto nativeImage = readPng((dir / "native.png").string());
   ASSERT_TRUE(cpuImage.ok() && nativeImage.ok());
@@ -203,7 +189,7 @@ TEST(GlRasterCli, ExactIsTheCpuEnginesPngAndNativeIsClose) {
   const int rc = std::system(bad.c_str());
   ASSERT_TRUE(WIFEXITED(rc));
   EXPECT_EQ(WEXITSTATUS(rc), 1);
-  const std::string err = slurp(dir / "err.txt");
+  const std::string err = test::fileBytes(dir / "err.txt");
   EXPECT_NE(err.find("--gl-raster 'fast': expected native or exact"), std::string::npos) << err;
   EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
   EXPECT_FALSE(std::filesystem::exists(dir / "x.png"));

@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "gl_engine_or_skip.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/gl/gl_render_engine.hpp"
 #include "mfr/method/budget_spec.hpp"
@@ -20,17 +21,11 @@
 namespace mfr::gl {
 namespace {
 
-#define MFR_GL_ENGINE_OR_SKIP(name)                                            \
-  auto name##Made = makeGlEngine("auto", "exact");                             \
-  if (!name##Made) {                                                           \
-    const char* ci = std::getenv("CI");                                        \
-    if (ci && std::string(ci) == "true") FAIL() << name##Made.error().message; \
-    GTEST_SKIP() << name##Made.error().message;                                \
-  }                                                                            \
-  std::unique_ptr<Engine> name = std::move(name##Made.value())
+// --gl-raster exact: the count pass is the CPU engine's, so a share is the same bytes
+#define MFR_GL_EXACT_ENGINE(name) MFR_GL_ENGINE_OR_SKIP(name, "auto", "exact")
 
 TEST(GlRelativeBudget, SameBytesAsTheCpuEngine) {
-  MFR_GL_ENGINE_OR_SKIP(gl);
+  MFR_GL_EXACT_ENGINE(gl);
   const Scene scene = loadScene("procedural:hairball?strands=150").value();
   const Camera camera =
       scene.defaultCamera ? *scene.defaultCamera : frameBounds(sceneBounds(scene));
@@ -60,7 +55,7 @@ TEST(GlRelativeBudget, SameBytesAsTheCpuEngine) {
 }
 
 TEST(GlRelativeBudget, RenderAndCompareOnTheGlEngine) {
-  MFR_GL_ENGINE_OR_SKIP(gl);
+  MFR_GL_EXACT_ENGINE(gl);
   gl.reset();  // the CLI makes its own context
   const std::filesystem::path dir =
       std::filesystem::temp_directory_path() / ("mfr_gl_relative_" + std::to_string(::getpid()));

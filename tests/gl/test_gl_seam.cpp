@@ -18,6 +18,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "gl_engine_or_skip.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/gl/gl_render_engine.hpp"
 #include "mfr/method/memory_model.hpp"
@@ -26,25 +27,9 @@
 namespace mfr::gl {
 namespace {
 
-// --gl-raster exact: the CPU engine's raster, so the statistics and images are the CPU engine's
-// bit for bit (test_gl_native.cpp checks the native pipeline's agreement)
-std::unique_ptr<Engine> glEngineOrSkipReason(std::string& reason) {
-  auto engine = makeGlEngine("auto", "exact");
-  if (!engine) {
-    reason = engine.error().message;
-    return nullptr;
-  }
-  return std::move(engine.value());
-}
-
-#define MFR_GL_ENGINE(name)                                      \
-  std::string glReason;                                          \
-  std::unique_ptr<Engine> name = glEngineOrSkipReason(glReason); \
-  if (!name) {                                                   \
-    const char* ci = std::getenv("CI");                          \
-    if (ci && std::string(ci) == "true") FAIL() << glReason;     \
-    GTEST_SKIP() << glReason;                                    \
-  }
+// MFR_GL_ENGINE(name): --gl-raster exact, the CPU engine's raster, so the statistics and images are
+// the CPU engine's bit for bit (test_gl_native.cpp checks the native pipeline's agreement)
+#define MFR_GL_ENGINE(name) MFR_GL_ENGINE_OR_SKIP(name, "auto", "exact")
 
 struct SeamCase {
   const char* scene;
@@ -550,23 +535,17 @@ TEST(GlSeamCli, GlSyncOption) {
   const std::string base = std::string(MFR_CLI_PATH) +
                            " render procedural:layers --engine gl -m kplus-heap --k 4 --width 64 "
                            "--height 64 --quiet";
-  auto slurp = [](const std::filesystem::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-  };
   ASSERT_EQ(std::system((base + " -o " + (dir / "auto.png").string()).c_str()), 0);
   ASSERT_EQ(std::system((base + " --gl-sync lock -o " + (dir / "lock.png").string()).c_str()), 0);
-  EXPECT_FALSE(slurp(dir / "auto.png").empty());
+  EXPECT_FALSE(test::fileBytes(dir / "auto.png").empty());
   if (!hasInterlock) {
-    EXPECT_EQ(slurp(dir / "auto.png"), slurp(dir / "lock.png"));
+    EXPECT_EQ(test::fileBytes(dir / "auto.png"), test::fileBytes(dir / "lock.png"));
     const std::string cmd = base + " --gl-sync interlock -o " + (dir / "x.png").string() + " 2>" +
                             (dir / "err.txt").string();
     const int rc = std::system(cmd.c_str());
     ASSERT_TRUE(WIFEXITED(rc));
     EXPECT_EQ(WEXITSTATUS(rc), 1);
-    const std::string err = slurp(dir / "err.txt");
+    const std::string err = test::fileBytes(dir / "err.txt");
     EXPECT_NE(err.find("--gl-sync interlock: the driver offers none of "
                        "GL_ARB_fragment_shader_interlock"),
               std::string::npos)
