@@ -65,8 +65,13 @@ const char* rasterPart(GlRaster raster) {
   return "raster_native.glsl";
 }
 
+struct StageFile {
+  GLenum stage;
+  std::string file;
+};
+
 // the vertex [and geometry] stages of a raster program
-std::vector<std::pair<GLenum, const char*>> rasterStages(GlRaster raster) {
+std::vector<StageFile> rasterStages(GlRaster raster) {
   switch (raster) {
     case GlRaster::Native:
       return {{GL_VERTEX_SHADER, "raster_native.vert"}};
@@ -167,11 +172,6 @@ std::string interlockPrelude(const std::string& ext) {
     prelude += "layout(pixel_interlock_ordered) in;\n";
   return prelude;
 }
-
-struct StageFile {
-  GLenum stage;
-  std::string file;
-};
 
 // `prelude`: lines after "#version" in the fragment shader (the interlock's #extension, #define);
 // `raster`: the fragment stage's raster part (nullptr: none)
@@ -490,13 +490,9 @@ struct GlEngine::State {
       const std::string prelude = row.prelude == Prelude::KBufferSync ? kbufferPrelude
                                   : row.prelude == Prelude::Atomic64  ? kAtomic64Prelude
                                                                       : "";
-      std::vector<StageFile> stages;
-      if (row.raster) {
-        for (const auto& [stage, file] : rasterStages(raster)) stages.push_back({stage, file});
-        stages.push_back({GL_FRAGMENT_SHADER, row.file});
-      } else {
-        stages.push_back({GL_COMPUTE_SHADER, row.file});
-      }
+      std::vector<StageFile> stages = row.raster ? rasterStages(raster) : std::vector<StageFile>{};
+      stages.push_back(
+          {static_cast<GLenum>(row.raster ? GL_FRAGMENT_SHADER : GL_COMPUTE_SHADER), row.file});
       auto linked =
           linkProgram(row.file, stages, prelude, row.raster ? rasterPart(raster) : nullptr);
       if (!linked && row.prelude == Prelude::Atomic64) {
@@ -1684,8 +1680,8 @@ std::vector<ShaderVariant> shaderVariants() {
       }
       for (const GlRaster raster : {GlRaster::Native, GlRaster::Exact}) {
         const std::string named = program + " [" + toString(raster) + "]";
-        for (const auto& [stage, file] : rasterStages(raster))
-          add(named, file, stage == GL_VERTEX_SHADER ? "vert" : "geom", nullptr, "");
+        for (const StageFile& sf : rasterStages(raster))
+          add(named, sf.file, sf.stage == GL_VERTEX_SHADER ? "vert" : "geom", nullptr, "");
         add(named, row.file, "frag", rasterPart(raster), prelude);
       }
     }
