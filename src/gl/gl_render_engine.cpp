@@ -15,6 +15,7 @@
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/gl/gl_context.hpp"
 #include "mfr/gl/gl_engine.hpp"
+#include "mfr/gl/gl_technique.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/allocation.hpp"
 #include "mfr/method/dkb_model.hpp"
@@ -114,6 +115,8 @@ class GlFrame {
   }
 
   Result<RenderOutput> run(bool interlock) {
+    auto technique = classifyGl(method_);  // before any pass: a method the GL engine lacks
+    if (!technique) return technique.error();
     if (method_.allocation == AllocationPolicy::FixedK) {  // k from the budget, as on the CPU
       auto a = allocate(layout_, method_, memory_, options_.budgetBytes, {}, {}, {});
       if (!a) return a.error();

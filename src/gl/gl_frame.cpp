@@ -1,0 +1,540 @@
+// One frame of the GL engine: the plan of a method's technique (GlEngine::State::planRender),
+// then its passes in order (FrameRun: allocation, n(p), capture, resolve, read-back), each phase
+// one switch over the technique (mfr/gl/gl_technique.hpp).
+#include <epoxy/gl.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <vector>
+
+#include "gl/gl_state.hpp"
+#include "mfr/gl/gl_engine.hpp"
+#include "mfr/gl/gl_technique.hpp"
+#include "mfr/gl/shared_layout.h"
+
+namespace mfr::gl {
+namespace {
+
+// n(p) before the capture: the A-buffer sizes its slots by it; the others count n(p) in their
+// capture when no count came before (no pass of its own)
+bool countPassFirst(GlTechnique t) {
+  switch (t) {
+    case GlTechnique::ABuffer:
+      return true;
+    case GlTechnique::KBuffer:
+    case GlTechnique::Wboit:
+    case GlTechnique::Mboit:
+    case GlTechnique::Mlab:
+      return false;
+  }
+  return false;
+}
+
+// whether the technique's nodes are fragment nodes (depth, colour) that readNodes returns
+bool fragmentNodes(GlTechnique t) {
+  switch (t) {
+    case GlTechnique::ABuffer:
+    case GlTechnique::KBuffer:
+      return true;
+    case GlTechnique::Wboit:
+    case GlTechnique::Mboit:
+    case GlTechnique::Mlab:  // (mlab's nodes are merged layers, not fragments)
+      return false;
+  }
+  return false;
+}
+
+// bytes per pixel of the frame's largest per-pixel buffer (each must fit one storage block)
+uint64_t largestPerPixelBytes(const RenderPlan& p) {
+  const uint64_t occupancy = static_cast<uint64_t>(std::max(p.method.occupancyWords, 0)) * 4;
+  switch (p.technique) {
+    case GlTechnique::ABuffer:
+      return 12;  // the image (the nodes are checked on their own)
+    case GlTechnique::KBuffer:
+      return std::max<uint64_t>({12, p.hybrid ? kTailWords * 4 : 0,
+                                 p.perPixel ? 8 : uint64_t{p.k} * kNodeBytes, occupancy});
+    case GlTechnique::Wboit:
+      return std::max<uint64_t>(12, kWboitWords * 4);
+    case GlTechnique::Mboit:
+      return std::max<uint64_t>(12, kMboitWords * 4);
+    case GlTechnique::Mlab:
+      return std::max<uint64_t>(12, uint64_t{p.k} * kMlabWords * 4);
+  }
+  return 12;
+}
+
+}  // namespace
+
+// One run of render(): the frame's buffers (freed with it), the passes in order and the read-back.
+struct GlEngine::State::FrameRun {
+  State& s;
+  const RenderPlan& plan;
+  GlRenderOutput& out;
+  FrameBuffers fb;
+  GLuint counts = 0, offsets = 0, nodes = 0, tails = 0, accum = 0, image = 0;
+  uint64_t nodeCount = 0;
+  bool countInCapture = false;  // the capture adds n(p) (no count pass ran)
+
+  // a capture program: whether it counts n(p), and the counts' image unit
+  void useCapture(GLuint program) {
+    glUseProgram(program);
+    glProgramUniform1ui(program, loc(program, "uCountInCapture"), countInCapture ? 1u : 0u);
+    fb.bindImage(counts, kBindCounts);
+  }
+
+  FrameRun(State& state, const RenderPlan& p, GlRenderOutput& output)
+      : s(state), plan(p), out(output), fb(&output.bufferBytes) {}
+
+  // one timed pass: GL's elapsed time and the wall time around it
+  template <class Body>
+  void pass(const char* name, Body&& body) {
+    if (fb.failure) return;  // a buffer GL could not allocate: reported below
+    timedGpuPass(s.query, out.passes, name, body);
+  }
+
+  // the per-pixel allocation: (first slot, k(p) | heap bit), a texel buffer
+  void bindAllocation() {
+    const Allocation* alloc = plan.alloc;
+    const uint32_t pixels = plan.pixels;
+    const bool device = plan.device;
+    const bool perPixel = plan.perPixel;
+    if (device) {
+      out.bufferBytes["allocation"] += uint64_t{pixels} * 8;
+      fb.bindTexture(s.deviceWords, GL_RG32UI, kBindAllocation);
+    } else if (perPixel) {
+      std::vector<uint32_t> words(uint64_t{pixels} * 2);
+      for (uint32_t p = 0; p < pixels; ++p) {
+        words[2 * p] = static_cast<uint32_t>(alloc->offsets[p]);
+        words[2 * p + 1] =
+            alloc->capacity[p] | (alloc->kind[p] == StoreKind::MaxHeap ? kAllocHeapBit : 0u);
+      }
+      const GLuint a = fb.make("allocation", uint64_t{pixels} * 8, words.data());
+      if (a) fb.bindTexture(a, GL_RG32UI, kBindAllocation);
+    }
+  }
+
+  // n(p): the counts given, those on the device, a count pass (the A-buffer needs n(p) before
+  // its capture), or counted by the capture itself (countInCapture: no pass of its own)
+  void countFragments() {
+    const GlRenderOptions& options = plan.options;
+    const uint32_t pixels = plan.pixels;
+    const bool device = plan.device;
+    const bool counted = device || (options.counts && options.counts->size() == pixels);
+    counts = fb.make("counts", uint64_t{pixels} * 4,
+                     counted && !device ? options.counts->data() : nullptr);
+    if (device)  // n(p) of countOnDevice, copied on the GPU
+      glCopyNamedBufferSubData(s.deviceCounts, counts, 0, 0, uint64_t{pixels} * 4);
+    const bool countPass = countPassFirst(plan.technique);
+    countInCapture = !counted && !countPass;
+    if (countInCapture) clearUint(counts, 0);
+    if (!counted && countPass) {
+      clearUint(counts, 0);
+      pass("count", [&] {
+        glUseProgram(s.program(ProgramId::Count));
+        fb.bindImage(counts, kBindCounts);
+        s.drawScene();
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                        GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+    }
+  }
+
+  // wboit, mboit: the per-pixel accumulators (mboit: its moments first)
+  void captureAccumulators() {
+    const uint32_t pixels = plan.pixels;
+    const bool isWboit = plan.technique == GlTechnique::Wboit;
+    const uint32_t accumWords = isWboit ? kWboitWords : kMboitWords;
+    accum = fb.make("accumulators", uint64_t{pixels} * accumWords * 4);
+    {  // wboit: revealage 1, the rest 0
+      std::vector<float> init(uint64_t{pixels} * accumWords, 0.0f);
+      if (isWboit)
+        for (uint32_t p = 0; p < pixels; ++p) init[uint64_t{p} * accumWords + 4] = 1.0f;
+      glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
+    }
+    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+    clearUint(locks, kLockFree);
+    auto accumulate = [&](GLuint program, bool capture) {
+      if (capture) {
+        useCapture(program);
+      } else {
+        glUseProgram(program);
+      }
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+      fb.bindImage(locks, kBindLocks);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    };
+    if (!isWboit) pass("moments", [&] { accumulate(s.program(ProgramId::MboitMoments), false); });
+    pass("capture", [&] {
+      accumulate(isWboit ? s.program(ProgramId::Wboit) : s.program(ProgramId::MboitColor), true);
+    });
+  }
+
+  // mlab: k nodes per pixel merged in place, their count per pixel
+  void captureMlab() {
+    const uint32_t pixels = plan.pixels;
+    const uint32_t k = plan.k;
+    nodes = fb.make("nodes", uint64_t{pixels} * k * kMlabWords * 4);
+    accum = fb.make("counters", uint64_t{pixels} * 4);  // nodes in use per pixel
+    clearUint(accum, 0);
+    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+    clearUint(locks, kLockFree);
+    pass("capture", [&] {
+      const GLuint p = s.program(ProgramId::Mlab);
+      useCapture(p);
+      glProgramUniform1ui(p, loc(p, "uK"), k);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, accum);
+      fb.bindImage(locks, kBindLocks);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    });
+  }
+
+  // the A-buffer: the prefix sum of n(p), then every fragment into its slot
+  Result<void> captureABuffer() {
+    const MethodDesc& method = plan.method;
+    const uint32_t pixels = plan.pixels;
+    offsets = fb.make("offsets", uint64_t{pixels} * 4);
+    pass("prefix sum", [&] { s.scan(fb, counts, offsets, pixels); });
+    // the total in 64 bits from n(p) itself (the 32-bit scan would wrap silently)
+    std::vector<uint32_t> n(pixels);
+    glGetNamedBufferSubData(counts, 0, uint64_t{pixels} * 4ll, n.data());
+    nodeCount = 0;
+    for (uint32_t c : n) nodeCount += c;
+    if (nodeCount * kNodeBytes > s.maxBlockBytes)  // (also keeps the uint offsets exact)
+      return s.tooLarge(method, "A-buffer node", nodeCount * kNodeBytes);
+    nodes = fb.make("nodes", nodeCount * kNodeBytes);
+    const GLuint fill = fb.make("fill counters", uint64_t{pixels} * 4);
+    clearUint(fill, 0);
+    pass("capture", [&] {
+      glUseProgram(s.program(ProgramId::ABuffer));
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, offsets);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, fill);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    });
+    return {};
+  }
+
+  // occupancy culling: depth range, bitmap fill, k-th occupied bucket; the range buffer
+  GLuint occupancyCulling(uint32_t words) {
+    const uint32_t pixels = plan.pixels;
+    const uint32_t k = plan.k;
+    const bool perPixel = plan.perPixel;
+    const GLuint range = fb.make("occupancy", uint64_t{pixels} * kOccupancyWords * 4);
+    static_assert(kOccupancyWords == 3);
+    const uint32_t init[3] = {kFarDepthBits, 0u, kOccupancyNoCulling};
+    glClearNamedBufferData(range, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
+    const GLuint bitmap = fb.make("occupancy", uint64_t{pixels} * words * 4);
+    clearUint(bitmap, 0);
+    pass("depth range", [&] {
+      glUseProgram(s.program(ProgramId::DepthRange));
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    });
+    pass("occupancy fill", [&] {
+      const GLuint p = s.program(ProgramId::OccupancyFill);
+      glUseProgram(p);
+      glProgramUniform1ui(p, loc(p, "uWords"), words);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    });
+    pass("occupancy count", [&] {
+      const GLuint p = s.program(ProgramId::OccupancyCount);
+      glUseProgram(p);
+      glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
+      glProgramUniform1ui(p, loc(p, "uWords"), words);
+      glProgramUniform1ui(p, loc(p, "uK"), k);
+      glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccBits, bitmap);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+      dispatchGroups((pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
+    });
+    return range;
+  }
+
+  // the k-buffer family: fixed or per-pixel k, max-array or max-heap, optional tail and occupancy
+  void captureKBuffer() {
+    const MethodDesc& method = plan.method;
+    const uint32_t pixels = plan.pixels;
+    const uint32_t k = plan.k;
+    const bool perPixel = plan.perPixel;
+    const bool hybrid = plan.hybrid;
+    const uint64_t allocSlots = plan.allocSlots;
+    nodeCount = perPixel ? allocSlots : uint64_t{pixels} * k;
+    const uint32_t words = static_cast<uint32_t>(method.occupancyWords);
+    const GLuint stats = fb.make("capture counters", 8);
+    clearUint(stats, 0);
+    if (hybrid) {
+      tails = fb.make("tails", uint64_t{pixels} * kTailWords * 4);
+      clearUint(tails, 0);
+    } else {
+      tails = stats;  // not read
+    }
+    GLuint range = stats;
+    if (words > 0) range = occupancyCulling(words);
+    // a fixed k without tail or occupancy takes 64-bit atomicMin where the driver has them
+    const bool atomic =
+        s.program(ProgramId::KBufferAtomic64) != 0 && !perPixel && !hybrid && words == 0;
+    out.atomic64 = atomic;
+    nodes = fb.make("nodes", nodeCount * kNodeBytes);
+    // the far node; as uint64 words (colour, depth) for the atomic capture
+    const uint32_t far[2] = {atomic ? 0u : kFarDepthBits, atomic ? kFarDepthBits : 0u};
+    glClearNamedBufferData(nodes, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT, far);
+    // (the lock words stay allocated and charged with the atomics: bytes_used does not depend
+    // on the capture's synchronisation)
+    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+    clearUint(locks, kLockFree);
+    const GLuint p = s.program(atomic ? ProgramId::KBufferAtomic64 : ProgramId::KBuffer);
+    glProgramUniform1ui(p, loc(p, "uK"), k);
+    glProgramUniform1ui(p, loc(p, "uStore"),
+                        method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
+    glProgramUniform1ui(p, loc(p, "uOccupancyWords"), words);
+    glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
+    glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
+    pass("capture", [&] {
+      useCapture(p);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOccupancy, range);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTails, tails);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCaptureStats, stats);
+      fb.bindImage(locks, kBindLocks);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    });
+    if (atomic)
+      pass("node words", [&] {
+        const GLuint q = s.program(ProgramId::SwapNodeWords);
+        glUseProgram(q);
+        glProgramUniform1ui(q, loc(q, "uCount"), static_cast<GLuint>(nodeCount));
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+        dispatchGroups((nodeCount + kResolveGroupSize - 1) / kResolveGroupSize);
+        glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+      });
+    uint32_t culled[2] = {0, 0};
+    glGetNamedBufferSubData(stats, 0, 8, culled);
+    out.culledOccupancy = culled[0];
+    out.culledKPlus = culled[1];
+  }
+
+  // mlab: its nodes front to back over the background
+  void resolveMlab() {
+    image = fb.make("image", uint64_t{plan.pixels} * 12);
+    pass("resolve", [&] {
+      const GLuint p = s.program(ProgramId::MlabResolve);
+      useResolve(p);
+      glProgramUniform1ui(p, loc(p, "uK"), plan.k);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, accum);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage2, image);
+      dispatchPixels();
+    });
+  }
+
+  // wboit, mboit: the accumulators' composite
+  void resolveAccumulators(ProgramId program) {
+    image = fb.make("image", uint64_t{plan.pixels} * 12);
+    pass("resolve", [&] {
+      useResolve(s.program(program));
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+      dispatchPixels();
+    });
+  }
+
+  // the A-buffer and the k-buffer family: sort each pixel's nodes, composite front to back
+  // (kbuffer or hybrid with the pixel's tail)
+  void resolveNodes() {
+    image = fb.make("image", uint64_t{plan.pixels} * 12);
+    pass("resolve", [&] {
+      const GLuint p = s.program(ProgramId::Resolve);
+      useResolve(p);
+      glProgramUniform1ui(p, loc(p, "uK"), plan.k);
+      glProgramUniform1ui(p, loc(p, "uHybrid"), plan.hybrid ? 1u : 0u);
+      glProgramUniform1ui(p, loc(p, "uPerPixel"), plan.perPixel ? 1u : 0u);
+      glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : counts);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCounts, counts);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, offsets ? offsets : counts);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
+      dispatchPixels();
+    });
+  }
+
+  // a resolve program in use with the uniforms every resolve takes
+  void useResolve(GLuint p) {
+    const glm::vec3 bg = plan.options.background;
+    glUseProgram(p);
+    glProgramUniform1ui(p, loc(p, "uPixels"), plan.pixels);
+    glProgramUniform3f(p, loc(p, "uBackground"), bg.r, bg.g, bg.b);
+  }
+
+  // one invocation per pixel, then the image readable
+  void dispatchPixels() {
+    dispatchGroups((plan.pixels + kResolveGroupSize - 1) / kResolveGroupSize);
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  }
+
+  // a GL error or a buffer GL could not allocate
+  Result<void> checkErrors() {
+    const MethodDesc& method = plan.method;
+    if (const GLenum e = glGetError(); e != GL_NO_ERROR) {
+      char buf[16];
+      std::snprintf(buf, sizeof buf, "%x", e);
+      if (fb.failure) return *fb.failure;
+      return makeError("--engine gl: " + method.name + " failed (GL error 0x" + buf + ")");
+    }
+    if (fb.failure) return *fb.failure;
+    return {};
+  }
+
+  // n(p), the image and, with readNodes, the nodes with their per-pixel ranges
+  void readBack() {
+    const GlRenderOptions& options = plan.options;
+    const uint32_t pixels = plan.pixels;
+    out.counts.resize(pixels);
+    glGetNamedBufferSubData(counts, 0, uint64_t{pixels} * 4ll, out.counts.data());
+    for (uint32_t n : out.counts) out.fragments += n;
+    out.image = ImageRGB(s.width, s.height);
+    glGetNamedBufferSubData(image, 0, uint64_t{pixels} * 12ll, out.image.pixels.data());
+    if (options.readNodes && fragmentNodes(plan.technique)) readNodes();
+  }
+
+  // the nodes, and each pixel's first node and count
+  void readNodes() {
+    const Allocation* alloc = plan.alloc;
+    const uint32_t pixels = plan.pixels;
+    const uint32_t k = plan.k;
+    const bool device = plan.device;
+    const bool isABuffer = plan.technique == GlTechnique::ABuffer;
+    std::vector<uint32_t> words(nodeCount * 2);
+    if (nodeCount > 0)
+      glGetNamedBufferSubData(nodes, 0, static_cast<GLsizeiptr>(nodeCount * kNodeBytes),
+                              words.data());
+    out.nodes.resize(nodeCount);
+    for (uint64_t i = 0; i < nodeCount; ++i)
+      out.nodes[i] = (static_cast<uint64_t>(words[2 * i + kNodeHiIndex]) << 32) |
+                     words[2 * i + 1 - kNodeHiIndex];
+    out.nodeOffsets.resize(pixels);
+    out.nodeCounts.resize(pixels);
+    if (isABuffer) {
+      std::vector<uint32_t> off(pixels);
+      glGetNamedBufferSubData(offsets, 0, uint64_t{pixels} * 4ll, off.data());
+      for (uint32_t p = 0; p < pixels; ++p) {
+        out.nodeOffsets[p] = off[p];
+        out.nodeCounts[p] = out.counts[p];
+      }
+    } else {
+      std::vector<uint32_t> words;
+      if (device) {
+        words.resize(uint64_t{pixels} * 2);
+        glGetNamedBufferSubData(s.deviceWords, 0, uint64_t{pixels} * 8ll, words.data());
+      }
+      for (uint32_t p = 0; p < pixels; ++p) {
+        const uint64_t first = device ? words[2 * p] : alloc ? alloc->offsets[p] : uint64_t{p} * k;
+        const uint32_t capacity = device  ? words[2 * p + 1] & ~kAllocHeapBit
+                                  : alloc ? alloc->capacity[p]
+                                          : k;
+        out.nodeOffsets[p] = first;
+        out.nodeCounts[p] = std::min(out.counts[p], capacity);
+      }
+    }
+  }
+};
+
+Result<RenderPlan> GlEngine::State::planRender(const MethodDesc& method,
+                                               const GlRenderOptions& options) const {
+  auto technique = classifyGl(method);
+  if (!technique) return technique.error();
+  const Allocation* alloc = options.allocation;
+  // the allocation the compute shaders left in the engine's buffers (allocateCapped,
+  // allocateByImportance), else the host's
+  const bool device = options.deviceAllocation;
+  if (device && !this->device)
+    return makeError("--engine gl: " + method.name + ": no allocation on the device");
+  if (alloc && (alloc->capacity.size() != pixels() || alloc->offsets.size() != pixels() ||
+                alloc->kind.size() != pixels()))
+    return makeError("--engine gl: " + method.name + ": an allocation of another size");
+  RenderPlan plan{method, options, *technique, alloc, pixels(), device, false, 0, false, 0};
+  switch (*technique) {
+    case GlTechnique::ABuffer:
+    case GlTechnique::Wboit:
+    case GlTechnique::Mboit:
+      break;
+    case GlTechnique::KBuffer:
+      plan.perPixel = alloc != nullptr || device;
+      plan.allocSlots = device ? deviceSlots : alloc ? alloc->slots : 0;
+      plan.hybrid = method.compositing == Compositing::Hybrid;
+      if (plan.perPixel) break;
+      [[fallthrough]];  // a fixed k
+    case GlTechnique::Mlab:
+      if (method.allocation != AllocationPolicy::FixedK || !method.k || *method.k == 0)
+        return makeError("--engine gl: " + method.name +
+                         ": a fixed k (k >= 1) or a per-pixel allocation needed");
+      plan.k = *method.k;
+      break;
+  }
+  if (uint64_t{plan.pixels} * largestPerPixelBytes(plan) > maxBlockBytes)
+    return tooLarge(method, "per-pixel", uint64_t{plan.pixels} * largestPerPixelBytes(plan));
+  if (plan.perPixel && plan.allocSlots * kNodeBytes > maxBlockBytes)  // (keeps uint offsets exact)
+    return tooLarge(method, "node", plan.allocSlots * kNodeBytes);
+  return plan;
+}
+
+Error GlEngine::State::tooLarge(const MethodDesc& method, const std::string& what,
+                                uint64_t bytes) const {
+  return makeError("--engine gl: " + method.name + " at " + std::to_string(width) + "x" +
+                   std::to_string(height) + ": the " + what + " buffer needs " +
+                   std::to_string(bytes) + " B, above GL_MAX_SHADER_STORAGE_BLOCK_SIZE (" +
+                   std::to_string(maxBlockBytes) + " B)");
+}
+
+Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRenderOptions& options) {
+  State& s = *state_;
+  auto plan = s.planRender(method, options);
+  if (!plan) return plan.error();
+  GlRenderOutput out;
+  for (int run = options.warmUp ? 0 : 1; run < 2; ++run) {
+    const bool timed = run == 1;
+    out.bufferBytes = s.sceneBytes;
+    out.passes.clear();
+    State::FrameRun frame(s, *plan, out);
+    frame.bindAllocation();
+    frame.countFragments();
+    switch (plan->technique) {
+      case GlTechnique::ABuffer:
+        MFR_TRY(frame.captureABuffer());
+        frame.resolveNodes();
+        break;
+      case GlTechnique::KBuffer:
+        frame.captureKBuffer();
+        frame.resolveNodes();
+        break;
+      case GlTechnique::Wboit:
+        frame.captureAccumulators();
+        frame.resolveAccumulators(ProgramId::WboitResolve);
+        break;
+      case GlTechnique::Mboit:
+        frame.captureAccumulators();
+        frame.resolveAccumulators(ProgramId::MboitResolve);
+        break;
+      case GlTechnique::Mlab:
+        frame.captureMlab();
+        frame.resolveMlab();
+        break;
+    }
+    MFR_TRY(frame.checkErrors());
+    if (timed) frame.readBack();
+  }
+  return out;
+}
+
+}  // namespace mfr::gl

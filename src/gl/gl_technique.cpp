@@ -1,0 +1,121 @@
+// The GL engine's technique table and classifyGl (mfr/gl/gl_technique.hpp).
+#include "mfr/gl/gl_technique.hpp"
+
+#include <iterator>
+#include <optional>
+#include <string>
+
+namespace mfr::gl {
+namespace {
+
+constexpr GlTechniqueInfo kTechniques[] = {
+    {GlTechnique::ABuffer, "abuffer",
+     "count -> prefix sum -> capture (append) -> resolve (sort, front-to-back over)",
+     "capture_abuffer.frag", "resolve.comp",
+     "n(p) 4 B + offset 4 B + fill counter 4 B + n(p) nodes of 8 B", "abuffer"},
+    {GlTechnique::KBuffer, "kbuffer",
+     "[count + allocation (variable k)] -> [depth range -> occupancy fill -> occupancy count] -> "
+     "capture (k+ test, lock / interlock / 64-bit atomicMin) -> resolve (sort, kbuffer or hybrid)",
+     "capture_kbuffer.frag, capture_kbuffer_atomic64.frag (+ swap_node_words.comp)", "resolve.comp",
+     "k or k(p) nodes of 8 B + lock 4 B [+ allocation 8 B] [+ tail 20 B] [+ occupancy 12 + 4d B]",
+     "zbuffer, fkb, kplus-array, kplus-heap, kplus-sb, kplus-dynamic, vkb, vkb-fill, dkb, "
+     "dkb-fill, dkb-curve, optimal, optimal-greedy (and their +occupancy forms)"},
+    {GlTechnique::Wboit, "wboit", "capture (accumulate under the lock) -> resolve", "wboit.frag",
+     "wboit_resolve.comp", "accumulators 20 B + lock 4 B", "wboit"},
+    {GlTechnique::Mboit, "mboit",
+     "moments (accumulate) -> capture (colour, reconstructed transmittance) -> resolve",
+     "mboit_moments.frag, mboit_color.frag", "mboit_resolve.comp", "accumulators 36 B + lock 4 B",
+     "mboit"},
+    {GlTechnique::Mlab, "mlab", "capture (insert, merge the two farthest when full) -> resolve",
+     "mlab.frag", "mlab_resolve.comp", "k nodes of 20 B + node count 4 B + lock 4 B", "mlab"},
+};
+
+constexpr bool rowsInEnumOrder() {
+  for (size_t i = 0; i < std::size(kTechniques); ++i)
+    if (static_cast<size_t>(kTechniques[i].technique) != i) return false;
+  return true;
+}
+static_assert(rowsInEnumOrder(), "kTechniques lists the techniques in GlTechnique's order");
+
+// the k-buffer family's stores and rules on the GL engine
+bool kBufferStore(const MethodDesc& m) {
+  switch (m.store) {
+    case StoreChoice::MaxArray:
+    case StoreChoice::MaxHeap:
+      return true;
+    case StoreChoice::PerPixel:  // K+B-SB: chosen per pixel from the allocation
+      return m.allocation != AllocationPolicy::FixedK;
+    case StoreChoice::Append:
+    case StoreChoice::MultiLayer:
+    case StoreChoice::None:
+      return false;
+  }
+  return false;
+}
+
+bool kBufferAllocation(AllocationPolicy a) {
+  switch (a) {
+    case AllocationPolicy::FixedK:
+    case AllocationPolicy::CountedK:
+    case AllocationPolicy::DynamicK:
+    case AllocationPolicy::Importance:
+    case AllocationPolicy::Optimal:
+      return true;
+    case AllocationPolicy::Unbounded:
+    case AllocationPolicy::NoNodes:
+      return false;
+  }
+  return false;
+}
+
+// the technique a method's fields name, before the checks of its options
+std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
+  switch (m.compositing) {
+    case Compositing::KBuffer:
+    case Compositing::Hybrid:
+      if (m.allocation == AllocationPolicy::Unbounded && m.store == StoreChoice::Append &&
+          m.compositing == Compositing::KBuffer && m.occupancyWords == 0)
+        return GlTechnique::ABuffer;
+      if (kBufferAllocation(m.allocation) && kBufferStore(m)) return GlTechnique::KBuffer;
+      return std::nullopt;
+    case Compositing::WeightedBlended:
+    case Compositing::MomentBased:
+      if (m.allocation != AllocationPolicy::NoNodes || m.store != StoreChoice::None ||
+          m.occupancyWords != 0)
+        return std::nullopt;
+      return m.compositing == Compositing::WeightedBlended ? GlTechnique::Wboit
+                                                           : GlTechnique::Mboit;
+    case Compositing::MultiLayerAlpha:
+      if (m.allocation != AllocationPolicy::FixedK || m.store != StoreChoice::MultiLayer ||
+          m.occupancyWords != 0)
+        return std::nullopt;
+      return GlTechnique::Mlab;
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::span<const GlTechniqueInfo> glTechniques() {
+  return kTechniques;
+}
+
+const GlTechniqueInfo& techniqueInfo(GlTechnique technique) {
+  return kTechniques[static_cast<size_t>(technique)];
+}
+
+const char* toString(GlTechnique technique) {
+  return techniqueInfo(technique).name;
+}
+
+Result<GlTechnique> classifyGl(const MethodDesc& method) {
+  const std::optional<GlTechnique> t = techniqueOf(method);
+  if (!t || method.occupancyWords < 0 || method.occupancyWords > 64)
+    return makeError("--engine gl: method " + method.name +
+                     " is not in the GL engine (it runs the A-buffer; the k-buffer family with a "
+                     "fixed k or a per-pixel k(p), max-array or max-heap stores, occupancy culling "
+                     "and kbuffer or hybrid compositing; wboit; mboit; mlab)");
+  return *t;
+}
+
+}  // namespace mfr::gl

@@ -1,0 +1,101 @@
+// The GL engine's technique table (mfr/gl/gl_technique.hpp): every preset the library names runs
+// as the technique its paper describes, the table lists the techniques in the enum's order, and a
+// method outside the GL engine is one line naming it. No GL context needed.
+#include <gtest/gtest.h>
+
+#include <map>
+#include <string>
+
+#include "mfr/gl/gl_technique.hpp"
+#include "mfr/method/method.hpp"
+
+namespace {
+
+using namespace mfr;
+using namespace mfr::gl;
+
+// what each preset is, written from the papers rather than from classifyGl's rules
+GlTechnique expectedTechnique(const std::string& preset) {
+  static const std::map<std::string, GlTechnique> peers = {{"abuffer", GlTechnique::ABuffer},
+                                                           {"wboit", GlTechnique::Wboit},
+                                                           {"mboit", GlTechnique::Mboit},
+                                                           {"mlab", GlTechnique::Mlab}};
+  const auto it = peers.find(preset);
+  return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
+}
+
+TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
+  int presets = 0;
+  for (const std::string& name : presetNames()) {
+    const MethodDesc method = methodPreset(name).value();
+    auto t = classifyGl(method);
+    ASSERT_TRUE(t.ok()) << name << ": " << t.error().message;
+    EXPECT_EQ(*t, expectedTechnique(name)) << name << " runs as " << toString(*t);
+    ++presets;
+  }
+  EXPECT_GE(presets, 30);  // 17 presets and 13 +occupancy forms
+}
+
+TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
+  for (const char* name : {"fkb", "kplus-heap", "kplus-sb+occupancy", "vkb", "dkb", "optimal"}) {
+    MethodDesc method = methodPreset(name).value();
+    for (Compositing c : {Compositing::KBuffer, Compositing::Hybrid}) {
+      method.compositing = c;
+      auto t = classifyGl(method);
+      ASSERT_TRUE(t.ok()) << name << ": " << t.error().message;
+      EXPECT_EQ(*t, GlTechnique::KBuffer) << name;
+    }
+  }
+}
+
+TEST(GlTechnique, TableRowsFollowTheEnum) {
+  const auto rows = glTechniques();
+  ASSERT_EQ(rows.size(), 5u);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    EXPECT_EQ(static_cast<size_t>(rows[i].technique), i);
+    EXPECT_EQ(&techniqueInfo(rows[i].technique), &rows[i]);
+    for (const char* field : {rows[i].name, rows[i].passes, rows[i].capture, rows[i].resolve,
+                              rows[i].perPixel, rows[i].presets})
+      EXPECT_GT(std::string(field).size(), 0u) << i;
+  }
+  EXPECT_EQ(std::string(toString(GlTechnique::Mboit)), "mboit");
+  EXPECT_EQ(std::string(toString(GlTechnique::KBuffer)), "kbuffer");
+}
+
+TEST(GlTechnique, CombinationsOutsideTheGlEngineAreOneLineErrors) {
+  auto expectRefused = [](MethodDesc m, const std::string& what) {
+    m.name = "custom-" + what;
+    auto t = classifyGl(m);
+    ASSERT_FALSE(t.ok()) << what << " ran as " << toString(*t);
+    EXPECT_NE(t.error().message.find("--engine gl: method custom-" + what), std::string::npos)
+        << t.error().message;
+    EXPECT_NE(t.error().message.find("not in the GL engine"), std::string::npos);
+    EXPECT_EQ(t.error().message.find('\n'), std::string::npos);
+  };
+  MethodDesc m = methodPreset("mlab").value();
+  m.occupancyWords = 1;
+  expectRefused(m, "mlab-occupancy");
+  m = methodPreset("abuffer").value();
+  m.occupancyWords = 2;
+  expectRefused(m, "abuffer-occupancy");
+  m = methodPreset("abuffer").value();
+  m.compositing = Compositing::Hybrid;
+  expectRefused(m, "abuffer-hybrid");
+  m = methodPreset("wboit").value();
+  m.occupancyWords = 1;
+  expectRefused(m, "wboit-occupancy");
+  m = methodPreset("fkb").value();
+  m.store = StoreChoice::Append;
+  expectRefused(m, "fkb-append");
+  m = methodPreset("fkb").value();
+  m.store = StoreChoice::PerPixel;  // K+B-SB picks per pixel from an allocation a fixed k lacks
+  expectRefused(m, "fkb-perpixel");
+  m = methodPreset("kplus-heap").value();
+  m.occupancyWords = 65;
+  expectRefused(m, "occupancy-65");
+  m = methodPreset("mboit").value();
+  m.allocation = AllocationPolicy::FixedK;
+  expectRefused(m, "mboit-nodes");
+}
+
+}  // namespace
