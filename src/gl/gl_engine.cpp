@@ -17,6 +17,7 @@
 #include "mfr/core/color.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/gl/shared_layout.h"
+#include "mfr/method/method_math.h"
 
 namespace mfr::gl {
 
@@ -38,9 +39,9 @@ uint64_t GlRenderOutput::totalBufferBytes() const {
 
 namespace {
 
-// Guard band clamp of the CPU set-up, a copy of setupTriangle's kMaxNdc in src/cpu/raster_frame.cpp
-// (kGuardBand = 8, times 1.001); raster.geom clamps to it as the uniform uMaxNdc.
-constexpr double kMaxNdc = 8.0f * 1.001;
+// Guard band clamp of the CPU set-up (method_math.h, as setupTriangle in src/cpu/raster_frame.cpp);
+// raster.geom clamps to it as the uniform uMaxNdc.
+constexpr double kMaxNdc = method_math::kGuardBandMaxNdc;
 
 std::string oneLine(std::string text) {
   while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
@@ -87,6 +88,8 @@ std::string composeSource(const std::string& file, const char* raster, const std
   std::string s = "#version 450 core\n";
   s += prelude;
   s += embeddedShader("shared_layout.h");
+  s += "\n";
+  s += embeddedShader("method_math.h");  // the methods' maths, shared with the CPU engine
   s += "\n";
   if (raster) {
     s += embeddedShader(raster);
