@@ -12,7 +12,8 @@ file(GLOB MFR_SHADER_FILES CONFIGURE_DEPENDS
      ${CMAKE_CURRENT_SOURCE_DIR}/shaders/*.glsl)
 list(SORT MFR_SHADER_FILES)
 set(MFR_SHADER_INPUTS ${MFR_SHADER_FILES}
-    ${CMAKE_CURRENT_SOURCE_DIR}/include/mfr/gl/shared_layout.h)
+    ${CMAKE_CURRENT_SOURCE_DIR}/include/mfr/gl/shared_layout.h
+    ${CMAKE_CURRENT_SOURCE_DIR}/include/mfr/method/method_math.h)
 string(REPLACE ";" "|" MFR_SHADER_ARG "${MFR_SHADER_INPUTS}")
 set(MFR_SHADERS_CPP "${CMAKE_CURRENT_BINARY_DIR}/generated/gl_shaders.cpp")
 add_custom_command(OUTPUT "${MFR_SHADERS_CPP}"

@@ -1,5 +1,5 @@
 # Installable package: `cmake --install BUILD --prefix P` puts
-#   P/include/mfr/**.hpp                       public headers (src/ stays private)
+#   P/include/mfr/**.hpp, **.h                 public headers (src/ stays private)
 #   P/lib/libmfr.a                             the library (the built-in dkb model is compiled in)
 #   P/bin/mfr                                  the command line
 #   P/lib/cmake/mfr/mfr{Config,ConfigVersion,Targets}.cmake   find_package(mfr) -> mfr::mfr
@@ -18,7 +18,7 @@ install(TARGETS mfr EXPORT mfrTargets
   INCLUDES DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}")
 install(TARGETS mfr_cli RUNTIME DESTINATION "${CMAKE_INSTALL_BINDIR}")
 install(DIRECTORY "${PROJECT_SOURCE_DIR}/include/mfr" DESTINATION "${CMAKE_INSTALL_INCLUDEDIR}"
-  FILES_MATCHING PATTERN "*.hpp")
+  FILES_MATCHING PATTERN "*.hpp" PATTERN "*.h")
 install(EXPORT mfrTargets NAMESPACE mfr:: DESTINATION "${MFR_INSTALL_CMAKEDIR}")
 
 configure_package_config_file("${PROJECT_SOURCE_DIR}/cmake/mfrConfig.cmake.in"

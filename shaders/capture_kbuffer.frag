@@ -94,20 +94,20 @@ void insertNode(const uint p, const uint first, const uint k, const uint storeKi
     toTail = true;  // evicted (an empty slot's far node is not a fragment)
     tailColor = maxNode.y;
   }
-  if (toTail && uHybrid != 0u) {  // mfr::HybridTail::add
+  if (toTail && uHybrid != 0u) {  // mfr::HybridTail::add (method_math.h's hybridTailAdd)
     const uint t = kTailWords * p;
     precise float a = float(tailColor >> 24) * uInv255;
-    precise float r = uintBitsToFloat(tails[t]) + a * srgb8ToLinear(tailColor & 0xffu);
-    precise float g =
-        uintBitsToFloat(tails[t + 1u]) + a * srgb8ToLinear((tailColor >> 8) & 0xffu);
-    precise float b =
-        uintBitsToFloat(tails[t + 2u]) + a * srgb8ToLinear((tailColor >> 16) & 0xffu);
-    precise float sumA = uintBitsToFloat(tails[t + 3u]) + a;
+    float r = uintBitsToFloat(tails[t]), g = uintBitsToFloat(tails[t + 1u]),
+          b = uintBitsToFloat(tails[t + 2u]), sumA = uintBitsToFloat(tails[t + 3u]);
+    uint count = tails[t + 4u];
+    hybridTailAdd(r, g, b, sumA, count, a, srgb8ToLinear(tailColor & 0xffu),
+                  srgb8ToLinear((tailColor >> 8) & 0xffu),
+                  srgb8ToLinear((tailColor >> 16) & 0xffu));
     tails[t] = floatBitsToUint(r);
     tails[t + 1u] = floatBitsToUint(g);
     tails[t + 2u] = floatBitsToUint(b);
     tails[t + 3u] = floatBitsToUint(sumA);
-    tails[t + 4u] += 1u;
+    tails[t + 4u] = count;
   }
 }
 

@@ -2,11 +2,14 @@
 // sec. 3.2, Eqs. 3-6), per pixel as mfr::computeImportance:
 //   I_d = alpha + (1 - alpha) min(1, n / N_limit), I_per = 1 - (2 |p - o| / (1.1 sqrt(w^2 + h^2)))^d,
 //   I_f = 1 - (1 - |n.v|)^5 / 2, I = max(0, I_per I_d I_f + lambda (xi - 0.5)); 0 where n(p) = 0.
-// Bit for bit the host's float arithmetic: every operation `precise` (no fused multiply-add);
-// division and square root in double rounded to float (the correctly rounded float result, as
-// the host's); an integer power as a product in double rounded to float (the host's powf, which
-// glibc rounds correctly in all but rare cases); xi the same SplitMix64 hash in 32-bit words. A
-// non-integer d uses GLSL's float pow (a few ulp from powf).
+// The terms are method_math.h's importanceDepth, importancePeriphery, importanceFresnel,
+// importanceNoiseTerm and importanceCombine, which mfr::computeImportance calls too. Bit for bit
+// the host's float arithmetic: every operation `precise` (no fused multiply-add); division and
+// square root in double rounded to float (the correctly rounded float result, as the host's:
+// method_math.h's exactDivide, exactSqrt); an integer power as a product in double rounded to
+// float (the host's powf, which glibc rounds correctly in all but rare cases: hostPow); xi the
+// same SplitMix64 hash (method_math.h's constants) in 32-bit words. A non-integer d uses GLSL's
+// float pow (a few ulp from powf).
 layout(local_size_x = kResolveGroupSize) in;
 
 layout(std430, binding = kBindAllocCounts) readonly buffer Counts {
@@ -32,16 +35,6 @@ uniform uvec2 uSeedMix;    // seed * 0x9E3779B97F4A7C15 + 0x632BE59BD9B4E019 (lo
 uniform uint uUse;         // bits: 1 depth, 2 periphery, 4 Fresnel, 8 noise
 uniform uint uCosine;      // kCosineNone, kCosineNearest or kCosineFloats
 
-float divide(float a, float b) {
-  return float(double(a) / double(b));
-}
-
-float powInt(float x, int e) {
-  precise double r = 1.0lf;
-  for (int i = 0; i < e; ++i) r *= double(x);
-  return float(r);
-}
-
 // 64-bit words as uvec2(lo, hi)
 uvec2 add64(uvec2 a, uvec2 b) {
   uint carry;
@@ -60,10 +53,10 @@ uvec2 shr64(uvec2 a, uint s) {  // 0 < s < 32
 // mfr::importanceNoise: SplitMix64's finaliser of (seed, pixel), 24 bits to [0, 1)
 float noiseXi(uint pixel) {
   uvec2 z = add64(uSeedMix, uvec2(pixel, 0u));
-  z = mul64(z ^ shr64(z, 30u), uvec2(0x1CE4E5B9u, 0xBF58476Du));
-  z = mul64(z ^ shr64(z, 27u), uvec2(0x133111EBu, 0x94D049BBu));
-  z ^= shr64(z, 31u);
-  return float(z.y >> 8u) * (1.0 / 16777216.0);
+  z = mul64(z ^ shr64(z, kSplitMixShift1), uvec2(kSplitMixMul1Lo, kSplitMixMul1Hi));
+  z = mul64(z ^ shr64(z, kSplitMixShift2), uvec2(kSplitMixMul2Lo, kSplitMixMul2Hi));
+  z ^= shr64(z, kSplitMixShift3);
+  return float(z.y >> (kSplitMixKeepShift - 32u)) * kImportanceNoiseUnit;
 }
 
 void main() {
@@ -76,30 +69,22 @@ void main() {
     for (uint i = 0u; i < kImportanceWords; ++i) importance[w + i] = 0.0;
     return;
   }
-  precise float id = 1.0;
-  if ((uUse & 1u) != 0u) id = uAlpha + uOneMinusAlpha * min(1.0, divide(float(n), uNLimit));
-  precise float iper = 1.0;
-  if ((uUse & 2u) != 0u) {
-    const uint x = p % uWidth, y = p / uWidth;
-    precise float dx = (float(x) + 0.5) - uFovea.x;
-    precise float dy = (float(y) + 0.5) - uFovea.y;
-    precise float length2 = dx * dx + dy * dy;
-    const float len = float(sqrt(double(length2)));
-    precise float base = divide(2.0 * len, uDiagonal);
-    iper = 1.0 - (uExponentInt >= 0 ? powInt(base, uExponentInt) : pow(base, uExponent));
-  }
-  float c = 1.0;
+  float id = 1.0f;
+  if ((uUse & 1u) != 0u) id = importanceDepth(uAlpha, uOneMinusAlpha, n, uNLimit);
+  float iper = 1.0f;
+  if ((uUse & 2u) != 0u)
+    iper = importancePeriphery(p % uWidth, p / uWidth, uFovea, uDiagonal, uExponent, uExponentInt);
+  float c = 1.0f;
   if (uCosine == kCosineNearest)
-    c = divide(float(cosine[p * kNearestWords + 2u]), 255.0);
+    c = exactDivide(float(cosine[p * kNearestWords + 2u]), 255.0f);  // the unorm8 code
   else if (uCosine == kCosineFloats)
     c = uintBitsToFloat(cosine[p]);
-  c = min(max(c, 0.0), 1.0);
-  precise float ifr = 1.0;
-  if ((uUse & 4u) != 0u) ifr = 1.0 - powInt(1.0 - c, 5) * 0.5;
-  precise float noise = 0.0;
-  if ((uUse & 8u) != 0u) noise = uNoise * (noiseXi(p) - 0.5);
-  precise float v = iper * id * ifr + noise;
-  importance[w] = v > 0.0 ? v : 0.0;  // std::max(0, v): NaN -> 0
+  c = min(max(c, 0.0f), 1.0f);
+  float ifr = 1.0f;
+  if ((uUse & 4u) != 0u) ifr = importanceFresnel(c);
+  float noise = 0.0f;
+  if ((uUse & 8u) != 0u) noise = importanceNoiseTerm(uNoise, noiseXi(p));
+  importance[w] = importanceCombine(iper, id, ifr, noise);  // std::max(0, v): NaN -> 0
   importance[w + 1u] = id;
   importance[w + 2u] = iper;
   importance[w + 3u] = ifr;

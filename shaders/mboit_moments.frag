@@ -6,9 +6,10 @@
 //
 // Bytes per pixel: 36 (moments and accumulators) + 4 (lock); no nodes.
 //
-// Moment-based OIT, pass 1 (Muenstermann et al. 2018; mfr::MboitPixel::addMoments): each fragment
-// adds its absorbance A = -ln(1 - min(a, 0.99999)) times 1, z, z^2, z^3, z^4 (z = 2 d - 1) to the
-// pixel's moments under the pixel's spin-lock. Sums in arrival order (see wboit.frag).
+// Moment-based OIT, pass 1 (Muenstermann et al. 2018; mfr::MboitPixel::addMoments, method_math.h's
+// mboitAbsorbance, mboitWarpDepth and mboitAddMoments): each fragment adds its absorbance
+// A = -ln(1 - min(a, kMboitMaxAlpha)) times 1, z, z^2, z^3, z^4 (z = 2 d - 1) to the pixel's
+// moments under the pixel's spin-lock. Sums in arrival order (see wboit.frag).
 layout(std430, binding = kBindAccum) coherent buffer Accum {
   float accum[];  // kMboitWords per pixel: b0, b1..b4, sum T a c (r, g, b), sum T a
 };
@@ -23,22 +24,15 @@ void main() {
   const uint rgba = shade(f, base);
   precise float alpha = float(rgba >> 24) / 255.0;
   if (alpha <= 0.0) return;
-  precise float A = -log(1.0 - min(alpha, 0.99999));
-  precise float z = 2.0 * clamp(depth, 0.0, 1.0) - 1.0;
-  precise float z2 = z * z;
-  precise float m1 = A * z;
-  precise float m2 = A * z2;
-  precise float m3 = A * z2 * z;
-  precise float m4 = A * z2 * z2;
+  const float A = mboitAbsorbance(alpha);
+  const float z = mboitWarpDepth(depth);
   const uint i = kMboitWords * uint(f.pixel);
   bool done = false;
   while (!done) {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
-      precise float s0 = accum[i] + A;
-      precise float s1 = accum[i + 1u] + m1;
-      precise float s2 = accum[i + 2u] + m2;
-      precise float s3 = accum[i + 3u] + m3;
-      precise float s4 = accum[i + 4u] + m4;
+      float s0 = accum[i], s1 = accum[i + 1u], s2 = accum[i + 2u], s3 = accum[i + 3u],
+            s4 = accum[i + 4u];
+      mboitAddMoments(s0, s1, s2, s3, s4, A, z);
       accum[i] = s0;
       accum[i + 1u] = s1;
       accum[i + 2u] = s2;

@@ -1,5 +1,5 @@
-// Moment-based OIT composite (mfr::MboitPixel::composite): T_total = exp(-b0),
-// (1 - T_total) * sum(T a c) / sum(T a) + T_total * background.
+// Moment-based OIT composite (mfr::MboitPixel::composite, method_math.h's mboitComposite):
+// T_total = exp(-b0), (1 - T_total) * sum(T a c) / sum(T a) + T_total * background.
 layout(local_size_x = kResolveGroupSize) in;
 
 layout(std430, binding = kBindAccum) readonly buffer Accum {
@@ -16,14 +16,8 @@ void main() {
   const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
   if (p >= uPixels) return;
   const uint i = kMboitWords * p;
-  const float b0 = accum[i], a = accum[i + 8u];
-  vec3 result = uBackground;
-  if (b0 > 0.0 && a > 0.0) {
-    const float total = exp(-b0);
-    precise vec3 mixed = (1.0 - total) * vec3(accum[i + 5u], accum[i + 6u], accum[i + 7u]) / a +
-                         total * uBackground;
-    result = mixed;
-  }
+  const vec3 result = mboitComposite(accum[i], vec3(accum[i + 5u], accum[i + 6u], accum[i + 7u]),
+                                     accum[i + 8u], uBackground);
   image[3u * p + 0u] = result.r;
   image[3u * p + 1u] = result.g;
   image[3u * p + 2u] = result.b;

@@ -34,14 +34,12 @@ void writeNode(uint at, float z, vec3 rgb, float t) {
   mlab[kMlabWords * at + 4u] = t;
 }
 
-// MlabNode::mergeBehind: the node at `at` gets (rgb, t) composited behind it
+// MlabNode::mergeBehind (method_math.h's mlabMergeBehind): the node at `at` gets (rgb, t)
+// composited behind it
 void mergeBehind(uint at, vec3 rgb, float t) {
   const uint w = kMlabWords * at;
-  const float T = mlab[w + 4u];
-  precise float r = mlab[w + 1u] + T * rgb.r;
-  precise float g = mlab[w + 2u] + T * rgb.g;
-  precise float b = mlab[w + 3u] + T * rgb.b;
-  precise float nextT = T * t;
+  float r = mlab[w + 1u], g = mlab[w + 2u], b = mlab[w + 3u], nextT = mlab[w + 4u];
+  mlabMergeBehind(r, g, b, nextT, rgb, t);
   mlab[w + 1u] = r;
   mlab[w + 2u] = g;
   mlab[w + 3u] = b;
@@ -59,8 +57,8 @@ void main() {
   precise float a = float(rgba >> 24) * uInv255;
   const vec3 c = vec3(srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
                       srgb8ToLinear((rgba >> 16) & 0xffu));
-  precise vec3 premultiplied = c * a;  // MlabNode::fromFragment
-  precise float transmittance = 1.0 - a;
+  const vec3 premultiplied = mlabPremultiplied(c, a);  // MlabNode::fromFragment
+  const float transmittance = mlabTransmittance(a);
   const uint p = uint(f.pixel);
   const uint first = p * uK;
   bool done = false;

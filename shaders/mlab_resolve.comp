@@ -1,5 +1,5 @@
-// Multi-layer alpha blending resolve (mfr::compositeMlab): the pixel's sorted nodes front to back
-// over the background.
+// Multi-layer alpha blending resolve (mfr::compositeMlab: method_math.h's mlabCompositeStep and
+// overBackground): the pixel's sorted nodes front to back over the background.
 layout(local_size_x = kResolveGroupSize) in;
 
 layout(std430, binding = kBindNodes) readonly buffer MlabNodes {
@@ -19,16 +19,13 @@ void main() {
   const uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
   const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
   if (p >= uPixels) return;
-  vec3 color = vec3(0.0);
-  float T = 1.0;
+  vec3 color = vec3(0.0f);
+  float T = 1.0f;
   for (uint i = 0u; i < fill[p]; ++i) {
     const uint w = kMlabWords * (p * uK + i);
-    precise vec3 sum = color + T * vec3(mlab[w + 1u], mlab[w + 2u], mlab[w + 3u]);
-    color = sum;
-    precise float nextT = T * mlab[w + 4u];
-    T = nextT;
+    mlabCompositeStep(color, T, vec3(mlab[w + 1u], mlab[w + 2u], mlab[w + 3u]), mlab[w + 4u]);
   }
-  precise vec3 result = color + T * uBackground;
+  const vec3 result = overBackground(color, T, uBackground);
   image[3u * p + 0u] = result.r;
   image[3u * p + 1u] = result.g;
   image[3u * p + 2u] = result.b;

@@ -15,7 +15,7 @@ in VertexData {
 } vIn[];
 
 uniform ivec2 uSize;
-uniform double uMaxNdc;  // the CPU engine's guard band clamp, kGuardBand * 1.001
+uniform double uMaxNdc;  // the CPU engine's guard band clamp (method_math.h's kGuardBandMaxNdc)
 
 layout(std430, binding = kBindTriMaterial) readonly buffer TriMaterial {
   uint triMaterial[];
@@ -34,7 +34,7 @@ flat out float gInvArea;
 flat out uint gTopLeft;
 flat out uint gMaterial;
 
-const float kGuardBand = 8.0;
+// kGuardBand: method_math.h (the CPU set-up's)
 
 float planeDistance(vec4 c, int plane) {
   precise float d;

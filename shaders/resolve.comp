@@ -11,7 +11,8 @@
 // count works),
 // writes them back sorted, and composites them front to back in linear RGB over the
 // background with the CPU engine's kbuffer rule (mfr::compositeKBuffer), operation for operation,
-// or its hybrid rule (mfr::compositeHybrid) with the pixel's tail.
+// or its hybrid rule (mfr::compositeHybrid) with the pixel's tail: method_math.h's overStep,
+// hybridBehind and overBackground, the functions the CPU engine calls.
 layout(local_size_x = kResolveGroupSize) in;
 
 layout(std430, binding = kBindCounts) readonly buffer Counts {
@@ -108,36 +109,22 @@ void main() {
       siftDown(first, 0u, end);
     }
   }
-  vec3 color = vec3(0.0);
-  float T = 1.0;
+  float r = 0.0f, g = 0.0f, b = 0.0f, T = 1.0f;
   for (uint i = 0u; i < n; ++i) {
     const uint rgba = nodes[first + i].y;
     precise float a = float(rgba >> 24) * uInv255;
-    const vec3 c = vec3(srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
-                        srgb8ToLinear((rgba >> 16) & 0xffu));
-    precise float w = a * T;
-    precise vec3 sum = color + c * w;
-    color = sum;
-    precise float nextT = T * (1.0 - a);
-    T = nextT;
+    overStep(r, g, b, T, a, srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
+             srgb8ToLinear((rgba >> 16) & 0xffu));
   }
   vec3 behind = uBackground;
   if (uHybrid != 0u) {
     const uint t = kTailWords * p;
-    const float tailAlphaSum = uintBitsToFloat(tails[t + 3u]);
-    const uint tailCount = tails[t + 4u];
-    if (tailCount != 0u && tailAlphaSum > 0.0) {
-      const vec3 sum = vec3(uintBitsToFloat(tails[t]), uintBitsToFloat(tails[t + 1u]),
-                            uintBitsToFloat(tails[t + 2u]));
-      precise vec3 tailColor = sum / tailAlphaSum;
-      precise float avgAlpha = tailAlphaSum / float(tailCount);
-      // GLSL pow is exp2(y log2 x), not std::pow: last bits differ from the CPU engine
-      precise float tailAlpha = 1.0 - pow(max(0.0, 1.0 - avgAlpha), float(tailCount));
-      precise vec3 mixed = tailAlpha * tailColor + (1.0 - tailAlpha) * uBackground;
-      behind = mixed;
-    }
+    const vec3 sum = vec3(uintBitsToFloat(tails[t]), uintBitsToFloat(tails[t + 1u]),
+                          uintBitsToFloat(tails[t + 2u]));
+    // (GLSL pow is exp2(y log2 x), not std::pow: last bits differ from the CPU engine)
+    behind = hybridBehind(sum, uintBitsToFloat(tails[t + 3u]), tails[t + 4u], uBackground);
   }
-  precise vec3 result = color + T * behind;
+  const vec3 result = overBackground(vec3(r, g, b), T, behind);
   image[3u * p + 0u] = result.r;
   image[3u * p + 1u] = result.g;
   image[3u * p + 2u] = result.b;

@@ -28,22 +28,14 @@ void main() {
   if (a <= 0.0) return;
   const vec3 c = vec3(srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
                       srgb8ToLinear((rgba >> 16) & 0xffu));
-  precise float t = 1.0 - clamp(depth, 0.0, 1.0);
-  precise float w = a * max(1e-2, 3e3 * t * t * t);  // mfr::wboitWeight
-  precise float cr = c.r * a * w;
-  precise float cg = c.g * a * w;
-  precise float cb = c.b * a * w;
-  precise float aw = a * w;
-  precise float keep = 1.0 - a;
+  const float w = wboitWeight(depth, a);  // method_math.h, as mfr::WboitPixel::add
   const uint i = kWboitWords * uint(f.pixel);
   bool done = false;
   while (!done) {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
-      precise float r = accum[i] + cr;
-      precise float g = accum[i + 1u] + cg;
-      precise float b = accum[i + 2u] + cb;
-      precise float sumA = accum[i + 3u] + aw;
-      precise float revealage = accum[i + 4u] * keep;
+      float r = accum[i], g = accum[i + 1u], b = accum[i + 2u], sumA = accum[i + 3u],
+            revealage = accum[i + 4u];
+      wboitAccumulate(r, g, b, sumA, revealage, c, a, w);
       accum[i] = r;
       accum[i + 1u] = g;
       accum[i + 2u] = b;

@@ -11,6 +11,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "mfr/method/method_math.h"
+
 namespace mfr {
 
 Result<void> checkThreads(int threads, const std::string& name) {
@@ -52,8 +54,9 @@ ClipVertex lerp(const ClipVertex& a, const ClipVertex& b, float t) {
   return {glm::mix(a.clip, b.clip, t), glm::mix(a.normal, b.normal, t), glm::mix(a.uv, b.uv, t)};
 }
 
-// x/y guard band in NDC units: keeps fixed-point window coordinates below 2^25 at 16384 pixels.
-constexpr float kGuardBand = 8.0f;
+// x/y guard band in NDC units: keeps fixed-point window coordinates below 2^25 at 16384 pixels
+// (method_math.h, shared with shaders/raster.geom).
+using method_math::kGuardBand;
 
 // Signed distances to the six clip planes (inside >= 0).
 inline float planeDistance(const glm::vec4& c, int plane) {
@@ -103,7 +106,7 @@ bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVert
   // Clipping leaves |x/w|, |y/w| <= kGuardBand up to float rounding; under extreme projections
   // (a field of view of 1e-20 degrees, coordinates near the float range) that rounding is large
   // or NaN. Clamping to the guard band keeps the fixed-point set-up below in range.
-  constexpr double kMaxNdc = kGuardBand * 1.001;
+  constexpr double kMaxNdc = method_math::kGuardBandMaxNdc;
   double sx[3], sy[3];
   for (int i = 0; i < 3; ++i) {
     const glm::vec4& c = v[i]->clip;

@@ -18,6 +18,7 @@
 #include "mfr/core/color.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/gl/shared_layout.h"
+#include "mfr/method/method_math.h"
 
 namespace mfr::gl {
 
@@ -39,9 +40,9 @@ uint64_t GlRenderOutput::totalBufferBytes() const {
 
 namespace {
 
-// Guard band clamp of the CPU set-up, a copy of setupTriangle's kMaxNdc in src/cpu/raster_frame.cpp
-// (kGuardBand = 8, times 1.001); raster.geom clamps to it as the uniform uMaxNdc.
-constexpr double kMaxNdc = 8.0f * 1.001;
+// Guard band clamp of the CPU set-up (method_math.h, as setupTriangle in src/cpu/raster_frame.cpp);
+// raster.geom clamps to it as the uniform uMaxNdc.
+constexpr double kMaxNdc = method_math::kGuardBandMaxNdc;
 
 }  // namespace
 

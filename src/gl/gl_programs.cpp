@@ -45,6 +45,8 @@ std::string composeSource(const std::string& file, const char* raster, const std
   s += prelude;
   s += embeddedShader("shared_layout.h");
   s += "\n";
+  s += embeddedShader("method_math.h");  // the methods' maths, shared with the CPU engine
+  s += "\n";
   if (raster) {
     s += embeddedShader(raster);
     s += "\n";

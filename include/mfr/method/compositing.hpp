@@ -10,6 +10,8 @@
 //   final = C_core + (1 - alpha_core) * (alpha_tail * C_tail + (1 - alpha_tail) * background).
 // The tail colour is weighted by the tail's opacity alpha_tail (the public DHOIT shader forgets
 // this factor). With an empty tail the result is bit-identical to the kbuffer rule.
+// The steps are method_math.h's (overStep, hybridTailAdd, hybridBehind), which the GL engine's
+// shaders run too.
 #pragma once
 
 #include <algorithm>
@@ -20,6 +22,7 @@
 
 #include "mfr/core/color.hpp"
 #include "mfr/method/fragment_node.hpp"
+#include "mfr/method/method_math.h"
 
 namespace mfr {
 
@@ -31,11 +34,7 @@ struct HybridTail {
 
   void add(uint32_t rgba) {
     const glm::vec4 c = unpackFragmentColor(rgba);
-    r += c.a * c.r;
-    g += c.a * c.g;
-    b += c.a * c.b;
-    alpha += c.a;
-    ++count;
+    method_math::hybridTailAdd(r, g, b, alpha, count, c.a, c.r, c.g, c.b);
   }
 };
 static_assert(sizeof(HybridTail) == 20);
@@ -49,11 +48,9 @@ inline glm::vec3 compositeCore(const FragmentNode* sorted, uint32_t n, float& tr
   for (uint32_t i = 0; i < n; ++i) {
     const uint32_t rgba = nodeColor(sorted[i]);
     const float a = static_cast<float>(rgba >> 24) * (1.0f / 255.0f);
-    const float w = a * T;
-    r += t.srgb8ToLinear[rgba & 0xffu] * w;
-    g += t.srgb8ToLinear[(rgba >> 8) & 0xffu] * w;
-    b += t.srgb8ToLinear[(rgba >> 16) & 0xffu] * w;
-    T *= 1.0f - a;
+    method_math::overStep(r, g, b, T, a, t.srgb8ToLinear[rgba & 0xffu],
+                          t.srgb8ToLinear[(rgba >> 8) & 0xffu],
+                          t.srgb8ToLinear[(rgba >> 16) & 0xffu]);
   }
   transmittance = T;
   return {r, g, b};
@@ -62,19 +59,16 @@ inline glm::vec3 compositeCore(const FragmentNode* sorted, uint32_t n, float& tr
 inline glm::vec3 compositeKBuffer(const FragmentNode* sorted, uint32_t n, glm::vec3 background) {
   float T;
   const glm::vec3 core = compositeCore(sorted, n, T);
-  return core + T * background;
+  return method_math::overBackground(core, T, background);
 }
 
 inline glm::vec3 compositeHybrid(const FragmentNode* sorted, uint32_t n, const HybridTail& tail,
                                  glm::vec3 background) {
   float T;
   const glm::vec3 core = compositeCore(sorted, n, T);
-  if (tail.count == 0 || tail.alpha <= 0.0f) return core + T * background;
-  const glm::vec3 tailColor = glm::vec3(tail.r, tail.g, tail.b) / tail.alpha;
-  const float avgAlpha = tail.alpha / static_cast<float>(tail.count);
-  const float tailAlpha =
-      1.0f - std::pow(std::max(0.0f, 1.0f - avgAlpha), static_cast<float>(tail.count));
-  return core + T * (tailAlpha * tailColor + (1.0f - tailAlpha) * background);
+  return method_math::overBackground(core, T,
+                                     method_math::hybridBehind(glm::vec3(tail.r, tail.g, tail.b),
+                                                               tail.alpha, tail.count, background));
 }
 
 }  // namespace mfr

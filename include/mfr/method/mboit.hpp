@@ -22,75 +22,30 @@
 // pass 2: 36 B, float32 (the paper's 16-bit quantised variant is not implemented).
 #pragma once
 
-#include <algorithm>
 #include <array>
-#include <cmath>
 #include <cstdint>
 
 #include <glm/glm.hpp>
 
 #include "mfr/core/color.hpp"
 #include "mfr/method/method.hpp"
+#include "mfr/method/method_math.h"
 
 namespace mfr {
 
-inline constexpr float kMboitBias = 5e-7f;            // 4 power moments, float32
-inline constexpr float kMboitOverestimation = 0.25f;  // towards the upper absorbance bound
-inline constexpr float kMboitMaxAlpha = 0.99999f;     // keeps -ln(1 - a) finite
-
-inline float mboitWarpDepth(float depth) {
-  return 2.0f * std::clamp(depth, 0.0f, 1.0f) - 1.0f;
-}
-
-inline float mboitAbsorbance(float alpha) {
-  return -std::log(1.0f - std::min(alpha, kMboitMaxAlpha));
-}
+// the constants and the reconstruction are method_math.h's (also mboit_*.frag, mboit_resolve.comp)
+using method_math::kMboitBias;
+using method_math::kMboitMaxAlpha;
+using method_math::kMboitOverestimation;
+using method_math::mboitAbsorbance;
+using method_math::mboitWarpDepth;
 
 /// Transmittance in front of `z` (warped depth) from b_0 and the moments b_1..b_4 (not
 /// normalised), with the given bias and overestimation.
 inline float mboitTransmittance(float b0, const float* moments, float z, float bias = kMboitBias,
                                 float overestimation = kMboitOverestimation) {
-  if (b0 <= 0.0f) return 1.0f;
-  // normalise and bias (double for the solve; the moments are stored as float32)
-  const double beta = bias;
-  const double v[4] = {0.0, 0.375, 0.0, 0.375};
-  double b[4];
-  for (int j = 0; j < 4; ++j)
-    b[j] = (1.0 - beta) * (moments[j] / static_cast<double>(b0)) + beta * v[j];
-  // LDL^T of the Hankel matrix [[1, b1, b2], [b1, b2, b3], [b2, b3, b4]]
-  const double d1 = b[1] - b[0] * b[0];
-  const double l21 = (b[2] - b[0] * b[1]) / d1;
-  const double d2 = b[3] - b[1] * b[1] - l21 * l21 * d1;
-  // solve B c = (1, z, z^2)
-  const double z0 = z;
-  double c1 = z0 - b[0];
-  double c2 = z0 * z0 - b[1] - l21 * c1;
-  c1 /= d1;
-  c2 /= d2;
-  c1 -= l21 * c2;
-  const double c0 = 1.0 - b[0] * c1 - b[1] * c2;
-  // the roots of c0 + c1 x + c2 x^2
-  const double p = c1 / c2, q = c0 / c2;
-  const double r = std::sqrt(std::max(0.0, 0.25 * p * p - q));
-  double z1 = -0.5 * p - r, z2 = -0.5 * p + r;
-  // the quadratic through (z0, f0), (z1, f1), (z2, f2), by divided differences; its expectation
-  // under the moments is the normalised absorbance in front of z0
-  const double f0 = overestimation, f1 = z1 < z0 ? 1.0 : 0.0, f2 = z2 < z0 ? 1.0 : 0.0;
-  constexpr double kTiny = 1e-12;
-  if (std::fabs(z1 - z0) < kTiny) z1 = z0 - kTiny;
-  if (std::fabs(z2 - z0) < kTiny) z2 = z0 + kTiny;
-  if (std::fabs(z2 - z1) < kTiny) z2 = z1 + kTiny;
-  const double f01 = (f1 - f0) / (z1 - z0);
-  const double f12 = (f2 - f1) / (z2 - z1);
-  const double f012 = (f12 - f01) / (z2 - z0);
-  // P(x) = f0 + f01 (x - z0) + f012 (x - z0)(x - z1)
-  const double p2 = f012;
-  const double p1 = f01 - f012 * (z0 + z1);
-  const double p0 = f0 - f01 * z0 + f012 * z0 * z1;
-  const double absorbance = p0 + p1 * b[0] + p2 * b[1];
-  const double t = std::exp(-static_cast<double>(b0) * absorbance);
-  if (!std::isfinite(t)) return 1.0f;
-  return static_cast<float>(std::clamp(t, 0.0, 1.0));
+  return method_math::mboitTransmittance(b0, moments[0], moments[1], moments[2], moments[3], z,
+                                         bias, overestimation);
 }
 
 /// One pixel's buffers: 36 bytes.
@@ -101,31 +56,20 @@ struct MboitPixel {
 
   void addMoments(float depth, float alpha) {
     if (alpha <= 0.0f) return;
-    const float A = mboitAbsorbance(alpha);
-    const float z = mboitWarpDepth(depth), z2 = z * z;
-    b0 += A;
-    moments[0] += A * z;
-    moments[1] += A * z2;
-    moments[2] += A * z2 * z;
-    moments[3] += A * z2 * z2;
+    method_math::mboitAddMoments(b0, moments[0], moments[1], moments[2], moments[3],
+                                 mboitAbsorbance(alpha), mboitWarpDepth(depth));
   }
   float transmittanceAt(float depth) const {
     return mboitTransmittance(b0, moments, mboitWarpDepth(depth));
   }
   void addColor(float depth, glm::vec4 c) {
     if (c.a <= 0.0f) return;
-    const float ta = transmittanceAt(depth) * c.a;
-    r += ta * c.r;
-    g += ta * c.g;
-    b += ta * c.b;
-    a += ta;
+    method_math::mboitAddColor(r, g, b, a, glm::vec3(c), transmittanceAt(depth) * c.a);
   }
   void addColor(float depth, uint32_t rgba) { addColor(depth, unpackFragmentColor(rgba)); }
 
   glm::vec3 composite(glm::vec3 background) const {
-    if (b0 <= 0.0f || a <= 0.0f) return background;
-    const float total = std::exp(-b0);
-    return (1.0f - total) * glm::vec3(r, g, b) / a + total * background;
+    return method_math::mboitComposite(b0, glm::vec3(r, g, b), a, background);
   }
 };
 static_assert(sizeof(MboitPixel) == 36);

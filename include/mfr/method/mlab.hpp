@@ -6,6 +6,7 @@
 // A fragment (z, a, c) becomes the node (z, a c, 1 - a) and is inserted in depth order (after
 // nodes of equal depth); when that makes k + 1 nodes, the two farthest are merged by "over":
 //   merged.rgb = near.rgb + near.T * far.rgb,  merged.T = near.T * far.T,  merged.z = near.z.
+// (method_math.h's mlabMergeBehind, shared with shaders/mlab.frag)
 // The resolve composites the nodes front to back over the background:
 //   C = sum_i rgb_i prod_{j<i} T_j + prod_j T_j * background.
 // Nothing is merged while a pixel has at most k fragments, so MLAB with k >= n(p) is the A-buffer
@@ -22,6 +23,7 @@
 
 #include "mfr/core/color.hpp"
 #include "mfr/method/method.hpp"
+#include "mfr/method/method_math.h"
 
 namespace mfr {
 
@@ -31,17 +33,17 @@ struct MlabNode {
   float transmittance = 1.0f;
 
   static MlabNode fromFragment(float depth, glm::vec4 c) {
-    return {depth, c.r * c.a, c.g * c.a, c.b * c.a, 1.0f - c.a};
+    const glm::vec3 premultiplied = method_math::mlabPremultiplied(glm::vec3(c), c.a);
+    return {depth, premultiplied.r, premultiplied.g, premultiplied.b,
+            method_math::mlabTransmittance(c.a)};
   }
   static MlabNode fromFragment(float depth, uint32_t rgba) {
     return fromFragment(depth, unpackFragmentColor(rgba));
   }
   /// `far` composited behind this node.
   void mergeBehind(const MlabNode& far) {
-    r += transmittance * far.r;
-    g += transmittance * far.g;
-    b += transmittance * far.b;
-    transmittance *= far.transmittance;
+    method_math::mlabMergeBehind(r, g, b, transmittance, glm::vec3(far.r, far.g, far.b),
+                                 far.transmittance);
   }
 };
 static_assert(sizeof(MlabNode) == 20);
@@ -73,11 +75,10 @@ inline bool mlabInsert(MlabNode* nodes, uint32_t& count, uint32_t k, const MlabN
 inline glm::vec3 compositeMlab(const MlabNode* nodes, uint32_t count, glm::vec3 background) {
   glm::vec3 color(0.0f);
   float T = 1.0f;
-  for (uint32_t i = 0; i < count; ++i) {
-    color += T * glm::vec3(nodes[i].r, nodes[i].g, nodes[i].b);
-    T *= nodes[i].transmittance;
-  }
-  return color + T * background;
+  for (uint32_t i = 0; i < count; ++i)
+    method_math::mlabCompositeStep(color, T, glm::vec3(nodes[i].r, nodes[i].g, nodes[i].b),
+                                   nodes[i].transmittance);
+  return method_math::overBackground(color, T, background);
 }
 
 /// mlab as a peer method (peer_method.hpp): k(p) blended nodes of 20 bytes at the fixed-k

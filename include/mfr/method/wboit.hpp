@@ -17,7 +17,6 @@
 // in the last bits (relative 1e-6 per fragment, see docs/METHODS.md).
 #pragma once
 
-#include <algorithm>
 #include <array>
 #include <cstdint>
 
@@ -25,17 +24,17 @@
 
 #include "mfr/core/color.hpp"
 #include "mfr/method/method.hpp"
+#include "mfr/method/method_math.h"
 
 namespace mfr {
 
-inline constexpr float kWboitMinWeight = 1e-2f;
-inline constexpr float kWboitMaxWeight = 3e3f;
-
-/// The paper's Eq. 10: w(z, alpha) = alpha * max(1e-2, 3e3 (1 - d)^3), d window-space depth.
-inline float wboitWeight(float depth, float alpha) {
-  const float t = 1.0f - std::clamp(depth, 0.0f, 1.0f);
-  return alpha * std::max(kWboitMinWeight, kWboitMaxWeight * t * t * t);
-}
+// the weight, its clamps and the composite are method_math.h's (also wboit.frag,
+// wboit_resolve.comp)
+using method_math::kWboitMaxDenominator;
+using method_math::kWboitMaxWeight;
+using method_math::kWboitMinDenominator;
+using method_math::kWboitMinWeight;
+using method_math::wboitWeight;
 
 /// One pixel's accumulators: 20 bytes.
 struct WboitPixel {
@@ -45,19 +44,12 @@ struct WboitPixel {
 
   void add(float depth, glm::vec4 c) {  // c: linear colour, alpha
     if (c.a <= 0.0f) return;
-    const float w = wboitWeight(depth, c.a);
-    r += c.r * c.a * w;
-    g += c.g * c.a * w;
-    b += c.b * c.a * w;
-    a += c.a * w;
-    revealage *= 1.0f - c.a;
+    method_math::wboitAccumulate(r, g, b, a, revealage, glm::vec3(c), c.a, wboitWeight(depth, c.a));
   }
   void add(float depth, uint32_t rgba) { add(depth, unpackFragmentColor(rgba)); }
 
   glm::vec3 composite(glm::vec3 background) const {
-    if (a <= 0.0f) return background;
-    const glm::vec3 average = glm::vec3(r, g, b) / std::clamp(a, 1e-4f, 5e4f);
-    return average * (1.0f - revealage) + revealage * background;
+    return method_math::wboitComposite(glm::vec3(r, g, b), a, revealage, background);
   }
 };
 static_assert(sizeof(WboitPixel) == 20);
