@@ -11,6 +11,7 @@
 #include "gl/gl_state.hpp"
 #include "mfr/gl/gl_engine.hpp"
 #include "mfr/gl/shared_layout.h"
+#include "mfr/method/method_math.h"
 
 namespace mfr::gl {
 
@@ -266,10 +267,12 @@ Result<GlAllocationTotals> GlEngine::allocateByImportance(const ImportanceParams
   const float width = static_cast<float>(s.width), height = static_cast<float>(s.height);
   // the host's constants of mfr::computeImportance, rounded as there
   const glm::vec2 fovea = params.fovea.value_or(glm::vec2(s.width * 0.5f, s.height * 0.5f));
-  const float diagonal = 1.1f * std::sqrt(width * width + height * height);
+  const float diagonal = method_math::importanceDiagonal(width, height);
   const float d = params.peripheryExponent;
   const int dInt = d >= 0.0f && d <= 64.0f && std::floor(d) == d ? static_cast<int>(d) : -1;
-  const uint64_t seedMix = params.seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull;
+  namespace mm = method_math;
+  const uint64_t seedMix = params.seed * mm::words64(mm::kSplitMixGammaLo, mm::kSplitMixGammaHi) +
+                           mm::words64(mm::kSplitMixOffsetLo, mm::kSplitMixOffsetHi);
   glProgramUniform1ui(p, loc(p, "uPixels"), pixels);
   glProgramUniform1ui(p, loc(p, "uWidth"), static_cast<GLuint>(s.width));
   glProgramUniform1f(p, loc(p, "uAlpha"), params.alpha);

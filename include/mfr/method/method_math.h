@@ -1,7 +1,7 @@
 // The methods' per-pixel maths, written once for both engines: this file is C++20 (glm) and GLSL
 // 4.50 at the same time. The CPU engine includes it (namespace mfr::method_math, re-exported by
 // compositing.hpp, wboit.hpp, mboit.hpp, mlab.hpp and importance.hpp); the shader embedding step
-// prepends it to every shader after shared_layout.h (src/gl/gl_engine.cpp, composeSource). Every
+// prepends it to every shader after shared_layout.h (src/gl/gl_programs.cpp, composeSource). Every
 // numeric constant of a method lives here; GlShaders.MethodConstantsOnlyInMethodMath checks that
 // no shader repeats one.
 //
