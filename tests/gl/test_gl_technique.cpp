@@ -25,15 +25,22 @@ GlTechnique expectedTechnique(const std::string& preset) {
 }
 
 TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
-  int presets = 0;
+  int presets = 0, occupancyForms = 0;
   for (const std::string& name : presetNames()) {
     const MethodDesc method = methodPreset(name).value();
     auto t = classifyGl(method);
     ASSERT_TRUE(t.ok()) << name << ": " << t.error().message;
     EXPECT_EQ(*t, expectedTechnique(name)) << name << " runs as " << toString(*t);
     ++presets;
+    auto culled = methodPreset(name + "+occupancy");  // the k-buffer family's occupancy form
+    if (!culled) continue;
+    auto tc = classifyGl(culled.value());
+    ASSERT_TRUE(tc.ok()) << name << "+occupancy: " << tc.error().message;
+    EXPECT_EQ(*tc, GlTechnique::KBuffer) << name << "+occupancy";
+    ++occupancyForms;
   }
-  EXPECT_GE(presets, 30);  // 17 presets and 13 +occupancy forms
+  EXPECT_EQ(presets, 17);
+  EXPECT_EQ(occupancyForms, 13);
 }
 
 TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
