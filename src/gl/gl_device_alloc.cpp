@@ -245,19 +245,8 @@ Result<GlAllocationTotals> GlEngine::allocateByImportance(const ImportanceParams
   // is given)
   static_assert(kNearestWords == 3);
   s.deviceNearest = s.device->make("nearest", uint64_t{pixels} * kNearestWords * 4);
-  const uint32_t init[3] = {kFarDepthBits, 0u, 0u};
-  glClearNamedBufferData(s.deviceNearest, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
-  const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
   if (s.device->failure) return *s.device->failure;
-  if (fb.failure) return *fb.failure;
-  clearUint(locks, kLockFree);
-  timedPass(passes, "nearest_normal", [&] {
-    glUseProgram(s.program(ProgramId::NearestCosine));
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNearest, s.deviceNearest);
-    fb.bindImage(locks, kBindLocks);
-    s.drawScene();
-    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
-  });
+  MFR_TRY(s.nearestPass(fb, s.deviceNearest, passes));
   const bool previous = previousCosine.size() == pixels;
   const GLuint cosine = previous
                             ? fb.make("previous |n.v|", uint64_t{pixels} * 4, previousCosine.data())
@@ -372,12 +361,35 @@ Result<ImportanceMaps> GlEngine::readImportance() {
 Result<std::vector<float>> GlEngine::readNearestCosine() {
   State& s = *state_;
   if (!s.device || !s.deviceNearest) return makeError("--engine gl: no nearest pass on the device");
-  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
-  std::vector<uint32_t> words(pixels * kNearestWords);
-  glGetNamedBufferSubData(s.deviceNearest, 0, static_cast<GLsizeiptr>(words.size() * 4),
-                          words.data());
-  std::vector<float> cosine(pixels);
-  for (uint64_t p = 0; p < pixels; ++p)
+  return s.readCosine(s.deviceNearest);
+}
+
+Result<void> GlEngine::State::nearestPass(FrameBuffers& fb, GLuint nearest,
+                                          std::vector<GlPassTime>* passes) const {
+  static_assert(kNearestWords == 3);
+  const uint32_t init[3] = {kFarDepthBits, 0u, 0u};
+  glClearNamedBufferData(nearest, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
+  const GLuint locks = fb.make("locks", uint64_t{pixels()} * 4);
+  if (fb.failure) return *fb.failure;
+  clearUint(locks, kLockFree);
+  timedPass(passes, "nearest_normal", [&] {
+    glUseProgram(program(ProgramId::NearestCosine));
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNearest, nearest);
+    fb.bindImage(locks, kBindLocks);
+    drawScene();
+    glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+  });
+  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
+    return makeError("--engine gl: the nearest |n.v| pass failed (GL error " + glErrorText(e) +
+                     ")");
+  return {};
+}
+
+std::vector<float> GlEngine::State::readCosine(GLuint nearest) const {
+  std::vector<uint32_t> words(uint64_t{pixels()} * kNearestWords);
+  glGetNamedBufferSubData(nearest, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
+  std::vector<float> cosine(pixels());
+  for (uint64_t p = 0; p < pixels(); ++p)
     cosine[p] = static_cast<float>(words[p * kNearestWords + 2]) / 255.0f;
   return cosine;
 }

@@ -316,30 +316,12 @@ Result<std::vector<uint32_t>> GlEngine::count() {
 
 Result<std::vector<float>> GlEngine::nearestCosine() {
   State& s = *state_;
-  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
   std::map<std::string, uint64_t> ledger;
   FrameBuffers fb(&ledger);
-  const GLuint nearest = fb.make("nearest", pixels * kNearestWords * 4);
-  static_assert(kNearestWords == 3);
-  const uint32_t init[3] = {kFarDepthBits, 0u, 0u};
-  glClearNamedBufferData(nearest, GL_RGB32UI, GL_RGB_INTEGER, GL_UNSIGNED_INT, init);
-  const GLuint locks = fb.make("locks", pixels * 4);
+  const GLuint nearest = fb.make("nearest", uint64_t{s.pixels()} * kNearestWords * 4);
   if (fb.failure) return *fb.failure;
-  clearUint(locks, kLockFree);
-  glUseProgram(s.program(ProgramId::NearestCosine));
-  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNearest, nearest);
-  fb.bindImage(locks, kBindLocks);
-  s.drawScene();
-  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_STORAGE_BARRIER_BIT);
-  std::vector<uint32_t> words(pixels * kNearestWords);
-  glGetNamedBufferSubData(nearest, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
-  if (const GLenum e = glGetError(); e != GL_NO_ERROR)
-    return makeError("--engine gl: the nearest |n.v| pass failed (GL error " + std::to_string(e) +
-                     ")");
-  std::vector<float> cosine(pixels);
-  for (uint64_t p = 0; p < pixels; ++p)
-    cosine[p] = static_cast<float>(words[p * kNearestWords + 2]) / 255.0f;
-  return cosine;
+  MFR_TRY(s.nearestPass(fb, nearest, nullptr));
+  return s.readCosine(nearest);
 }
 
 }  // namespace mfr::gl

@@ -90,6 +90,11 @@ struct GlEngine::State {
   struct FrameRun;
 
   // --- the device-side allocation (gl_device_alloc.cpp) ---
+  /// the nearest fragment's unorm8 |n.v| per pixel into `nearest` (kNearestWords per pixel,
+  /// cleared here), under the pixel's spin-lock
+  Result<void> nearestPass(FrameBuffers& fb, GLuint nearest, std::vector<GlPassTime>* passes) const;
+  /// the |n.v| of a nearest pass's buffer, as floats (unorm8 / 255, mfr::nearestCosine)
+  std::vector<float> readCosine(GLuint nearest) const;
   /// exclusive prefix sum of `count` uints of `in` into `out`
   void scan(FrameBuffers& fb, GLuint in, GLuint out, uint32_t count) const;
   /// k(p) by alloc_k.comp (the uniforms set by the caller; `totals` cleared), then the prefix
