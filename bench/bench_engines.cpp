@@ -256,17 +256,14 @@ int main(int argc, char** argv) {
       const Measured& m = results[e];
       const std::string name = names[e];
       frames[e].push_back(m.error ? NAN : median(m.frame));
+      // scene, engine, renderer, pass_timer, width, height, threads, reps
+      std::vector<std::string> cells = {sc.label, name, e ? renderer : "cpu", toString(m.timer)};
+      cells.insert(cells.end(),
+                   {std::to_string(args.size), std::to_string(args.size),
+                    std::to_string(resolveThreads(args.threads)), std::to_string(args.reps)});
       if (m.error) {
         failed = true;
         printError(kProgram, sc.label + " on " + name + ": " + *m.error);
-        std::vector<std::string> cells = {sc.label,
-                                          name,
-                                          e ? renderer : "",
-                                          toString(m.timer),
-                                          std::to_string(args.size),
-                                          std::to_string(args.size),
-                                          std::to_string(resolveThreads(args.threads)),
-                                          std::to_string(args.reps)};
         cells.resize(19);  // no figures
         cells.push_back(*m.error);
         csv.row(cells);
@@ -290,20 +287,11 @@ int main(int argc, char** argv) {
                  fixed(pass("prefix sum"), 1), fixed(pass("capture"), 1), fixed(pass("resolve"), 1),
                  fixed(other, 1), fixed(frame, 1), fixed(mfragPerS(fragments, frame), 1), overCpu,
                  overAnchor, bothOk ? fixed(diff, 6) : "-"});
-      std::vector<std::string> cells = {sc.label,
-                                        name,
-                                        e ? renderer : "cpu",
-                                        toString(m.timer),
-                                        std::to_string(args.size),
-                                        std::to_string(args.size),
-                                        std::to_string(resolveThreads(args.threads)),
-                                        std::to_string(args.reps),
-                                        std::to_string(fragments)};
-      cells.insert(cells.end(),
-                   {fixed(pass("count"), 3), fixed(pass("prefix sum"), 3),
-                    fixed(pass("capture"), 3), fixed(pass("resolve"), 3), fixed(other, 3),
-                    fixed(frame, 3), fixed(mfragPerS(fragments, frame), 3), overCpu, overAnchor,
-                    bothOk ? fixed(diff, 8) : "", ""});
+      cells.insert(cells.end(), {std::to_string(fragments), fixed(pass("count"), 3),
+                                 fixed(pass("prefix sum"), 3), fixed(pass("capture"), 3),
+                                 fixed(pass("resolve"), 3), fixed(other, 3), fixed(frame, 3),
+                                 fixed(mfragPerS(fragments, frame), 3), overCpu, overAnchor,
+                                 bothOk ? fixed(diff, 8) : "", ""});
       csv.row(cells);
     }
   }
