@@ -69,3 +69,18 @@ if(MFR_BUILD_BENCH)
     add_dependencies(bench_engines gl_kbuffer_anchor)
   endif()
 endif()
+
+# gpu_check: every preset on GL native against the CPU engine, one CSV (bench/gpu_check.cpp); what
+# scripts/gpu-check.sh runs on a machine with a GPU. Built with the GL engine, benchmarks or not.
+add_executable(gpu_check bench/gpu_check.cpp)
+target_compile_options(gpu_check PRIVATE ${MFR_WARNINGS})
+target_compile_definitions(gpu_check PRIVATE MFR_SCENES_DIR="${MFR_SCENES_DIR}")
+target_link_libraries(gpu_check PRIVATE mfr_gl)
+if(MFR_BUILD_TESTS)
+  # the script itself, --quick at 64x64 on the binaries as built (llvmpipe where there is no GPU):
+  # its CSV's header and every row agreeing; skipped (77) without a GL 4.5 context, failed under CI
+  add_test(NAME GpuCheckScriptQuick
+    COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/tests/gpu_check_test.sh ${CMAKE_CURRENT_SOURCE_DIR}
+            $<TARGET_FILE_DIR:gpu_check>)
+  set_tests_properties(GpuCheckScriptQuick PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 300)
+endif()

@@ -1,6 +1,8 @@
-// Line-chart renderer: image size, where the series' pixels land, legend, and the rejected inputs.
+// Line and bar chart renderers: image size, where the series' pixels land, legend, and the rejected
+// inputs.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -8,6 +10,7 @@
 
 namespace {
 
+using mfr::BarSeries;
 using mfr::Image8;
 using mfr::PlotOptions;
 using mfr::PlotSeries;
@@ -145,6 +148,68 @@ TEST(PlotErrors, RejectsBadSizesAndData) {
   log.logY = true;
   EXPECT_FALSE(mfr::plotLines({line({0, -1, -2}, kRed)}, log).ok());
   EXPECT_TRUE(mfr::plotLines({line({0, -1, 2}, kRed)}, log).ok());  // one positive point: a dot
+}
+
+// Grouped bars: per category one bar per series, left to right in the series' order; a taller value
+// is a taller bar on a linear and on a log axis; a missing value draws no bar.
+TEST(PlotBars, BarsStandSideBySideWithHeightsInTheValuesOrder) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (bool logY : {false, true}) {
+    PlotOptions o;
+    o.logY = logY;
+    o.title = "frame time";
+    o.yLabel = "ms";
+    const std::vector<BarSeries> bars{{"", {100, 30}, kRed}, {"", {1000, nan}, kBlue}};
+    auto img = mfr::plotBars({"layers", "hairball"}, bars, o);
+    ASSERT_TRUE(img.ok()) << img.error().message;
+    auto again = mfr::plotBars({"layers", "hairball"}, bars, o);
+    ASSERT_TRUE(again.ok());
+    EXPECT_EQ(img->rgba, again->rgba);
+    // where each colour is in the image's left and right halves: x range, top row, pixels
+    const auto extent = [&](glm::vec3 c, bool right) {
+      int x0 = img->width, x1 = -1, top = img->height, count = 0;
+      for (auto [x, y] : pixelsOf(*img, c))
+        if ((x >= img->width / 2) == right) {
+          x0 = std::min(x0, x), x1 = std::max(x1, x), top = std::min(top, y), ++count;
+        }
+      return std::array<int, 4>{x0, x1, top, count};
+    };
+    const auto redLeft = extent(kRed, false), blueLeft = extent(kBlue, false);
+    const auto redRight = extent(kRed, true), blueRight = extent(kBlue, true);
+    ASSERT_GT(redLeft[3], 200) << "logY " << logY;
+    ASSERT_GT(blueLeft[3], 200) << "logY " << logY;
+    EXPECT_LT(redLeft[1], blueLeft[0]) << "cpu's bar left of gl's";
+    EXPECT_LT(blueLeft[2], redLeft[2]) << "1000 stands above 100";
+    EXPECT_LT(redLeft[2], redRight[2]) << "100 stands above 30";
+    EXPECT_GT(redRight[3], 200);
+    EXPECT_EQ(blueRight[3], 0) << "no bar for the missing value";
+    // labels add a legend row above the plot: a box of each colour above the unlabelled chart's
+    // tallest bar (the plot moves down by the row)
+    auto labelled = mfr::plotBars({"layers", "hairball"},
+                                  {{"cpu", {100, 30}, kRed}, {"gl", {1000, nan}, kBlue}}, o);
+    ASSERT_TRUE(labelled.ok());
+    const auto topOf = [](const Image8& image, glm::vec3 c) {
+      int top = image.height;
+      for (auto [x, y] : pixelsOf(image, c)) top = std::min(top, y);
+      return top;
+    };
+    EXPECT_LT(topOf(*labelled, kRed), topOf(*img, kBlue));
+    EXPECT_LT(topOf(*labelled, kBlue), topOf(*img, kBlue));
+  }
+}
+
+TEST(PlotBarsErrors, RejectsBadCategoriesAndData) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_TRUE(mfr::plotBars({"a"}, {{"s", {2}, kRed}}, {}).ok());
+  EXPECT_FALSE(mfr::plotBars({}, {{"s", {}, kRed}}, {}).ok());
+  EXPECT_FALSE(mfr::plotBars({"a", "b"}, {{"s", {1}, kRed}}, {}).ok());
+  EXPECT_FALSE(mfr::plotBars({"a"}, {{"s", {nan}, kRed}}, {}).ok());
+  PlotOptions log;
+  log.logY = true;
+  EXPECT_FALSE(mfr::plotBars({"a"}, {{"s", {-1}, kRed}}, log).ok());
+  PlotOptions tiny;
+  tiny.width = 50;
+  EXPECT_FALSE(mfr::plotBars({"a"}, {{"s", {1}, kRed}}, tiny).ok());
 }
 
 }  // namespace

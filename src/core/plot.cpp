@@ -1,7 +1,8 @@
-// Line charts as raster images (see mfr/core/plot.hpp). Text, ticks and line widths scale by an
-// integer factor with the image size. Axis ranges widen to whole tick steps (1, 2 or 5 x 10^k, at
-// most 5 intervals; whole decades on a log axis) and series are drawn over the frame so that points
-// on the range ends stay visible. Integer rasterisation only, so the output is deterministic.
+// Line and grouped bar charts as raster images (see mfr/core/plot.hpp). Text, ticks and line widths
+// scale by an integer factor with the image size. Axis ranges widen to whole tick steps (1, 2 or 5
+// x 10^k, at most 5 intervals; whole decades on a log axis) and series are drawn over the frame so
+// that points on the range ends stay visible. Integer rasterisation only, so the output is
+// deterministic.
 #include "mfr/core/plot.hpp"
 
 #include <algorithm>
@@ -180,13 +181,14 @@ struct Layout {
   }
 };
 
-Result<Layout> layOut(const PlotOptions& options, Axes axes) {
+// `legendRow`: a row under the title for the legend (bar charts: no corner of their plot is free)
+Result<Layout> layOut(const PlotOptions& options, Axes axes, bool legendRow = false) {
   const int W = options.width, H = options.height;
   const int s = std::max(1, std::min(W / 400, H / 250));
   const int charH = 7 * s, pad = 8 * s, tick = 4 * s, gap = 3 * s;
   int yTickW = 0;
   for (const std::string& l : axes.y.labels) yTickW = std::max(yTickW, textWidth(l, s));
-  const int top = pad + (options.title.empty() ? 0 : charH + pad);
+  const int top = pad + (options.title.empty() ? 0 : charH + pad) + (legendRow ? charH + pad : 0);
   const int left = pad + (options.yLabel.empty() ? 0 : charH + pad) + yTickW + gap + tick;
   const int bottom = tick + gap + charH + (options.xLabel.empty() ? 0 : pad + charH) + pad;
   const int right = pad + textWidth(axes.x.labels.back(), s) / 2;
@@ -196,12 +198,12 @@ Result<Layout> layOut(const PlotOptions& options, Axes axes) {
   return Layout{W, H, s, charH, pad, tick, gap, std::move(axes), options.logY, plot};
 }
 
-// grid lines, the frame and the tick marks
-void drawGrid(Image8& img, const Layout& L) {
+// grid lines (vertical ones with xGrid), the frame and the tick marks
+void drawGrid(Image8& img, const Layout& L, bool xGrid = true) {
   const Rect& plot = L.plot;
   for (double t : L.axes.x.ticks) {
     const int x = static_cast<int>(std::lround(L.px(t)));
-    fill(img, {x, plot.y0, x, plot.y1 + L.tick}, kGrid);
+    if (xGrid) fill(img, {x, plot.y0, x, plot.y1 + L.tick}, kGrid);
     fill(img, {x, plot.y1, x, plot.y1 + L.tick}, kInk);
   }
   for (double t : L.axes.y.ticks) {
@@ -228,7 +230,8 @@ void drawTickLabels(Image8& img, const Layout& L) {
   };
   int xLabelW = 0;
   for (const std::string& l : ax.labels) xLabelW = std::max(xLabelW, textWidth(l, s));
-  const int xEvery = stride(L.px(ax.ticks[1]) - L.px(ax.ticks[0]), xLabelW + 2 * gap);
+  const int xEvery =
+      ax.ticks.size() < 2 ? 1 : stride(L.px(ax.ticks[1]) - L.px(ax.ticks[0]), xLabelW + 2 * gap);
   const int yEvery =
       ay.ticks.size() < 2 ? 1 : stride(L.py(ay.ticks[1]) - L.py(ay.ticks[0]), L.charH + gap);
   for (size_t i = 0; i < ax.ticks.size(); i += xEvery) {
@@ -303,6 +306,23 @@ void drawLegend(Image8& img, const Layout& L, const std::vector<PlotSeries>& ser
   }
 }
 
+// the legend as one row of filled boxes and labels, centred above the plot (bar charts)
+void drawLegendRow(Image8& img, const Layout& L, const std::vector<BarSeries>& series) {
+  const int s = L.s, pad = L.pad, swatch = 10 * s;
+  int width = 0;
+  for (const BarSeries& se : series)
+    if (!se.label.empty()) width += (width ? 2 * pad : 0) + swatch + L.gap + textWidth(se.label, s);
+  int x = std::max(0, (L.plot.x0 + L.plot.x1 - width) / 2);
+  const int y = L.plot.y0 - pad - L.charH;
+  for (const BarSeries& se : series) {
+    if (se.label.empty()) continue;
+    fill(img, {x, y, x + swatch - 1, y + L.charH - 1},
+         glm::clamp(se.color, glm::vec3(0.0f), glm::vec3(1.0f)));
+    drawText(img, x + swatch + L.gap, y, se.label, s, kInk);
+    x += swatch + L.gap + textWidth(se.label, s) + 2 * pad;
+  }
+}
+
 // title and axis labels
 void drawTitles(Image8& img, const Layout& L, const PlotOptions& options) {
   const int s = L.s, pad = L.pad;
@@ -316,28 +336,133 @@ void drawTitles(Image8& img, const Layout& L, const PlotOptions& options) {
     drawTextUp(img, pad, (L.plot.y0 + L.plot.y1) / 2, options.yLabel, s, kInk);
 }
 
+Result<void> checkSize(const PlotOptions& options) {
+  const int W = options.width, H = options.height;
+  if (W >= 100 && H >= 100 && W <= 8192 && H <= 8192) return {};
+  std::string m = "plot size ";
+  m += std::to_string(W) + "x" + std::to_string(H) + " is outside [100, 8192]";
+  return makeError(m);
+}
+
+Image8 whiteImage(const PlotOptions& options) {
+  Image8 img;
+  img.width = options.width;
+  img.height = options.height;
+  img.rgba.assign(static_cast<size_t>(img.width) * img.height * 4, 255);
+  return img;
+}
+
+// The bar chart's axes: one x unit per category (its name at the tick), the y range over the
+// drawable values and 0 (a linear axis), with room above the highest bar for its value.
+Result<Axes> barAxes(const std::vector<std::string>& categories,
+                     const std::vector<BarSeries>& series, bool logY) {
+  if (categories.empty()) return makeError("bar chart has no category");
+  double yMin = INFINITY, yMax = -INFINITY;
+  bool anyFinite = false;
+  for (const BarSeries& s : series) {
+    if (s.values.size() != categories.size()) {
+      std::string m = "bar series '";
+      m += s.label + "' has " + std::to_string(s.values.size()) + " values for " +
+           std::to_string(categories.size()) + " categories";
+      return makeError(m);
+    }
+    for (double v : s.values) {
+      anyFinite = anyFinite || std::isfinite(v);
+      if (!drawable(0.0, v, logY)) continue;
+      const double y = logY ? std::log10(v) : v;
+      yMin = std::min(yMin, y);
+      yMax = std::max(yMax, y);
+    }
+  }
+  if (!anyFinite) return makeError("plot has no finite data point");
+  if (yMin > yMax) return makeError("log-scale plot has no positive y value");
+  if (!std::isfinite(yMax - yMin)) return makeError("plot data range is too large");
+  Axes axes;
+  axes.x.lo = -0.5;
+  axes.x.hi = static_cast<double>(categories.size()) - 0.5;
+  for (size_t i = 0; i < categories.size(); ++i) {
+    axes.x.ticks.push_back(static_cast<double>(i));
+    axes.x.labels.push_back(categories[i]);
+  }
+  if (logY) {
+    axes.y = logAxis(yMin, yMax + 0.15);
+  } else {
+    const double lo = std::min(0.0, yMin), hi = std::max(0.0, yMax);
+    const double room = 0.08 * (hi - lo);  // for the values written above (below) the bars
+    axes.y = linearAxis(lo < 0.0 ? lo - room : lo, hi + room);
+  }
+  return axes;
+}
+
+// a bar's value: whole numbers from 100 up, else three significant digits
+std::string barLabel(double v) {
+  const double a = std::fabs(v);
+  return format("%.*f", v, a >= 100.0 ? 0 : a >= 10.0 ? 1 : a >= 1.0 ? 2 : 3);
+}
+
+// the bars, in groups of one bar per series around each category's tick, and their values
+void drawBars(Image8& img, const Layout& L, const std::vector<BarSeries>& series) {
+  const double group = 0.8, width = group / static_cast<double>(series.size());
+  const double base = L.logY ? L.axes.y.lo : 0.0;
+  const int yBase = static_cast<int>(std::lround(L.py(base)));
+  const Rect inside{L.plot.x0 + 1, L.plot.y0 + 1, L.plot.x1 - 1, L.plot.y1 - 1};
+  for (size_t j = 0; j < series.size(); ++j) {
+    const BarSeries& se = series[j];
+    const glm::vec3 c = glm::clamp(se.color, glm::vec3(0.0f), glm::vec3(1.0f));
+    for (size_t i = 0; i < se.values.size(); ++i) {
+      const double v = se.values[i];
+      if (!drawable(0.0, v, L.logY)) continue;
+      const double x0 = static_cast<double>(i) - group / 2 + static_cast<double>(j) * width;
+      int px0 = static_cast<int>(std::lround(L.px(x0)));
+      const int px1 = static_cast<int>(std::lround(L.px(x0 + width))) - 1;
+      if (px1 - px0 >= 4) ++px0;  // a white column between neighbouring bars
+      const int yTop = static_cast<int>(std::lround(L.py(L.logY ? std::log10(v) : v)));
+      const Rect bar{std::max(px0, inside.x0), std::max(std::min(yTop, yBase), inside.y0),
+                     std::min(px1, inside.x1), std::min(std::max(yTop, yBase), inside.y1)};
+      fill(img, bar, c);
+      const std::string text = barLabel(v);
+      const int w = textWidth(text, L.s);
+      if (w > px1 - px0 + 1 + 2 * L.gap) continue;  // no room for the value
+      const int ty = v >= 0.0 ? bar.y0 - L.gap - L.charH : bar.y1 + L.gap;
+      if (ty < inside.y0 || ty + L.charH > inside.y1) continue;
+      drawText(img, (px0 + px1 + 1 - w) / 2, ty, text, L.s, kInk);
+    }
+  }
+}
+
 }  // namespace
 
 Result<Image8> plotLines(const std::vector<PlotSeries>& series, const PlotOptions& options) {
-  const int W = options.width, H = options.height;
-  if (W < 100 || H < 100 || W > 8192 || H > 8192) {
-    std::string m = "plot size ";
-    m += std::to_string(W) + "x" + std::to_string(H) + " is outside [100, 8192]";
-    return makeError(m);
-  }
+  MFR_TRY(checkSize(options));
   auto axes = dataAxes(series, options.logY);
   if (!axes) return axes.error();
   auto layout = layOut(options, std::move(*axes));
   if (!layout) return layout.error();
 
-  Image8 img;
-  img.width = W;
-  img.height = H;
-  img.rgba.assign(static_cast<size_t>(W) * H * 4, 255);
+  Image8 img = whiteImage(options);
   drawGrid(img, *layout);
   drawTickLabels(img, *layout);
   drawSeries(img, *layout, series);
   drawLegend(img, *layout, series);
+  drawTitles(img, *layout, options);
+  return img;
+}
+
+Result<Image8> plotBars(const std::vector<std::string>& categories,
+                        const std::vector<BarSeries>& series, const PlotOptions& options) {
+  MFR_TRY(checkSize(options));
+  auto axes = barAxes(categories, series, options.logY);
+  if (!axes) return axes.error();
+  const bool labelled = std::any_of(series.begin(), series.end(),
+                                    [](const BarSeries& b) { return !b.label.empty(); });
+  auto layout = layOut(options, std::move(*axes), labelled);
+  if (!layout) return layout.error();
+
+  Image8 img = whiteImage(options);
+  drawGrid(img, *layout, false);
+  drawTickLabels(img, *layout);
+  drawBars(img, *layout, series);
+  if (labelled) drawLegendRow(img, *layout, series);
   drawTitles(img, *layout, options);
   return img;
 }
