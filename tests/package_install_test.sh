@@ -27,7 +27,7 @@ for f in bin/mfr include/mfr/mfr.hpp include/mfr/cpu/render.hpp include/mfr/engi
   [ -f "$prefix/$f" ] || fail "$f not installed"
 done
 # exactly the public headers: every include/mfr header, nothing of src/ (pipeline.hpp, ...)
-(cd "$source/include" && find mfr -name '*.hpp' | sort) > "$tmp/public"
+(cd "$source/include" && find mfr \( -name '*.hpp' -o -name '*.h' \) | sort) > "$tmp/public"
 (cd "$prefix/include" && find . -type f | sed 's|^\./||' | sort) > "$tmp/installed"
 diff "$tmp/public" "$tmp/installed" || fail "installed headers differ from include/mfr"
 for private in $(cd "$source/src" && find . -name '*.hpp' | sed 's|^\./||'); do
