@@ -1,8 +1,8 @@
 // Shared geometry shader of the geometry passes: the CPU engine's primitive set-up, operation for
 // operation (src/cpu/raster_frame.cpp): trivial reject and Sutherland-Hodgman clipping against
 // near, far and the x/y guard band in clip space (float), then per fan triangle the window
-// coordinates in double, snapped to 1/256 pixel with llround, the orientation made positive, the
-// top-left flags and the bounds test. Each fan triangle is emitted at its snapped position (w = 1,
+// coordinates in double, snapped to 1/256 pixel with llround, back faces culled where the material
+// says so, the orientation made positive, the top-left flags and the bounds test. Each fan triangle is emitted at its snapped position (w = 1,
 // so GL's own rasterizer covers the same pixel centres) with its set-up as flat outputs, from
 // which the fragment shader recomputes the exact integer edge functions and barycentrics.
 layout(triangles) in;
@@ -19,6 +19,9 @@ uniform double uMaxNdc;  // the CPU engine's guard band clamp (method_math.h's k
 
 layout(std430, binding = kBindTriMaterial) readonly buffer TriMaterial {
   uint triMaterial[];
+};
+layout(std430, binding = kBindMaterials) readonly buffer Materials {
+  uint materials[];  // kMaterialWords per material; only the flags are read here
 };
 
 flat out ivec3 gX;  // fixed-point window coordinates (1/256 px), y down
@@ -144,7 +147,12 @@ void setupAndEmit(int i0, int i1, int i2, uint material) {
   precise double area = double(x[1] - x[0]) * double(y[2] - y[0]) -
                         double(y[1] - y[0]) * double(x[2] - x[0]);
   if (area == 0.0lf) return;
-  if (area < 0.0lf) {  // no culling: flip to a positive orientation
+  // y down: a front face (counter-clockwise in GL's y-up window) has area < 0 here, as in the CPU
+  // set-up, which culls its back faces at this same step
+  const bool cullBack = (materials[material * kMaterialWords + kMaterialFlagsWord] &
+                         kMaterialCullBack) != 0u;
+  if (area > 0.0lf && cullBack) return;
+  if (area < 0.0lf) {  // a kept face: flip to a positive orientation
     int ti = x[1]; x[1] = x[2]; x[2] = ti;
     ti = y[1]; y[1] = y[2]; y[2] = ti;
     float tf = z[1]; z[1] = z[2]; z[2] = tf;

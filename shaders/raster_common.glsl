@@ -1,8 +1,9 @@
 // Shared part of the fragment shaders of the geometry passes, after the raster part
 // (raster_exact.glsl or raster_native.glsl, which define FragmentData, rasterFragment,
-// fragmentMaterial, fragmentUv, fragmentNormal and fragmentDepth): the alpha test, texture
-// sampling and shading of the CPU engine (include/mfr/cpu/raster_frame_impl.hpp), operation for
-// operation and `precise`.
+// fragmentMaterial, fragmentBackFacing, fragmentUv, fragmentNormal and fragmentDepth): back-face
+// culling (the native raster's; the exact raster culls at set-up, as the CPU engine), the alpha
+// test, texture sampling and shading of the CPU engine (include/mfr/cpu/raster_frame_impl.hpp),
+// operation for operation and `precise`.
 uniform vec4 uRay;       // view ray of pixel (x, y): (x * ray.x + ray.y, y * ray.z + ray.w, -1)
 uniform float uAmbient;  // kAmbient
 uniform float uDiffuse;  // 1 - kAmbient
@@ -68,12 +69,15 @@ vec4 sampleTexture(uint first, int width, int height, vec2 uv) {
   return s;
 }
 
-// alpha test and base colour (RasterFrame::surface); false when the fragment is discarded
+// back-face cull, alpha test and base colour (RasterFrame::surface); false when the fragment is
+// discarded
 bool surface(FragmentData f, bool coverageOnly, out vec4 base) {
   const uint m = fragmentMaterial() * kMaterialWords;
   const uint mode = materials[m + 7u];
   const bool needsAlphaTest = mode == kAlphaMask;
   base = vec4(0.0);
+  if (fragmentBackFacing() && (materials[m + kMaterialFlagsWord] & kMaterialCullBack) != 0u)
+    return false;
   if (coverageOnly && !needsAlphaTest) return true;
   base = vec4(uintBitsToFloat(materials[m + 0u]), uintBitsToFloat(materials[m + 1u]),
               uintBitsToFloat(materials[m + 2u]), uintBitsToFloat(materials[m + 3u]));

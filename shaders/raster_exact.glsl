@@ -81,3 +81,8 @@ float fragmentDepth(FragmentData f) {
   precise float z = gZ.x + f.l1 * dz1 + f.l2 * dz2;
   return z > 0.0 ? (z < 1.0 ? z : 1.0) : 0.0;
 }
+
+// raster.geom culled the back faces at set-up, as the CPU engine does: every fragment here is kept
+bool fragmentBackFacing() {
+  return false;
+}

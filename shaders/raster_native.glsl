@@ -29,6 +29,13 @@ uint fragmentMaterial() {
   return triMaterial[gl_PrimitiveID];
 }
 
+// raster_native.vert negates y, which mirrors every triangle: a front face (counter-clockwise in
+// the scene's own projection) reaches GL clockwise, so GL's front-facing (glFrontFace GL_CCW) is
+// the scene's back face
+bool fragmentBackFacing() {
+  return gl_FrontFacing;
+}
+
 vec2 fragmentUv(FragmentData f) {
   return vUv;
 }

@@ -1,5 +1,6 @@
 // Writes tiny glTF 2.0 files for rendering tests: axis-aligned quads in planes z = const, facing
-// +z (towards a camera on the +z axis), each with its own material, one embedded base64 buffer.
+// +z (towards a camera on the +z axis; GltfQuad::reversed: facing -z), each with its own material,
+// one embedded base64 buffer.
 #pragma once
 
 #include <cstdint>
@@ -14,6 +15,7 @@ struct GltfQuad {
   float x0, y0, x1, y1;     // world-space rectangle
   float z;                  // plane
   nlohmann::json material;  // a glTF material object
+  bool reversed = false;    // clockwise seen from +z: the quad shows its back face to +z
 };
 
 inline std::string base64Encode(const std::string& bytes) {
@@ -52,8 +54,10 @@ inline std::string gltfWithQuads(const std::vector<GltfQuad>& quads) {
   for (const GltfQuad& q : quads) {
     const float positions[12] = {q.x0, q.y0, q.z, q.x1, q.y0, q.z,
                                  q.x1, q.y1, q.z, q.x0, q.y1, q.z};
-    const float normals[12] = {0, 0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1};
-    const uint16_t indices[6] = {0, 1, 2, 0, 2, 3};
+    const float nz = q.reversed ? -1.0f : 1.0f;
+    const float normals[12] = {0, 0, nz, 0, 0, nz, 0, 0, nz, 0, 0, nz};
+    const uint16_t forward[6] = {0, 1, 2, 0, 2, 3}, backward[6] = {0, 2, 1, 0, 3, 2};
+    const uint16_t* indices = q.reversed ? backward : forward;
     accessors.push_back({{"bufferView", append(positions, sizeof positions)},
                          {"componentType", 5126},
                          {"count", 4},
@@ -66,7 +70,7 @@ inline std::string gltfWithQuads(const std::vector<GltfQuad>& quads) {
                          {"count", 4},
                          {"type", "VEC3"}});
     const size_t normal = accessors.size() - 1;
-    accessors.push_back({{"bufferView", append(indices, sizeof indices)},
+    accessors.push_back({{"bufferView", append(indices, sizeof forward)},
                          {"componentType", 5123},
                          {"count", 6},
                          {"type", "SCALAR"}});

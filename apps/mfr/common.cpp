@@ -45,6 +45,10 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
   app.add_option(
       "--transmission-floor", transmissionFloor,
       "Alpha floor for KHR_materials_transmission glass (alpha = max(floor, 1 - transmission))");
+  app.add_option("--cull", cull,
+                 "Back faces culled: auto (as the file says: glTF materials with doubleSided "
+                 "false; OBJ, PLY, JSON and procedural scenes are double-sided), none or back "
+                 "(every back face; front = counter-clockwise) (default auto)");
   app.add_flag("--quiet,-q", quiet, "No progress or summary on the terminal");
   app.add_flag("--json", json, "Print machine-readable JSON on stdout");
   app.add_flag("--allow-outside-references", allowOutsideReferences,
@@ -106,6 +110,7 @@ SceneRequest SceneOptions::request() const {
   r.alpha = alpha;
   r.background = background;
   r.transmissionFloor = transmissionFloor;
+  r.cull = cull;
   if (gltfScene != -1) r.gltfScene = gltfScene;
   return r;
 }

@@ -116,7 +116,7 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
            view=None, orbit=0, orbit_view=None, zoom=1.0, composite=None, capture="tile",
            threads=0, seed=1, model=None, occupancy_d=None, importance=None, alpha=None,
            background=None, transmission_floor=0.1, shuffle_draw_order=None, gltf_scene=None,
-           engine="cpu", gl_sync="auto", gl_raster="native", memory_limit=None,
+           cull=None, engine="cpu", gl_sync="auto", gl_raster="native", memory_limit=None,
            allow_outside_references=False, depth_complexity=True):
     """Renders with one method, exactly as `mfr render` with the same options (the library checks
     both the same way: its errors name the Python argument where the CLI names its flag).
@@ -139,7 +139,9 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
         on a circle around the camera's target (a list of N results); orbit_view: only view I of
         them (one result; view I - 1 feeds vkb's previous-frame term, as in the full orbit).
     shuffle_draw_order: submit the triangles in this seed's random order. gltf_scene: which of a
-        glTF file's scenes (`--scene N`; default the file's own).
+        glTF file's scenes (`--scene N`; default the file's own). cull: the back faces culled,
+        "auto" (as the file says: glTF materials with doubleSided false), "none" or "back" (every
+        back face), as `mfr --cull`; None: the scene's own (Scene.cull, "auto" when loaded).
     engine: "cpu" or "gl" (mfr.engine_names()); gl_sync: the GL k-buffer's "auto", "lock" or
         "interlock"; gl_raster: the GL geometry passes, "native" (GL's own pipeline) or "exact"
         (the CPU engine's raster emulated: bit-identical to engine="cpu").
@@ -161,8 +163,8 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
                    composite=composite, capture=capture, threads=threads, seed=seed, model=model,
                    occupancy_d=occupancy_d, importance=importance, alpha=alpha,
                    background=background, transmission_floor=transmission_floor,
-                   shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, engine=engine,
-                   gl_sync=gl_sync, gl_raster=gl_raster, memory_limit=memory_limit,
+                   shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
+                   engine=engine, gl_sync=gl_sync, gl_raster=gl_raster, memory_limit=memory_limit,
                    allow_outside_references=allow_outside_references,
                    depth_complexity=depth_complexity)
 
@@ -172,8 +174,8 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
             zoom=1.0,
             composite=None, capture="tile", threads=0, seed=1, model=None, ppd=FLIP_DEFAULT_PPD,
             alpha=None, background=None, transmission_floor=0.1, shuffle_draw_order=None,
-            gltf_scene=None, engine="cpu", gl_sync="auto", gl_raster="native", memory_limit=None,
-            allow_outside_references=False) -> dict:
+            gltf_scene=None, cull=None, engine="cpu", gl_sync="auto", gl_raster="native",
+            memory_limit=None, allow_outside_references=False) -> dict:
     """Writes the folder `mfr compare --out OUT` writes for the same options and returns its
     results.json as a dict.
 
@@ -186,10 +188,10 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
     degree. orbit=N: the temporal comparison of `mfr compare --orbit N` (every frame in
     OUT/frame_NNN, the flicker of each method along the path in results.json and report.html;
     orbit_step: degrees between frames, default 360/N); with orbit_view=I only view I of the N
-    is compared. scene, camera, view, zoom, width, height, threads, seed, alpha,
-    background, transmission_floor, shuffle_draw_order, gltf_scene, engine, gl_sync, gl_raster,
-    memory_limit, allow_outside_references: as in mfr.render. A method that fails at a budget is recorded with
-    its error; bad input raises mfr.Error.
+    is compared. scene, camera, view, zoom, width, height, threads, seed, alpha, background,
+    transmission_floor, shuffle_draw_order, gltf_scene, cull, engine, gl_sync, gl_raster,
+    memory_limit, allow_outside_references: as in mfr.render. A method that fails at a budget is
+    recorded with its error; bad input raises mfr.Error.
     """
     if isinstance(budgets, (str, int)):
         budgets = [budgets]
@@ -208,7 +210,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                                  ("alpha", alpha, None), ("background", background, None),
                                  ("transmission_floor", transmission_floor, 0.1),
                                  ("shuffle_draw_order", shuffle_draw_order, None),
-                                 ("gltf_scene", gltf_scene, None),
+                                 ("gltf_scene", gltf_scene, None), ("cull", cull, None),
                                  ("engine", engine, "cpu"), ("gl_sync", gl_sync, "auto"),
                                  ("gl_raster", gl_raster, "native"),
                                  ("memory_limit", memory_limit, None),
@@ -223,8 +225,8 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                     orbit_step=orbit_step, zoom=zoom, composite=composite, capture=capture,
                     threads=threads, seed=seed, model=model, ppd=ppd, alpha=alpha,
                     background=background, transmission_floor=transmission_floor,
-                    shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, engine=engine,
-                    gl_sync=gl_sync, gl_raster=gl_raster, memory_limit=memory_limit,
+                    shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
+                    engine=engine, gl_sync=gl_sync, gl_raster=gl_raster, memory_limit=memory_limit,
                     allow_outside_references=allow_outside_references,
                     command_line="mfr.compare(" + ", ".join(call) + ")")
 

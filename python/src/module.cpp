@@ -110,22 +110,20 @@ PyRenderResult renderResult(RenderOutput&& out, nlohmann::json stats, int width,
   return r;
 }
 
-py::object renderScene(const py::object& sceneArg, const std::string& method,
-                       const py::object& budget, const py::object& k, int width, int height,
-                       const py::object& camera, const py::object& view, int orbit,
-                       const py::object& orbitView, double zoom, const py::object& composite,
-                       const std::string& capture, int threads, uint64_t seed,
-                       const py::object& model, const py::object& occupancyD,
-                       const py::object& importance, const py::object& alpha,
-                       const py::object& background, double transmissionFloor,
-                       const py::object& shuffleDrawOrder, const py::object& gltfScene,
-                       const std::string& engineName, const std::string& glSync,
-                       const std::string& glRaster, const py::object& memoryLimitArg,
-                       bool allowOutsideReferences, bool wantDepthComplexity) {
+py::object renderScene(
+    const py::object& sceneArg, const std::string& method, const py::object& budget,
+    const py::object& k, int width, int height, const py::object& camera, const py::object& view,
+    int orbit, const py::object& orbitView, double zoom, const py::object& composite,
+    const std::string& capture, int threads, uint64_t seed, const py::object& model,
+    const py::object& occupancyD, const py::object& importance, const py::object& alpha,
+    const py::object& background, double transmissionFloor, const py::object& shuffleDrawOrder,
+    const py::object& gltfScene, const py::object& cull, const std::string& engineName,
+    const std::string& glSync, const std::string& glRaster, const py::object& memoryLimitArg,
+    bool allowOutsideReferences, bool wantDepthComplexity) {
   const std::optional<uint64_t> memoryLimit = memoryLimitArgument(memoryLimitArg);
   const SceneRequest request =
       sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
-                           transmissionFloor, shuffleDrawOrder, gltfScene);
+                           transmissionFloor, shuffleDrawOrder, gltfScene, cull);
   unwrap(checkThreads(threads, "threads"));
   const MethodDesc m = buildMethod(method, k, composite, model, occupancyD, importance, seed);
   RenderOptions options;
@@ -267,6 +265,11 @@ void addSceneAndRender(py::module_& m) {
           "alpha_override", [](const Scene& s) { return s.alphaOverride; },
           [](Scene& s, const py::object& v) { s.alphaOverride = alphaArgument(v); },
           "When set (0..1), every material is blended with this alpha; None: the file's.")
+      .def_property(
+          "cull", [](const Scene& s) { return std::string(toString(s.cull)); },
+          [](Scene& s, const std::string& v) { s.cull = unwrap(parseCullMode(v, "cull")); },
+          "Back faces culled: 'auto' (as the file says: glTF materials with doubleSided false), "
+          "'none' or 'back' (every back face), as `mfr --cull`.")
       .def_property_readonly(
           "positions",
           [](py::object self) {
@@ -342,9 +345,9 @@ lines are not rendered: Scene.primitives_skipped counts them.)");
         py::arg("importance") = py::none(), py::arg("alpha") = py::none(),
         py::arg("background") = py::none(), py::arg("transmission_floor") = 0.1,
         py::arg("shuffle_draw_order") = py::none(), py::arg("gltf_scene") = py::none(),
-        py::arg("engine") = "cpu", py::arg("gl_sync") = "auto", py::arg("gl_raster") = "native",
-        py::arg("memory_limit") = py::none(), py::arg("allow_outside_references") = false,
-        py::arg("depth_complexity") = true,
+        py::arg("cull") = py::none(), py::arg("engine") = "cpu", py::arg("gl_sync") = "auto",
+        py::arg("gl_raster") = "native", py::arg("memory_limit") = py::none(),
+        py::arg("allow_outside_references") = false, py::arg("depth_complexity") = true,
         R"(Renders a scene (an mfr.Scene, or a source string loaded with `seed`) with one method, as
 `mfr render` does with the same options, and returns an mfr.RenderResult (a list of them for an
 orbit of several views). See mfr.render's Python documentation (python/mfr/__init__.py) for the

@@ -115,7 +115,8 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
                                   const py::object& view, int orbit, const py::object& orbitView,
                                   double zoom, const py::object& alpha,
                                   const py::object& background, double transmissionFloor,
-                                  const py::object& shuffleDrawOrder, const py::object& gltfScene) {
+                                  const py::object& shuffleDrawOrder, const py::object& gltfScene,
+                                  const py::object& cull) {
   SceneRequest r;
   r.width = width;
   r.height = height;
@@ -152,6 +153,7 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
   }
   if (!shuffleDrawOrder.is_none())
     r.shuffleDrawOrder = castArgument<uint64_t>(shuffleDrawOrder, "shuffle_draw_order");
+  if (!cull.is_none()) r.cull = castArgument<std::string>(cull, "cull");
   unwrap(checkSceneRequest(r, Spelling::Python));
   return r;
 }

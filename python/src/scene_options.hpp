@@ -45,7 +45,8 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
                                   const py::object& view, int orbit, const py::object& orbitView,
                                   double zoom, const py::object& alpha,
                                   const py::object& background, double transmissionFloor,
-                                  const py::object& shuffleDrawOrder, const py::object& gltfScene);
+                                  const py::object& shuffleDrawOrder, const py::object& gltfScene,
+                                  const py::object& cull);
 
 /// A budget: bytes as an int, a size ("20MB") or a share of the A-buffer ("25%").
 BudgetSpec budgetSpecArgument(const py::object& budget);

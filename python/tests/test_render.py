@@ -235,6 +235,25 @@ def test_gltf_scene_and_skipped_primitives():
     assert mfr.render(scene, width=W, height=H).stats["primitives_skipped"] == 0
 
 
+def test_cull_argument_and_scene_property():
+    # --cull: "auto" (the file's doubleSided), "none", "back"; closed spheres lose their back half
+    scene = mfr.load_scene("procedural:spheres?count=2")
+    assert scene.cull == "auto"
+    total = {}
+    for mode in ("none", "back"):
+        result = mfr.render(scene, width=W, height=H, cull=mode)
+        assert result.stats["cull"] == mode
+        total[mode] = int(result.depth_complexity.sum())
+    assert 0.4 < total["back"] / total["none"] < 0.6
+    assert scene.cull == "auto"  # the argument changed a copy
+    scene.cull = "back"
+    assert mfr.render(scene, width=W, height=H).stats["cull"] == "back"
+    with pytest.raises(mfr.Error, match=r"^cull 'front': expected auto, none or back$"):
+        mfr.render(scene, width=W, height=H, cull="front")
+    with pytest.raises(mfr.Error, match=r"^cull 'side': expected auto, none or back$"):
+        scene.cull = "side"
+
+
 def test_engine_names_and_bad_engine():
     assert mfr.engine_names()[0] == "cpu"
     with pytest.raises(mfr.Error, match=r"engine"):

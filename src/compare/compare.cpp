@@ -333,6 +333,7 @@ nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersi
   j["height"] = r.height;
   j["compositing"] = r.compositing ? toString(*r.compositing) : "per-method";
   j["capture"] = captureName(r.capture);
+  j["cull"] = toString(r.groundTruth.stats.cull);  // every run rasterizes the same view
   j["flip_pixels_per_degree"] = r.flipPixelsPerDegree;
   j["budget_bytes"] =
       r.budgets.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.budgets[0].budgetBytes);

@@ -617,6 +617,12 @@ std::string setupSection(const CompareResult& r, const ReportInfo& info,
                        ? "tile-owned (lock-free)"
                        : "fragment-parallel (per-pixel spin-locks)") +
        "</td></tr>\n";
+  h += "<tr><th>Back faces</th><td><code>--cull " + std::string(toString(gs.cull)) + "</code>" +
+       (gs.cull == CullMode::Auto
+            ? " (culled where the file says so: glTF materials with doubleSided false)"
+        : gs.cull == CullMode::Back ? " (every back face culled)"
+                                    : " (none culled)") +
+       "</td></tr>\n";
   h += "<tr><th>Ground truth</th><td>exact A-buffer: " + grouped(gs.fragmentsGenerated) +
        " fragments over " + grouped(gs.coveredPixels) + " covered pixels";
   if (gs.maxDepthComplexity)

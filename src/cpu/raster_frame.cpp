@@ -99,9 +99,11 @@ struct SetupContext {
   int width, height;
 };
 
-// Screen-space set-up of one clipped triangle; returns false when it covers no pixel centre.
+// Screen-space set-up of one clipped triangle; returns false when it covers no pixel centre or is
+// a back face that `cullBack` drops.
 bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVertex& v1,
-                   const ClipVertex& v2, uint32_t prim, uint32_t material, TriangleSetup& t) {
+                   const ClipVertex& v2, uint32_t prim, uint32_t material, bool cullBack,
+                   TriangleSetup& t) {
   const ClipVertex* v[3] = {&v0, &v1, &v2};
   // Clipping leaves |x/w|, |y/w| <= kGuardBand up to float rounding; under extreme projections
   // (a field of view of 1e-20 degrees, coordinates near the float range) that rounding is large
@@ -125,7 +127,11 @@ bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVert
   int64_t area = (static_cast<int64_t>(t.x[1]) - t.x[0]) * (static_cast<int64_t>(t.y[2]) - t.y[0]) -
                  (static_cast<int64_t>(t.y[1]) - t.y[0]) * (static_cast<int64_t>(t.x[2]) - t.x[0]);
   if (area == 0) return false;
-  if (area < 0) {  // no culling: flip to a positive orientation
+  // Window y runs down, so a front face (counter-clockwise in GL's y-up window) has area < 0
+  // here. Clipping keeps the winding (w > 0 inside the near plane): every fan triangle of a
+  // clipped back face is a back face.
+  if (area > 0 && cullBack) return false;
+  if (area < 0) {  // a kept face: flip to a positive orientation
     std::swap(t.x[1], t.x[2]);
     std::swap(t.y[1], t.y[2]);
     std::swap(t.z[1], t.z[2]);
@@ -167,6 +173,7 @@ std::vector<ShadeMaterial> resolveMaterials(const Scene& scene) {
     s.texture = m.baseColorTexture >= 0 ? &scene.textures[m.baseColorTexture] : nullptr;
     s.mode = m.alphaMode;
     s.cutoff = m.alphaCutoff;
+    s.cullBack = scene.cullsBackFaces(static_cast<uint32_t>(out.size()));
     if (scene.alphaOverride) {
       s.alphaOverridden = true;
       s.overrideAlpha = *scene.alphaOverride;
@@ -213,6 +220,7 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   frame.tilesY_ = (options.height + options.tileSize - 1) / options.tileSize;
   frame.camera_ = fitClipPlanes(cameraIn, sceneBounds(scene));
   frame.materials_ = resolveMaterials(scene);
+  frame.cull_ = scene.cull;
 
   const glm::mat4 view = viewMatrix(frame.camera_);
   const glm::mat4 viewProj = projectionMatrix(frame.camera_, options.width, options.height) * view;
@@ -268,7 +276,8 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
         const int count = crossed ? clipPolygon(poly, 3, crossed) : 3;
         for (int i = 1; i + 1 < count; ++i) {
           TriangleSetup t;
-          if (setupTriangle(ctx, poly[0], poly[i], poly[i + 1], prim, material, t))
+          if (setupTriangle(ctx, poly[0], poly[i], poly[i + 1], prim, material,
+                            frame.materials_[material].cullBack, t))
             out.push_back(t);
         }
       }

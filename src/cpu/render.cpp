@@ -398,6 +398,7 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
                                  options.budgetBytes},
                   out.stats);
   cpuStats(counters, ledger, out.stats);
+  out.stats.cull = frame.cull();
   out.kMap = alloc.reservedK.empty() ? std::move(alloc.capacity) : std::move(alloc.reservedK);
   if (options.keepStores) {
     out.nodes.assign(stores.nodes.data(), stores.nodes.data() + stores.nodes.size());

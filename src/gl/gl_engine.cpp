@@ -147,7 +147,8 @@ Result<void> GlEngine::State::uploadMaterials(const Scene& scene) {
   }
   std::vector<uint32_t> materialWords;
   auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
-  for (const Material& m : scene.materials) {
+  for (uint32_t index = 0; index < scene.materials.size(); ++index) {
+    const Material& m = scene.materials[index];
     const bool textured = m.baseColorTexture >= 0;
     const Texture* t = textured ? &scene.textures[m.baseColorTexture] : nullptr;
     const uint32_t words[kMaterialWords] = {
@@ -162,7 +163,7 @@ Result<void> GlEngine::State::uploadMaterials(const Scene& scene) {
         bits(m.alphaCutoff),
         scene.alphaOverride ? 1u : 0u,
         bits(scene.alphaOverride ? *scene.alphaOverride : 1.0f),
-        0u};
+        scene.cullsBackFaces(index) ? kMaterialCullBack : 0u};
     materialWords.insert(materialWords.end(), words, words + kMaterialWords);
   }
   for (const auto& [name, bytes] :

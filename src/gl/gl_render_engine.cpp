@@ -304,6 +304,7 @@ class GlFrame {
     s.culledOccupancy = g.culledOccupancy;
     s.culledKPlus = g.culledKPlus;
     s.engine = "gl";
+    s.cull = gv_.view().scene->cull;
     s.passes = std::move(hostPasses_);  // the host side of a variable-k allocation first
     for (const GlPassTime& t : g.passes) {
       s.passes.push_back({t.name, t.wallMs});  // llvmpipe's GL_TIME_ELAPSED is not usable

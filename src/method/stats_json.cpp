@@ -32,6 +32,7 @@ nlohmann::json statsToJson(const RenderStats& s) {
   j["time_ms"] = times;
   if (!s.engine.empty()) j["engine"] = s.engine;
   j["primitives_skipped"] = s.primitivesSkipped;
+  j["cull"] = toString(s.cull);
   if (!s.isa.empty()) j["isa"] = s.isa;
   for (const auto& [name, value] : s.engineCounters) j["engine_counters"][name] = value;
   j["total_ms"] = s.totalMs();

@@ -1,6 +1,7 @@
 // glTF 2.0 loader (.gltf and .glb) on top of tinygltf, following the Khronos glTF 2.0 specification
 // (accessors incl. sparse and normalized integers, node hierarchy with matrix or TRS transforms,
-// triangle primitives, metallic-roughness base colour, alpha modes, perspective cameras) and the
+// triangle primitives, metallic-roughness base colour, alpha modes, doubleSided (Scene::cull;
+// mirroring transforms reverse the winding), perspective cameras) and the
 // KHR_materials_transmission (folded into alpha, see LoadOptions), KHR_mesh_quantization and
 // EXT_mesh_gpu_instancing (one copy of the mesh per instance) extensions.
 //
@@ -817,6 +818,7 @@ uint32_t GltfSceneBuilder::materialIndex(int gltfMaterial) {
   Material material;
   material.name = "default";
   material.alphaMode = AlphaMode::Opaque;
+  material.doubleSided = false;  // glTF's default material is single-sided
   if (gltfMaterial >= 0) {
     const tinygltf::Material& src = model_.materials[static_cast<size_t>(gltfMaterial)];
     material.name = src.name;
@@ -830,6 +832,7 @@ uint32_t GltfSceneBuilder::materialIndex(int gltfMaterial) {
     else if (src.alphaMode == "BLEND")
       material.alphaMode = AlphaMode::Blend;
     material.alphaCutoff = static_cast<float>(src.alphaCutoff);
+    material.doubleSided = src.doubleSided;
     if (auto ext = src.extensions.find("KHR_materials_transmission"); ext != src.extensions.end()) {
       double transmission = 0.0;
       if (ext->second.Has("transmissionFactor") && ext->second.Get("transmissionFactor").IsNumber())

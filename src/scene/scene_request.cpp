@@ -36,6 +36,7 @@ Result<void> checkSceneRequest(const SceneRequest& r, Spelling spelling) {
       return makeError(flag("--background") + ": components must be in [0, 1]");
   if (!(r.transmissionFloor >= 0.0 && r.transmissionFloor <= 1.0))
     return makeError(flag("--transmission-floor") + ": must be in [0, 1]");
+  if (!r.cull.empty()) MFR_TRY(parseCullMode(r.cull, flag("--cull")));
   if (r.view < -1) return makeError(flag("--view") + ": must be a camera index (0-based)");
   if (r.gltfScene && *r.gltfScene < 0)
     return makeError(spell(spelling, spelling == Spelling::Cli ? "--scene" : "gltf_scene") +
@@ -52,6 +53,7 @@ void applyToScene(const SceneRequest& r, Scene& scene) {
   if (r.alpha) scene.alphaOverride = static_cast<float>(*r.alpha);
   if (r.background.size() == 3)
     scene.background = glm::vec3(r.background[0], r.background[1], r.background[2]);
+  if (auto cull = parseCullMode(r.cull, "--cull"); cull && !r.cull.empty()) scene.cull = *cull;
 }
 
 Result<SceneViews> sceneViews(const Scene& scene, const std::string& source, const SceneRequest& r,

@@ -5,7 +5,9 @@
 //   - clipping in homogeneous clip space against near and far (z = -w, z = w) and an x/y
 //     guard band;
 //   - perspective-correct attributes, depth = window z in [0, 1] interpolated linearly in screen;
-//   - no back-face culling (transparent geometry shows both sides).
+//   - back faces (clockwise in GL's y-up window coordinates) culled at set-up for the triangles
+//     whose material Scene::cullsBackFaces says so; every other face is kept, whichever side it
+//     shows (transparent geometry shows both sides).
 // Set-up transforms, clips and bins the triangles once per frame into square tiles; every capture
 // pass then rasterizes tile by tile. A tile is owned by one worker for the whole pass, so per-pixel
 // updates need no locks, and within a pixel fragments arrive in primitive order: output is the same
@@ -45,6 +47,7 @@ struct ShadeMaterial {
   float cutoff = 0.5f;
   bool alphaOverridden = false;
   float overrideAlpha = 1.0f;
+  bool cullBack = false;  // Scene::cullsBackFaces: back faces dropped at set-up
 };
 
 /// Everything the inner loop needs of one (clipped) screen-space triangle.
@@ -104,6 +107,8 @@ class RasterFrame {
   /// queue; the fragment-parallel capture uses the full requested count on its own threads).
   int arenaThreads() const;
   const Camera& camera() const { return camera_; }
+  /// The scene's cull mode (Scene::cull), recorded in the statistics.
+  CullMode cull() const { return cull_; }
 
   int tileSize() const { return tileSize_; }
   int tileCount() const { return tilesX_ * tilesY_; }
@@ -147,6 +152,7 @@ class RasterFrame {
 
   int width_ = 0, height_ = 0, threads_ = 1, tileSize_ = 32, tilesX_ = 0, tilesY_ = 0;
   Camera camera_;
+  CullMode cull_ = CullMode::Auto;
   std::vector<TriangleSetup> setups_;
   std::vector<uint32_t> binned_;
   std::vector<uint32_t> binOffsets_;

@@ -99,8 +99,10 @@ MFR_GL_CONST(uint, kBindAllocOffsets, 7u)       // exclusive prefix sum of k(p) 
 
 // material record (12 uint words; floats as their bits): base colour R, G, B, A; the texture's
 // first texel in the texel buffer (kNoTexture: none), its width, height; alpha mode
-// (mfr::AlphaMode); cutoff; alpha override flag, override value; padding
+// (mfr::AlphaMode); cutoff; alpha override flag, override value; flags (kMaterialCullBack)
 MFR_GL_CONST(uint, kMaterialWords, 12u)
+MFR_GL_CONST(uint, kMaterialFlagsWord, 11u)
+MFR_GL_CONST(uint, kMaterialCullBack, 1u)  // flag: back faces culled (mfr::Scene::cullsBackFaces)
 MFR_GL_CONST(uint, kNoTexture, 0xffffffffu)
 MFR_GL_CONST(uint, kAlphaOpaque, 0u)  // mfr::AlphaMode values
 MFR_GL_CONST(uint, kAlphaMask, 1u)
@@ -146,7 +148,7 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //   wboit_resolve.comp: kBindAccum kBindImage
 //   raster_common.glsl: kBindMaterials kBindColorTables kBindTexels kBindCounts(image)
 //   raster_native.glsl: kBindTriMaterial
-//   raster.geom: kBindTriMaterial
+//   raster.geom: kBindTriMaterial kBindMaterials
 // (end of the bindings per shader file)
 
 #ifdef __cplusplus

@@ -15,6 +15,7 @@
 #include "mfr/core/image.hpp"
 #include "mfr/method/fragment_node.hpp"
 #include "mfr/method/importance.hpp"
+#include "mfr/scene/cull_mode.hpp"
 
 namespace mfr {
 
@@ -88,6 +89,7 @@ struct RenderStats {
   std::vector<PassTime> passes;
   std::optional<OracleReport> oracle;  // optimal / optimal-greedy
   uint64_t primitivesSkipped = 0;      // the scene's points and lines, not rendered
+  CullMode cull = CullMode::Auto;      // the back faces the raster culled (Scene::cull)
   /// The engine that rendered (Engine::name) and what only it measures (the CPU engine: threads,
   /// tile_workers), beside the shared fields above.
   std::string engine;

@@ -11,6 +11,7 @@
 
 #include "mfr/core/result.hpp"
 #include "mfr/scene/camera.hpp"
+#include "mfr/scene/cull_mode.hpp"
 
 namespace mfr {
 
@@ -33,6 +34,9 @@ struct Material {
   /// KHR_materials_transmission: set when the material declares transmission; the loader folds it
   /// into baseColor.a (alpha = max(floor, 1 - transmissionFactor)) and records the raw factor here.
   std::optional<float> transmission;
+  /// glTF `doubleSided`: false lets CullMode::Auto cull the back faces. Formats without the notion
+  /// (OBJ, PLY, JSON and procedural scenes) are double-sided.
+  bool doubleSided = true;
 };
 
 struct Scene {
@@ -59,6 +63,14 @@ struct Scene {
   /// Primitives of the file that are not surfaces (glTF points and lines): not rendered, and
   /// reported (RenderStats::primitivesSkipped, the CLI's summary line) instead of dropped silently.
   uint64_t primitivesSkipped = 0;
+  /// The back faces the engines cull (SceneRequest::cull, `--cull`).
+  CullMode cull = CullMode::Auto;
+
+  /// Whether the engines drop the back faces of triangles with material `material`: the scene's
+  /// cull mode resolved against the material's doubleSided. The one rule every raster applies.
+  bool cullsBackFaces(uint32_t material) const {
+    return cull == CullMode::Back || (cull == CullMode::Auto && !materials[material].doubleSided);
+  }
 
   size_t triangleCount() const { return indices.size() / 3; }
   size_t vertexCount() const { return positions.size(); }

@@ -29,16 +29,20 @@ struct SceneRequest {
   std::vector<double> background;            // --background R,G,B (linear; empty: the scene's)
   double transmissionFloor = 0.1;            // --transmission-floor (glTF transmission glass)
   std::optional<int> gltfScene;              // --scene N: which of a glTF file's scenes
+  std::string cull;  // --cull auto|none|back (Scene::cull); empty: the scene's as it is
 
   bool hasCamera() const { return !camera.empty() || !cameraNumbers.empty(); }
   /// True when applyToScene changes a loaded scene.
-  bool changesScene() const { return shuffleDrawOrder || alpha || !background.empty(); }
+  bool changesScene() const {
+    return shuffleDrawOrder || alpha || !background.empty() || !cull.empty();
+  }
 };
 
 /// The checks that need no scene: sizes, ranges, one camera source, --orbit-view within --orbit.
 Result<void> checkSceneRequest(const SceneRequest& request, Spelling spelling = Spelling::Cli);
 
-/// The draw order, alpha and background overrides, applied to a loaded scene.
+/// The draw order, alpha, background and cull overrides, applied to a loaded scene (a request
+/// that passed checkSceneRequest).
 void applyToScene(const SceneRequest& request, Scene& scene);
 
 /// The views to render and, with --orbit-view I > 0, view I - 1 of the orbit (the frame before
