@@ -132,7 +132,7 @@ void main() {
       store = false;
     }
   }
-  const uvec2 node = uvec2(floatBitsToUint(depth), shade(f, base));
+  const uint depthBits = floatBitsToUint(depth);
   uint first = p * uK, k = uK, storeKind = uStore;
   if (uPerPixel != 0u) {
     const uvec2 a = texelFetch(uAlloc, f.pixel).xy;
@@ -143,11 +143,14 @@ void main() {
   if (store && k == 0u) {  // no slot: rejected
     if (uHybrid == 0u) drop = true;
     store = false;
-  } else if (store && node.x > nodes[first].x) {  // k+ test
+  } else if (store && depthBits > nodes[first].x) {  // k+ test
     atomicAdd(culledKPlus, 1u);
     if (uHybrid == 0u) drop = true;
     store = false;
   }
+  // shaded only when something keeps its colour (the store or the tail): a culled fragment
+  // under kbuffer compositing costs no shading
+  const uvec2 node = uvec2(depthBits, drop ? 0u : shade(f, base));
 #ifdef MFR_INTERLOCK
   // the driver orders the pixel's fragments (outside any control flow, no return before it)
   MFR_INTERLOCK_BEGIN();
