@@ -33,14 +33,14 @@ float srgb8ToLinear(uint code) {
   return uintBitsToFloat(colorTables[kTableLinearBase + code]);
 }
 
-int wrapIndex(int v, int n) {
-  return v >= 0 ? v % n : n - 1 - ((-v - 1) % n);
-}
-
-int texelIndex(float f, int n) {
+// detail::texelIndex: exact below 1e9; beyond, past the edge for clamp, else reduced over the
+// wrap's period (n, 2n mirrored)
+int texelIndex(float f, int n, uint wrap) {
   if (isnan(f) || isinf(f)) return 0;
   if (abs(f) < 1e9) return int(f);
-  precise float r = f - float(n) * trunc(f / float(n));  // fmod (approximately)
+  if (wrap == kTextureWrapClamp) return f < 0.0 ? -1 : n;
+  const float period = float(wrap == kTextureWrapMirror ? 2 * n : n);
+  precise float r = f - period * trunc(f / period);  // fmod (approximately)
   return int(r);
 }
 
@@ -51,16 +51,25 @@ vec4 texel(uint first, int width, int x, int y) {
               srgb8ToLinear((t >> 16) & 0xffu), a);
 }
 
-// bilinear, repeat (detail::sampleTexture)
-vec4 sampleTexture(uint first, int width, int height, vec2 uv) {
+// detail::sampleTexture: bilinear or nearest (the flags word's kMaterialNearest), each axis wrapped
+// by method_math.h's wrapTexel (the flags word's wrap S and wrap T)
+vec4 sampleTexture(uint first, int width, int height, uint flags, vec2 uv) {
+  const uint modeS = (flags >> kMaterialWrapSShift) & kMaterialWrapMask;
+  const uint modeT = (flags >> kMaterialWrapTShift) & kMaterialWrapMask;
+  if ((flags & kMaterialNearest) != 0u) {
+    precise float nx = uv.x * float(width);
+    precise float ny = uv.y * float(height);
+    return texel(first, width, wrapTexel(texelIndex(floor(nx), width, modeS), width, modeS),
+                 wrapTexel(texelIndex(floor(ny), height, modeT), height, modeT));
+  }
   precise float fx = uv.x * float(width) - 0.5;
   precise float fy = uv.y * float(height) - 0.5;
   const float flx = floor(fx), fly = floor(fy);
   precise float ax = fx - flx;
   precise float ay = fy - fly;
-  const int ix = texelIndex(flx, width), iy = texelIndex(fly, height);
-  const int x0 = wrapIndex(ix, width), x1 = wrapIndex(ix + 1, width);
-  const int y0 = wrapIndex(iy, height), y1 = wrapIndex(iy + 1, height);
+  const int ix = texelIndex(flx, width, modeS), iy = texelIndex(fly, height, modeT);
+  const int x0 = wrapTexel(ix, width, modeS), x1 = wrapTexel(ix + 1, width, modeS);
+  const int y0 = wrapTexel(iy, height, modeT), y1 = wrapTexel(iy + 1, height, modeT);
   precise float oax = 1.0 - ax;
   precise float oay = 1.0 - ay;
   precise vec4 top = texel(first, width, x0, y0) * oax + texel(first, width, x1, y0) * ax;
@@ -84,8 +93,8 @@ bool surface(FragmentData f, bool coverageOnly, out vec4 base) {
   const uint texture = materials[m + 4u];
   if (texture != kNoTexture) {
     const vec2 uv = fragmentUv(f);
-    precise vec4 b = base * sampleTexture(texture, int(materials[m + 5u]),
-                                          int(materials[m + 6u]), uv);
+    precise vec4 b = base * sampleTexture(texture, int(materials[m + 5u]), int(materials[m + 6u]),
+                                          materials[m + kMaterialFlagsWord], uv);
     base = b;
   }
   if (needsAlphaTest) {

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -269,27 +270,59 @@ TEST(CullConformance, NegativeScaleTestShowsNoRedCrossUnderAuto) {
               static_cast<unsigned long long>(all), static_cast<unsigned long long>(culled));
 }
 
+/// The triangles of `full` whose material is one of `names`.
+mfr::Scene onlyMaterials(const mfr::Scene& full, const std::vector<std::string>& names) {
+  mfr::Scene part = full;
+  part.indices.clear();
+  part.triangleMaterial.clear();
+  for (size_t t = 0; t < full.triangleCount(); ++t) {
+    const std::string& name = full.materials[full.triangleMaterial[t]].name;
+    if (std::find(names.begin(), names.end(), name) == names.end()) continue;
+    part.indices.insert(part.indices.end(), full.indices.begin() + 3 * t,
+                        full.indices.begin() + 3 * t + 3);
+    part.triangleMaterial.push_back(full.triangleMaterial[t]);
+  }
+  return part;
+}
+
 // README (TextureSettingsTest): the "single-sided" row's test tile shows its back face: culled,
-// the tile behind it (a check mark) shows. Only that row and the double-sided one are judged: the
-// sampler rows (clamp, mirror) need the wrap modes mfr does not read yet.
+// the tile behind it (a check mark) shows. The sampler rows: test_texture_sampler.cpp.
 TEST(CullConformance, TextureSettingsTestSidedRowsShowNoRedCross) {
   MFR_SHARED_SCENE(path, "khronos-conformance/TextureSettingsTest/glTF/TextureSettingsTest.gltf");
   const mfr::Scene full = mfr::loadScene(path.string()).value();
-  mfr::Scene sided = full;
-  sided.indices.clear();
-  sided.triangleMaterial.clear();
-  for (size_t t = 0; t < full.triangleCount(); ++t) {
-    const std::string& name = full.materials[full.triangleMaterial[t]].name;
-    if (name != "SingleSidedMaterial" && name != "DoubleSidedMaterial") continue;
-    sided.indices.insert(sided.indices.end(), full.indices.begin() + 3 * t,
-                         full.indices.begin() + 3 * t + 3);
-    sided.triangleMaterial.push_back(full.triangleMaterial[t]);
-  }
+  mfr::Scene sided = onlyMaterials(full, {"SingleSidedMaterial", "DoubleSidedMaterial"});
   ASSERT_GT(sided.triangleCount(), 0u) << "the sided rows' materials are named in the file";
   sided.cull = mfr::CullMode::None;
   EXPECT_GT(redPixels(sided, 160, 160), 10);
   sided.cull = mfr::CullMode::Auto;
   EXPECT_EQ(redPixels(sided, 160, 160), 0);
+}
+
+// README (TextureSettingsTest): the clamp rows' test tiles clamp against a green bar (solid green;
+// repeat or mirror shows a red X), the mirror rows' find the check mark by mirroring (repeat shows
+// a red X, clamp a red block), the repeat rows' by repeating. Each row's test tile alone (its
+// material), the file's samplers, then every texture forced to repeat (the red crosses return).
+TEST(SamplerConformance, TextureSettingsTestSamplerRowsShowNoRedCross) {
+  MFR_SHARED_SCENE(path, "khronos-conformance/TextureSettingsTest/glTF/TextureSettingsTest.gltf");
+  const mfr::Scene full = mfr::loadScene(path.string()).value();
+  int forcedRed = 0;
+  for (const char* row :
+       {"TextureClampMaterialS", "TextureClampMaterialT", "TextureMirrorMaterialS",
+        "TextureMirrorMaterialT", "TextureRepeatMaterialS", "TextureRepeatMaterialT"}) {
+    SCOPED_TRACE(row);
+    mfr::Scene tile = onlyMaterials(full, {row});
+    ASSERT_GT(tile.triangleCount(), 0u) << "the row's material is named in the file";
+    const int red = redPixels(tile, 160, 160);
+    EXPECT_EQ(red, 0);
+    for (mfr::Material& m : tile.materials) m.baseColorSampler = mfr::TextureSampler{};
+    const int redRepeating = redPixels(tile, 160, 160);
+    forcedRed += redRepeating;
+    std::printf(
+        "[ sampler ] TextureSettingsTest %s: %d red pixels (%d with every texture "
+        "repeating)\n",
+        row, red, redRepeating);
+  }
+  EXPECT_GT(forcedRed, 100) << "repeat everywhere shows the crosses the file's samplers avoid";
 }
 
 // TwoSidedPlane: one double-sided textured plane, seen from both sides under auto; back culls it

@@ -171,6 +171,7 @@ std::vector<ShadeMaterial> resolveMaterials(const Scene& scene) {
     s.color = glm::vec3(m.baseColor);
     s.alpha = m.baseColor.a;
     s.texture = m.baseColorTexture >= 0 ? &scene.textures[m.baseColorTexture] : nullptr;
+    s.sampler = m.baseColorSampler;
     s.mode = m.alphaMode;
     s.cutoff = m.alphaCutoff;
     s.cullBack = scene.cullsBackFaces(static_cast<uint32_t>(out.size()));

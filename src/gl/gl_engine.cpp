@@ -163,7 +163,10 @@ Result<void> GlEngine::State::uploadMaterials(const Scene& scene) {
         bits(m.alphaCutoff),
         scene.alphaOverride ? 1u : 0u,
         bits(scene.alphaOverride ? *scene.alphaOverride : 1.0f),
-        scene.cullsBackFaces(index) ? kMaterialCullBack : 0u};
+        (scene.cullsBackFaces(index) ? kMaterialCullBack : 0u) |
+            static_cast<uint32_t>(m.baseColorSampler.wrapS) << kMaterialWrapSShift |
+            static_cast<uint32_t>(m.baseColorSampler.wrapT) << kMaterialWrapTShift |
+            (m.baseColorSampler.filter == TextureFilter::Nearest ? kMaterialNearest : 0u)};
     materialWords.insert(materialWords.end(), words, words + kMaterialWords);
   }
   for (const auto& [name, bytes] :

@@ -443,6 +443,8 @@ class GltfSceneBuilder {
                             const std::string& what);
   uint32_t materialIndex(int gltfMaterial);
   int textureIndex(int gltfTexture);
+  Result<void> readSamplers();
+  TextureSampler samplerOf(int gltfTexture) const;
   Result<void> decodeTextures();
   Result<void> addCameras();
 
@@ -454,8 +456,9 @@ class GltfSceneBuilder {
 
   Scene scene_;
   bool anyUvs_ = false;
-  std::map<int, uint32_t> materialMap_;  // glTF material (-1: default) -> scene material
-  std::map<int, int> imageMap_;          // glTF image -> scene texture
+  std::map<int, uint32_t> materialMap_;   // glTF material (-1: default) -> scene material
+  std::map<int, int> imageMap_;           // glTF image -> scene texture
+  std::vector<TextureSampler> samplers_;  // per glTF sampler (readSamplers)
   std::vector<std::pair<int, glm::dmat4>> cameraNodes_;  // (camera index, node world matrix)
 };
 
@@ -827,6 +830,8 @@ uint32_t GltfSceneBuilder::materialIndex(int gltfMaterial) {
       material.baseColor = glm::vec4(static_cast<float>(factor[0]), static_cast<float>(factor[1]),
                                      static_cast<float>(factor[2]), static_cast<float>(factor[3]));
     material.baseColorTexture = textureIndex(src.pbrMetallicRoughness.baseColorTexture.index);
+    if (material.baseColorTexture >= 0)
+      material.baseColorSampler = samplerOf(src.pbrMetallicRoughness.baseColorTexture.index);
     if (src.alphaMode == "MASK")
       material.alphaMode = AlphaMode::Mask;
     else if (src.alphaMode == "BLEND")
@@ -858,6 +863,57 @@ int GltfSceneBuilder::textureIndex(int gltfTexture) {
   const int index = static_cast<int>(imageMap_.size());
   imageMap_.emplace(image, index);
   return index;
+}
+
+/// The glTF samplers as mfr samples: wrapS and wrapT (REPEAT 10497, CLAMP_TO_EDGE 33071,
+/// MIRRORED_REPEAT 33648; absent: REPEAT) and the filter, magFilter's (NEAREST 9728, LINEAR 9729;
+/// absent: linear). minFilter is checked (9728, 9729, 9984-9987) but not used: mfr takes one sample
+/// per fragment without derivatives and keeps no mip-maps (docs/GLTF.md). Any other value is an
+/// error naming the sampler.
+Result<void> GltfSceneBuilder::readSamplers() {
+  for (size_t i = 0; i < model_.samplers.size(); ++i) {
+    const tinygltf::Sampler& src = model_.samplers[i];
+    const std::string what = "sampler " + std::to_string(i) +
+                             (src.name.empty() ? "" : " (" + quoteInput(src.name) + ")");
+    auto wrap = [&](int value, const char* field) -> Result<TextureWrap> {
+      switch (value) {
+        case -1:
+        case 10497:
+          return TextureWrap::Repeat;
+        case 33071:
+          return TextureWrap::ClampToEdge;
+        case 33648:
+          return TextureWrap::MirroredRepeat;
+        default:
+          return fail(what + ": " + field + " " + std::to_string(value) +
+                      " is not REPEAT (10497), CLAMP_TO_EDGE (33071) or MIRRORED_REPEAT (33648)");
+      }
+    };
+    auto wrapS = wrap(src.wrapS, "wrapS");
+    if (!wrapS) return wrapS.error();
+    auto wrapT = wrap(src.wrapT, "wrapT");
+    if (!wrapT) return wrapT.error();
+    TextureSampler sampler{*wrapS, *wrapT, TextureFilter::Linear};
+    if (src.magFilter == 9728)
+      sampler.filter = TextureFilter::Nearest;
+    else if (src.magFilter != -1 && src.magFilter != 9729)
+      return fail(what + ": magFilter " + std::to_string(src.magFilter) +
+                  " is not NEAREST (9728) or LINEAR (9729)");
+    if (src.minFilter != -1 && src.minFilter != 9728 && src.minFilter != 9729 &&
+        (src.minFilter < 9984 || src.minFilter > 9987))
+      return fail(what + ": minFilter " + std::to_string(src.minFilter) +
+                  " is not NEAREST (9728), LINEAR (9729) or a mipmap filter (9984-9987)");
+    samplers_.push_back(sampler);
+  }
+  return {};
+}
+
+/// The sampler of a glTF texture (readSamplers), the glTF default without one.
+TextureSampler GltfSceneBuilder::samplerOf(int gltfTexture) const {
+  if (gltfTexture < 0 || static_cast<size_t>(gltfTexture) >= model_.textures.size()) return {};
+  const int sampler = model_.textures[static_cast<size_t>(gltfTexture)].sampler;
+  if (sampler < 0 || static_cast<size_t>(sampler) >= samplers_.size()) return {};
+  return samplers_[static_cast<size_t>(sampler)];
 }
 
 uint8_t toByte(const tinygltf::Image& image, size_t component) {
@@ -998,6 +1054,7 @@ Result<Scene> GltfSceneBuilder::build() {
   for (const std::string& extension : model_.extensionsRequired)  // checkReferences, too
     if (!isImplementedExtension(extension))
       return fail("requires extension " + quoteInput(extension) + ", which mfr does not implement");
+  MFR_TRY(readSamplers());
   MFR_TRY(visitNodes());
   MFR_TRY(decodeTextures());
   if (!anyUvs_) scene_.uvs.clear();

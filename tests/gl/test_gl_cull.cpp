@@ -4,7 +4,10 @@
 // pixels, mean LDR-FLIP of the image at most 2e-3). Scenes: closed spheres under --cull back
 // (half the fragments go), hand-made glTF quads of single- and double-sided materials under auto,
 // with and without a mirroring node transform, and the Khronos NegativeScaleTest when the shared
-// scenes are present. Without a GL 4.5 context the tests skip (fail under CI=true).
+// scenes are present. Sampler wrap modes and filters (the same suite, as they share the
+// agreement check): the textured quad of tests/gltf_textured_quad.hpp, texture coordinates from
+// -1.5 to 2.5, under each wrap pair and filter, seen tilted (perspective-correct coordinates), and
+// the Khronos TextureSettingsTest. Without a GL 4.5 context the tests skip (fail under CI=true).
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -19,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "../gltf_quads.hpp"
+#include "../gltf_textured_quad.hpp"
 #include "../shared_scenes.hpp"
 #include "gl_engine_or_skip.hpp"
 #include "mfr/core/image.hpp"
@@ -146,6 +150,26 @@ TEST_P(GlCull, SingleSidedGltfMaterialsMirroredOrNot) {
 TEST_P(GlCull, NegativeScaleTestAgrees) {
   MFR_GL_ENGINE_OR_SKIP(gl, "auto", GetParam());
   MFR_SHARED_SCENE(path, "khronos-conformance/NegativeScaleTest/glTF/NegativeScaleTest.gltf");
+  const Scene scene = loadScene(path.string()).value();
+  expectAgreement(*gl, GetParam(), scene, frameBounds(sceneBounds(scene)), 96, 64);
+}
+
+TEST_P(GlCull, SamplerWrapModesAndFiltersAgree) {
+  MFR_GL_ENGINE_OR_SKIP(gl, "auto", GetParam());
+  for (const int filter : {9728, 9729})
+    for (const auto& [wrapS, wrapT] :
+         {std::pair{10497, 33071}, {33071, 33648}, {33648, 10497}, {33648, 33648}}) {
+      SCOPED_TRACE(std::to_string(wrapS) + " " + std::to_string(wrapT) + " filter " +
+                   std::to_string(filter));
+      const json sampler = {{"wrapS", wrapS}, {"wrapT", wrapT}, {"magFilter", filter}};
+      const Scene scene = loadText("sampler.gltf", mfr::test::texturedQuadGltf(&sampler));
+      expectAgreement(*gl, GetParam(), scene, tilted(), 80, 48);
+    }
+}
+
+TEST_P(GlCull, TextureSettingsTestAgrees) {
+  MFR_GL_ENGINE_OR_SKIP(gl, "auto", GetParam());
+  MFR_SHARED_SCENE(path, "khronos-conformance/TextureSettingsTest/glTF/TextureSettingsTest.gltf");
   const Scene scene = loadScene(path.string()).value();
   expectAgreement(*gl, GetParam(), scene, frameBounds(sceneBounds(scene)), 96, 64);
 }

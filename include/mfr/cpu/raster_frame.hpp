@@ -43,6 +43,7 @@ struct ShadeMaterial {
   glm::vec3 color{1.0f};  // linear base colour
   float alpha = 1.0f;     // material alpha (factor, after transmission folding)
   const Texture* texture = nullptr;
+  TextureSampler sampler;  // the material's baseColorSampler
   AlphaMode mode = AlphaMode::Opaque;
   float cutoff = 0.5f;
   bool alphaOverridden = false;

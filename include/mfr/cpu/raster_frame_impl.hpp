@@ -12,6 +12,7 @@
 #include <tbb/task_arena.h>
 
 #include "mfr/core/color.hpp"
+#include "mfr/method/method_math.h"
 
 namespace mfr {
 
@@ -61,31 +62,51 @@ inline int64_t ceilDivPositive(int64_t a, int64_t b) {  // a > 0, b > 0
   return q;
 }
 
-/// Bilinear sample with repeat wrapping; returns linear RGB and alpha.
-inline glm::vec4 sampleTexture(const Texture& tex, glm::vec2 uv) {
+static_assert(static_cast<uint32_t>(TextureWrap::Repeat) == method_math::kTextureWrapRepeat &&
+              static_cast<uint32_t>(TextureWrap::ClampToEdge) == method_math::kTextureWrapClamp &&
+              static_cast<uint32_t>(TextureWrap::MirroredRepeat) ==
+                  method_math::kTextureWrapMirror);
+
+/// The integer part of a texel coordinate (floored) before wrapping: exact for |f| < 1e9; beyond,
+/// any value past the edge for clamp, else f reduced exactly by fmod over the wrap's period (n, 2n
+/// mirrored) so the conversion cannot overflow; 0 for NaN and infinities.
+inline int texelIndex(float f, int n, TextureWrap wrap) {
+  if (!std::isfinite(f)) return 0;
+  if (std::abs(f) < 1e9f) return static_cast<int>(f);
+  if (wrap == TextureWrap::ClampToEdge) return f < 0.0f ? -1 : n;
+  const int period = wrap == TextureWrap::MirroredRepeat ? 2 * n : n;
+  return static_cast<int>(std::fmod(f, static_cast<float>(period)));
+}
+
+/// One sample of `tex` at `uv` by `sampler`: bilinear (texel centres at half-integers, the four
+/// neighbours wrapped) or nearest (the texel containing uv), each axis wrapped by
+/// method_math::wrapTexel; returns linear RGB and alpha.
+inline glm::vec4 sampleTexture(const Texture& tex, const TextureSampler& sampler, glm::vec2 uv) {
   const ColorTables& t = ColorTables::get();
-  const float fx = uv.x * static_cast<float>(tex.width) - 0.5f;
-  const float fy = uv.y * static_cast<float>(tex.height) - 0.5f;
-  const float flx = std::floor(fx), fly = std::floor(fy);
-  const float ax = fx - flx, ay = fy - fly;
-  auto wrap = [](long v, int n) {  // the common case, uv in [0, 1), without a division
-    return v >= 0 && v < n ? static_cast<int>(v) : static_cast<int>(((v % n) + n) % n);
-  };
-  // uvs far outside [0, 1] (any finite float a file holds) wrap exactly with fmod before the
-  // conversion, which would overflow a long
-  auto texelIndex = [](float f, int n) -> long {
-    if (!std::isfinite(f)) return 0;
-    return static_cast<long>(std::abs(f) < 1e9f ? f : std::fmod(f, static_cast<float>(n)));
-  };
-  const long ix = texelIndex(flx, tex.width);
-  const long iy = texelIndex(fly, tex.height);
-  const int x0 = wrap(ix, tex.width), x1 = x0 + 1 == tex.width ? 0 : x0 + 1;
-  const int y0 = wrap(iy, tex.height), y1 = y0 + 1 == tex.height ? 0 : y0 + 1;
+  const auto modeS = static_cast<uint32_t>(sampler.wrapS);
+  const auto modeT = static_cast<uint32_t>(sampler.wrapT);
   auto texel = [&](int x, int y) {
     const uint8_t* p = &tex.rgba[(static_cast<size_t>(y) * tex.width + x) * 4];
     return glm::vec4(t.srgb8ToLinear[p[0]], t.srgb8ToLinear[p[1]], t.srgb8ToLinear[p[2]],
                      static_cast<float>(p[3]) * (1.0f / 255.0f));
   };
+  if (sampler.filter == TextureFilter::Nearest) {
+    const float fx = std::floor(uv.x * static_cast<float>(tex.width));
+    const float fy = std::floor(uv.y * static_cast<float>(tex.height));
+    return texel(
+        method_math::wrapTexel(texelIndex(fx, tex.width, sampler.wrapS), tex.width, modeS),
+        method_math::wrapTexel(texelIndex(fy, tex.height, sampler.wrapT), tex.height, modeT));
+  }
+  const float fx = uv.x * static_cast<float>(tex.width) - 0.5f;
+  const float fy = uv.y * static_cast<float>(tex.height) - 0.5f;
+  const float flx = std::floor(fx), fly = std::floor(fy);
+  const float ax = fx - flx, ay = fy - fly;
+  const int ix = texelIndex(flx, tex.width, sampler.wrapS);
+  const int iy = texelIndex(fly, tex.height, sampler.wrapT);
+  const int x0 = method_math::wrapTexel(ix, tex.width, modeS);
+  const int x1 = method_math::wrapTexel(ix + 1, tex.width, modeS);
+  const int y0 = method_math::wrapTexel(iy, tex.height, modeT);
+  const int y1 = method_math::wrapTexel(iy + 1, tex.height, modeT);
   const glm::vec4 top = glm::mix(texel(x0, y0), texel(x1, y0), ax);
   const glm::vec4 bottom = glm::mix(texel(x0, y1), texel(x1, y1), ax);
   return glm::mix(top, bottom, ay);
@@ -104,7 +125,7 @@ template <ShadeMode Mode>
   if (m.texture != nullptr) {
     const float invQ = 1.0f / (t.invW[0] * l0 + t.invW[1] * l1 + t.invW[2] * l2);
     const glm::vec2 uv = (t.uvW[0] * l0 + t.uvW[1] * l1 + t.uvW[2] * l2) * invQ;
-    base *= detail::sampleTexture(*m.texture, uv);
+    base *= detail::sampleTexture(*m.texture, m.sampler, uv);
   }
   if (needsAlphaTest) {
     if (base.a < m.cutoff) return false;

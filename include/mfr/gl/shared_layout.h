@@ -99,10 +99,16 @@ MFR_GL_CONST(uint, kBindAllocOffsets, 7u)       // exclusive prefix sum of k(p) 
 
 // material record (12 uint words; floats as their bits): base colour R, G, B, A; the texture's
 // first texel in the texel buffer (kNoTexture: none), its width, height; alpha mode
-// (mfr::AlphaMode); cutoff; alpha override flag, override value; flags (kMaterialCullBack)
+// (mfr::AlphaMode); cutoff; alpha override flag, override value; flags (kMaterialCullBack, the
+// texture's sampler: wrap S and wrap T as method_math.h's kTextureWrap* in 2 bits each at
+// kMaterialWrapSShift and kMaterialWrapTShift, kMaterialNearest)
 MFR_GL_CONST(uint, kMaterialWords, 12u)
 MFR_GL_CONST(uint, kMaterialFlagsWord, 11u)
-MFR_GL_CONST(uint, kMaterialCullBack, 1u)  // flag: back faces culled (mfr::Scene::cullsBackFaces)
+MFR_GL_CONST(uint, kMaterialCullBack, 1u)    // flag: back faces culled (mfr::Scene::cullsBackFaces)
+MFR_GL_CONST(uint, kMaterialWrapSShift, 1u)  // mfr::TextureSampler::wrapS
+MFR_GL_CONST(uint, kMaterialWrapTShift, 3u)  // mfr::TextureSampler::wrapT
+MFR_GL_CONST(uint, kMaterialWrapMask, 3u)
+MFR_GL_CONST(uint, kMaterialNearest, 32u)  // flag: TextureFilter::Nearest (else bilinear)
 MFR_GL_CONST(uint, kNoTexture, 0xffffffffu)
 MFR_GL_CONST(uint, kAlphaOpaque, 0u)  // mfr::AlphaMode values
 MFR_GL_CONST(uint, kAlphaMask, 1u)

@@ -111,6 +111,11 @@ MFR_MATH_CONST(uint, kSplitMixKeepShift, 40u)  // the top 24 of 64 bits
 // 2^25 at 16384 pixels; the set-up clamps NDC to kGuardBandMaxNdc (C++ part below)
 MFR_MATH_CONST(float, kGuardBand, 8.0f)
 
+// Texture wrap modes (mfr::TextureWrap's values; glTF REPEAT, CLAMP_TO_EDGE, MIRRORED_REPEAT)
+MFR_MATH_CONST(uint, kTextureWrapRepeat, 0u)
+MFR_MATH_CONST(uint, kTextureWrapClamp, 1u)
+MFR_MATH_CONST(uint, kTextureWrapMirror, 2u)
+
 // ---- per-side primitives -----------------------------------------------------------------------
 #ifdef __cplusplus
 inline constexpr double kGuardBandMaxNdc = kGuardBand * 1.001;  // raster.geom: uniform uMaxNdc
@@ -433,6 +438,20 @@ MFR_MATH_FN float importanceNoiseTerm(float lambda, float xi) {
 MFR_MATH_FN float importanceCombine(float iper, float id, float ifr, float noise) {
   MFR_PRECISE float v = iper * id * ifr + noise;
   return v > 0.0f ? v : 0.0f;
+}
+
+// ---- texture sampling -------------------------------------------------------------------------
+
+/// Texel index v (any int of magnitude below 2^30) of an axis of n texels wrapped into [0, n) by
+/// `mode` (kTextureWrap*): repeat takes v mod n; clamp to edge takes the nearest of 0 and n - 1;
+/// mirrored repeat runs 0..n-1 then n-1..0 (period 2n), as GL's MIRRORED_REPEAT. The CPU engine's
+/// detail::sampleTexture and raster_common.glsl's sampleTexture both call this.
+MFR_MATH_FN int wrapTexel(int v, int n, uint mode) {
+  if (v >= 0 && v < n) return v;
+  if (mode == kTextureWrapClamp) return v < 0 ? 0 : n - 1;
+  const int period = mode == kTextureWrapMirror ? 2 * n : n;
+  const int r = v >= 0 ? v % period : period - 1 - ((-v - 1) % period);
+  return r < n ? r : period - 1 - r;
 }
 
 #ifdef __cplusplus

@@ -18,17 +18,32 @@ namespace mfr {
 enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
 
 /// RGBA8 texture, rows top to bottom, colour channels sRGB-encoded (glTF base colour convention),
-/// alpha linear. Sampled bilinearly with repeat wrapping.
+/// alpha linear. How it is sampled is the referencing material's TextureSampler.
 struct Texture {
   int width = 0;
   int height = 0;
   std::vector<uint8_t> rgba;  // width * height * 4
 };
 
+/// glTF sampler wrap modes per axis (values: method_math.h's kTextureWrap*, shared by both
+/// engines).
+enum class TextureWrap : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
+/// Filter of the one sample a fragment takes (no derivatives, no mip-maps: docs/GLTF.md).
+enum class TextureFilter : uint8_t { Linear, Nearest };
+
+/// A texture reference's sampler (glTF attaches it to the texture): wrap in u (S) and v (T),
+/// filter. The glTF defaults: repeat, linear.
+struct TextureSampler {
+  TextureWrap wrapS = TextureWrap::Repeat;
+  TextureWrap wrapT = TextureWrap::Repeat;
+  TextureFilter filter = TextureFilter::Linear;
+};
+
 struct Material {
   std::string name;
-  glm::vec4 baseColor{1.0f};  // linear RGB, alpha factor
-  int baseColorTexture = -1;  // index into Scene::textures, or -1
+  glm::vec4 baseColor{1.0f};        // linear RGB, alpha factor
+  int baseColorTexture = -1;        // index into Scene::textures, or -1
+  TextureSampler baseColorSampler;  // how baseColorTexture is sampled
   AlphaMode alphaMode = AlphaMode::Blend;
   float alphaCutoff = 0.5f;  // AlphaMode::Mask only
   /// KHR_materials_transmission: set when the material declares transmission; the loader folds it
