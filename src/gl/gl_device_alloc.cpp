@@ -47,7 +47,7 @@ Result<GlAllocationTotals> GlEngine::State::allocateK(FrameBuffers& fb, GLuint t
                                                       GLuint importance, GLuint total,
                                                       StoreChoice store,
                                                       std::vector<GlPassTime>* passes) {
-  const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(width) * height);
+  const uint32_t pixels = this->pixels();
   const uint64_t groups = (uint64_t{pixels} + kResolveGroupSize - 1) / kResolveGroupSize;
   deviceCapacity = device->make("k(p)", uint64_t{pixels} * 4);
   deviceReserved = device->make("k(p) allocated", uint64_t{pixels} * 4);
@@ -116,7 +116,7 @@ Result<std::vector<float>> GlEngine::dkbImportance(const std::vector<float>& wei
   if (weights.size() != kWeights)
     return makeError("--engine gl: the deep k-buffer's network must be 12-128-64-1 on GL");
   State& s = *state_;
-  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  const uint64_t pixels = s.pixels();
   std::map<std::string, uint64_t> ledger;
   FrameBuffers fb(&ledger);
   const GLuint acc = fb.make("features", pixels * kDkbAccWords * 4);
@@ -170,13 +170,13 @@ Result<std::vector<float>> GlEngine::dkbImportance(const std::vector<float>& wei
   });
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
     return makeError("--engine gl: the deep k-buffer's importance failed (GL error " +
-                     std::to_string(e) + ")");
+                     glErrorText(e) + ")");
   return out;
 }
 
 Result<CountSummary> GlEngine::countOnDevice(std::vector<GlPassTime>* passes) {
   State& s = *state_;
-  const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
+  const uint32_t pixels = s.pixels();
   s.deviceLedger.clear();
   s.device = std::make_unique<FrameBuffers>(&s.deviceLedger);
   s.deviceCapacity = s.deviceReserved = s.deviceWords = s.deviceImportance = s.deviceNearest = 0;
@@ -237,7 +237,7 @@ Result<GlAllocationTotals> GlEngine::allocateByImportance(const ImportanceParams
                                                           std::vector<GlPassTime>* passes) {
   State& s = *state_;
   if (!s.device) return makeError("--engine gl: allocateByImportance before countOnDevice");
-  const uint32_t pixels = static_cast<uint32_t>(static_cast<uint64_t>(s.width) * s.height);
+  const uint32_t pixels = s.pixels();
   const uint64_t groups = (uint64_t{pixels} + kResolveGroupSize - 1) / kResolveGroupSize;
   std::map<std::string, uint64_t> ledger;
   FrameBuffers fb(&ledger);
@@ -314,7 +314,7 @@ Result<GlAllocationTotals> GlEngine::allocateByImportance(const ImportanceParams
 Result<Allocation> GlEngine::readDeviceAllocation() {
   State& s = *state_;
   if (!s.device || !s.deviceWords) return makeError("--engine gl: no allocation on the device");
-  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  const uint64_t pixels = s.pixels();
   std::vector<uint32_t> words(pixels * 2);
   glGetNamedBufferSubData(s.deviceWords, 0, static_cast<GLsizeiptr>(pixels * 8), words.data());
   Allocation a;
@@ -340,7 +340,7 @@ Result<ImportanceMaps> GlEngine::readImportance() {
   State& s = *state_;
   if (!s.device || !s.deviceImportance)
     return makeError("--engine gl: no importance map on the device");
-  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  const uint64_t pixels = s.pixels();
   std::vector<float> words(pixels * kImportanceWords);
   glGetNamedBufferSubData(s.deviceImportance, 0, static_cast<GLsizeiptr>(words.size() * 4),
                           words.data());

@@ -301,7 +301,7 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
 
 Result<std::vector<uint32_t>> GlEngine::count() {
   State& s = *state_;
-  const uint64_t pixels = static_cast<uint64_t>(s.width) * s.height;
+  const uint64_t pixels = s.pixels();
   std::map<std::string, uint64_t> ledger;
   FrameBuffers fb(&ledger);
   const GLuint counts = fb.make("counts", pixels * 4);
@@ -314,7 +314,7 @@ Result<std::vector<uint32_t>> GlEngine::count() {
   std::vector<uint32_t> n(pixels);
   glGetNamedBufferSubData(counts, 0, static_cast<GLsizeiptr>(pixels * 4), n.data());
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
-    return makeError("--engine gl: the count pass failed (GL error " + std::to_string(e) + ")");
+    return makeError("--engine gl: the count pass failed (GL error " + glErrorText(e) + ")");
   return n;
 }
 

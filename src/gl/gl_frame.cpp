@@ -4,7 +4,6 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
-#include <cstdio>
 #include <vector>
 
 #include "gl/gl_state.hpp"
@@ -387,10 +386,8 @@ struct GlEngine::State::FrameRun {
   Result<void> checkErrors() {
     const MethodDesc& method = plan.method;
     if (const GLenum e = glGetError(); e != GL_NO_ERROR) {
-      char buf[16];
-      std::snprintf(buf, sizeof buf, "%x", e);
       if (fb.failure) return *fb.failure;
-      return makeError("--engine gl: " + method.name + " failed (GL error 0x" + buf + ")");
+      return makeError("--engine gl: " + method.name + " failed (GL error " + glErrorText(e) + ")");
     }
     if (fb.failure) return *fb.failure;
     return {};
@@ -482,8 +479,8 @@ Result<RenderPlan> GlEngine::State::planRender(const MethodDesc& method,
       plan.k = *method.k;
       break;
   }
-  if (uint64_t{plan.pixels} * largestPerPixelBytes(plan) > maxBlockBytes)
-    return tooLarge(method, "per-pixel", uint64_t{plan.pixels} * largestPerPixelBytes(plan));
+  const uint64_t perPixelBytes = uint64_t{plan.pixels} * largestPerPixelBytes(plan);
+  if (perPixelBytes > maxBlockBytes) return tooLarge(method, "per-pixel", perPixelBytes);
   if (plan.perPixel && plan.allocSlots * kNodeBytes > maxBlockBytes)  // (keeps uint offsets exact)
     return tooLarge(method, "node", plan.allocSlots * kNodeBytes);
   return plan;
