@@ -249,6 +249,8 @@ CaptureCounters runCapture(const RasterFrame& frame, const Allocation& alloc,
     const ShadingInputs inputs = frame.shadingInputs();
     std::vector<CaptureCounters> perTile(static_cast<size_t>(frame.tileCount()));
     frame.forEachTile([&](int tile) {
+      // a tile no triangle reaches has nothing to capture: skip its per-pixel cull depths
+      if (frame.tileBegin(tile) == frame.tileEnd(tile)) return;
       thread_local std::vector<int32_t> cullDepth;  // reused by the worker's tiles
       if constexpr (Hybrid) {
         LaneHybridSink<Occupancy, KPlus> sink{{alloc, occupancy, stores, {}}, std::move(cullDepth)};

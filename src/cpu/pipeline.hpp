@@ -3,10 +3,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <map>
 #include <memory>
+#include <new>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <typeinfo>
 #include <vector>
 
@@ -76,6 +79,35 @@ class UninitializedBuffer {
   size_t size_ = 0;
 };
 
+/// Fixed-size array of zero bytes from calloc: a large one comes as fresh pages the kernel zeroes
+/// when first touched, so the pixels no fragment reaches cost neither a clear nor a page (a hybrid
+/// tail per pixel is 20 MB at 1024x1024). T must be trivially copyable, all-zero bytes its value.
+template <class T>
+class ZeroedBuffer {
+  static_assert(std::is_trivially_copyable_v<T>);
+
+ public:
+  void allocate(size_t n) {
+    data_.reset();
+    size_ = 0;
+    if (n == 0) return;
+    data_.reset(static_cast<T*>(std::calloc(n, sizeof(T))));
+    if (!data_) throw std::bad_alloc();
+    size_ = n;
+  }
+  T& operator[](size_t i) { return data_.get()[i]; }
+  const T& operator[](size_t i) const { return data_.get()[i]; }
+  size_t size() const { return size_; }
+  uint64_t bytes() const { return static_cast<uint64_t>(size_) * sizeof(T); }
+
+ private:
+  struct Free {
+    void operator()(T* p) const { std::free(p); }
+  };
+  std::unique_ptr<T, Free> data_;
+  size_t size_ = 0;
+};
+
 /// A peer method's buffer (peer_method.hpp): its Slots, one per pixel or k(p) per pixel, of the
 /// type the method names, value-initialised (each Slot's own defaults) by assign.
 class PeerBuffer {
@@ -104,9 +136,9 @@ struct Stores {
   UninitializedBuffer<FragmentNode> nodes;
   std::vector<uint32_t> counts;
   std::vector<uint32_t> locks;
-  std::vector<HybridTail> tails;  // empty unless hybrid
-  PeerBuffer peer;                // the peer method's accumulators or nodes (peer_methods.cpp)
-  bool peerHoldsNodes = false;    // the peer buffer holds nodes (mlab), not accumulators
+  ZeroedBuffer<HybridTail> tails;  // empty unless hybrid
+  PeerBuffer peer;                 // the peer method's accumulators or nodes (peer_methods.cpp)
+  bool peerHoldsNodes = false;     // the peer buffer holds nodes (mlab), not accumulators
 };
 
 /// The instruction set capture() runs this method on (what the statistics report as "isa").

@@ -88,9 +88,15 @@ ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method, const Alloc
                  detail::Stores& stores, glm::vec3 background) {
   if (detail::isPeerRule(method.compositing))
     return detail::resolvePeer(frame, method, alloc, stores, background);
-  ImageRGB image(frame.width(), frame.height());
   const bool hybrid = method.compositing == Compositing::Hybrid;
+  // a pixel no fragment reached (no node, an empty tail) shows the rule's empty composite: the
+  // same bits as compositing it, without the sort and the blend. The image starts as that colour,
+  // so a tile no triangle reaches is never visited (most of a sparse view).
+  const glm::vec3 empty = hybrid ? compositeHybrid(nullptr, 0, HybridTail{}, background)
+                                 : compositeKBuffer(nullptr, 0, background);
+  ImageRGB image(frame.width(), frame.height(), empty);
   frame.forEachTile([&](int tile) {
+    if (frame.tileBegin(tile) == frame.tileEnd(tile)) return;
     FragmentNode small[detail::kSortNetworkSize];
     std::vector<FragmentNode> large;  // pixels above the network's size; grows once per tile
     const TileRect r = frame.tileRect(tile);
@@ -98,6 +104,7 @@ ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method, const Alloc
       for (int x = r.x0; x <= r.x1; ++x) {
         const size_t p = static_cast<size_t>(y) * frame.width() + x;
         const uint32_t n = stores.counts[p];
+        if (n == 0 && (!hybrid || stores.tails[p].count == 0)) continue;
         const FragmentNode* sorted =
             detail::sortNodes(stores.nodes.data() + alloc.offsets[p], n, small, large);
         image.pixels[p] = hybrid ? compositeHybrid(sorted, n, stores.tails[p], background)
@@ -300,11 +307,11 @@ void clearStores(const MethodDesc& method, const RenderOptions& options, const A
     std::fill(stores.nodes.data(), stores.nodes.data() + alloc.slots, FragmentNode{0});
   stores.counts.assign(pixels, 0);
   if (options.capture == CaptureMode::FragmentParallel) stores.locks.assign(pixels, 0);
-  if (method.compositing == Compositing::Hybrid) stores.tails.assign(pixels, HybridTail{});
+  if (method.compositing == Compositing::Hybrid) stores.tails.allocate(pixels);
   ledger.addBytes("nodes", stores.nodes.size() * sizeof(FragmentNode));
   ledger.add("counters", stores.counts);
   ledger.add("locks", stores.locks);
-  ledger.add("tail", stores.tails);
+  ledger.addBytes("tail", stores.tails.bytes());
   ledger.addBytes(stores.peerHoldsNodes ? "nodes" : "accumulators", stores.peer.bytes());
 }
 
