@@ -16,7 +16,7 @@ if [[ $# -gt 0 && $1 != -* ]]; then
 fi
 out=bench-results
 plots="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/plots"
-benches=(abuffer k_sweep occupancy capture_modes isa presets dkb engines)
+benches=(abuffer k_sweep occupancy capture_modes isa presets dkb frame_costs engines)
 
 mkdir -p "$out"
 status=0
