@@ -1,16 +1,25 @@
-// Moment-based OIT, pass 2 (mfr::MboitPixel::addColor / mboitTransmittance: method_math.h's
-// mboitTransmittance and mboitAddColor): the transmittance in front of the fragment reconstructed
-// from the pixel's moments (biased Hankel system in double, the canonical 3-point distribution,
+// Moment-based OIT, pass 2 (mfr::MboitPixel::addColor / mboitTransmittance and
+// mfr::PowerMomentPixel::addColor: method_math.h's mboitTransmittance, mboitTransmittancePower
+// and mboitAddColor): the transmittance in front of the fragment reconstructed from the pixel's
+// N moments (biased Hankel system in double, the canonical N/2 + 1 point distribution,
 // kMboitOverestimation), then T a c and T a added to the pixel's accumulator under the spin-lock.
 // GLSL has no double exp: the final exp is float (method_math.h's doubleExp).
 layout(std430, binding = kBindAccum) coherent buffer Accum {
-  float accum[];  // kMboitWords per pixel
+  float accum[];  // kMboitWordsBase + N per pixel (mboit_moments.frag)
 };
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
+uniform uint uMomentCount;  // N: 4, 6 or 8
 
 float transmittance(uint i, float z) {
-  return mboitTransmittance(accum[i], accum[i + 1u], accum[i + 2u], accum[i + 3u], accum[i + 4u],
-                            z, kMboitBias, kMboitOverestimation);
+  if (uMomentCount == 4u)
+    return mboitTransmittance(accum[i], accum[i + 1u], accum[i + 2u], accum[i + 3u],
+                              accum[i + 4u], z, kMboitBias, kMboitOverestimation);
+  float m[kMboitMaxMoments];
+  for (uint j = 0u; j < uint(kMboitMaxMoments); ++j)
+    m[j] = j < uMomentCount ? accum[i + 1u + j] : 0.0;
+  const int count = int(uMomentCount);
+  return mboitTransmittancePower(count, accum[i], m, z, mboitPowerBias(count),
+                                 kMboitOverestimation);
 }
 
 void main() {
@@ -23,19 +32,20 @@ void main() {
   const uint rgba = shade(f, base);
   precise float a = float(rgba >> 24) * uInv255;
   if (a <= 0.0) return;
-  const uint i = kMboitWords * uint(f.pixel);
+  const uint i = (kMboitWordsBase + uMomentCount) * uint(f.pixel);
   precise float ta = transmittance(i, mboitWarpDepth(depth)) * a;  // the moments are final (pass 1)
   const vec3 c = vec3(srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
                       srgb8ToLinear((rgba >> 16) & 0xffu));
   bool done = false;
   while (!done) {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
-      float r = accum[i + 5u], g = accum[i + 6u], b = accum[i + 7u], sumA = accum[i + 8u];
+      const uint o = i + 1u + uMomentCount;  // the colour accumulators after the moments
+      float r = accum[o], g = accum[o + 1u], b = accum[o + 2u], sumA = accum[o + 3u];
       mboitAddColor(r, g, b, sumA, c, ta);
-      accum[i + 5u] = r;
-      accum[i + 6u] = g;
-      accum[i + 7u] = b;
-      accum[i + 8u] = sumA;
+      accum[o] = r;
+      accum[o + 1u] = g;
+      accum[o + 2u] = b;
+      accum[o + 3u] = sumA;
       memoryBarrierBuffer();
       imageAtomicExchange(uLocks, f.pixel, kLockFree);
       done = true;

@@ -3,8 +3,9 @@
 layout(local_size_x = kResolveGroupSize) in;
 
 layout(std430, binding = kBindAccum) readonly buffer Accum {
-  float accum[];  // kMboitWords per pixel
+  float accum[];  // kMboitWordsBase + N per pixel (mboit_moments.frag)
 };
+uniform uint uMomentCount;  // N: 4, 6 or 8
 layout(std430, binding = kBindImage) writeonly buffer Image {
   float image[];  // linear RGB, 3 floats per pixel
 };
@@ -15,9 +16,10 @@ void main() {
   const uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
   const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
   if (p >= uPixels) return;
-  const uint i = kMboitWords * p;
-  const vec3 result = mboitComposite(accum[i], vec3(accum[i + 5u], accum[i + 6u], accum[i + 7u]),
-                                     accum[i + 8u], uBackground);
+  const uint i = (kMboitWordsBase + uMomentCount) * p;
+  const uint o = i + 1u + uMomentCount;
+  const vec3 result = mboitComposite(accum[i], vec3(accum[o], accum[o + 1u], accum[o + 2u]),
+                                     accum[o + 3u], uBackground);
   image[3u * p + 0u] = result.r;
   image[3u * p + 1u] = result.g;
   image[3u * p + 2u] = result.b;

@@ -58,8 +58,9 @@ void expectThreadIndependent(const std::string& preset, const std::string& compo
     if (!peer) {
       EXPECT_EQ(j["compositing"], composite);
     }
-    // wboit and mboit lose no fragment (all are accumulated); mlab merges
-    if (preset != "abuffer" && preset != "wboit" && preset != "mboit") {
+    // wboit and the mboit family lose no fragment (all are accumulated); mlab merges
+    if (preset != "abuffer" &&
+        methodPreset(preset).value().allocation != AllocationPolicy::NoNodes) {
       EXPECT_GT(j["fragments_lost"].get<uint64_t>(), 0u) << preset << ": nothing overflows";
     }
     const std::string bytes = readBytes(png);

@@ -35,8 +35,13 @@ std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const 
                                                      uint64_t pixels, bool parallel,
                                                      uint64_t abufferFragments) {
   std::map<std::string, uint64_t> b;
-  if (m.allocation == AllocationPolicy::NoNodes) {  // wboit / mboit: accumulators, no nodes
-    b["accumulators"] = (m.compositing == Compositing::WeightedBlended ? 20 : 36) * pixels;
+  if (m.allocation == AllocationPolicy::NoNodes) {  // wboit, mboit*: accumulators, no nodes
+    // documented: wboit 20 B, mboit 36 B, mboit6 44 B, mboit8 52 B per pixel
+    const uint64_t perPixel = m.compositing == Compositing::WeightedBlended ? 20
+                              : m.compositing == Compositing::MomentBased6  ? 44
+                              : m.compositing == Compositing::MomentBased8  ? 52
+                                                                            : 36;
+    b["accumulators"] = perPixel * pixels;
     b["counters"] = 4 * pixels;  // the CPU engine's count of accumulated fragments
     b["k"] = 4 * pixels;
     b["offsets"] = 8 * pixels;
@@ -116,7 +121,8 @@ TEST(MemoryMeasured, BytesAllocatedFollowTheDocumentedCpuLayoutForEveryPreset) {
           }
           ++checked;
         }
-  constexpr int kPeers = 3;  // wboit, mboit, mlab: one rule, no +occupancy, both capture modes
+  // wboit, mboit, mboit6, mboit8, mlab: one rule, no +occupancy, both capture modes
+  constexpr int kPeers = 5;
   EXPECT_EQ(checked,
             4 * (1 + 2 * (static_cast<int>(presetNames().size()) - 1 - kPeers)) + 2 * kPeers);
 }

@@ -7,6 +7,8 @@
 #include <exception>
 #include <new>
 
+#include <unistd.h>
+
 #include "commands.hpp"
 #include "mfr/core/quote.hpp"
 #ifdef MFR_HAS_GL
@@ -102,5 +104,11 @@ int main(int argc, char** argv) {
   // past the file-size limit (ulimit -f) write() fails with EFBIG, reported as an error, instead
   // of SIGXFSZ killing the process silently
   std::signal(SIGXFSZ, SIG_IGN);
+  // stdout (--json, the summary) into a file or pipe is held in one 1 MiB buffer, so that a write
+  // error surfaces in finishStdout with its errno: an automatic flush of stdio's default 4 KiB
+  // buffer would fail mid-output and leave nothing to name the reason. A terminal keeps its
+  // line buffering.
+  static char stdoutBuffer[1 << 20];
+  if (!::isatty(STDOUT_FILENO)) std::setvbuf(stdout, stdoutBuffer, _IOFBF, sizeof stdoutBuffer);
   return finishStdout(run(argc, argv));
 }

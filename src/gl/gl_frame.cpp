@@ -10,6 +10,7 @@
 #include "mfr/gl/gl_engine.hpp"
 #include "mfr/gl/gl_technique.hpp"
 #include "mfr/gl/shared_layout.h"
+#include "mfr/method/mboit.hpp"
 
 namespace mfr::gl {
 namespace {
@@ -43,6 +44,11 @@ bool fragmentNodes(GlTechnique t) {
   return false;
 }
 
+// the moment technique's floats per pixel: b0, N moments, four accumulators (shared_layout.h)
+uint32_t mboitWords(const MethodDesc& m) {
+  return kMboitWordsBase + static_cast<uint32_t>(mboitMomentCount(m.compositing));
+}
+
 // bytes per pixel of the frame's largest per-pixel buffer (each must fit one storage block)
 uint64_t largestPerPixelBytes(const RenderPlan& p) {
   const uint64_t occupancy = static_cast<uint64_t>(std::max(p.method.occupancyWords, 0)) * 4;
@@ -55,7 +61,7 @@ uint64_t largestPerPixelBytes(const RenderPlan& p) {
     case GlTechnique::Wboit:
       return std::max<uint64_t>(12, kWboitWords * 4);
     case GlTechnique::Mboit:
-      return std::max<uint64_t>(12, kMboitWords * 4);
+      return std::max<uint64_t>(12, mboitWords(p.method) * 4);
     case GlTechnique::Mlab:
       return std::max<uint64_t>(12, uint64_t{p.k} * kMlabWords * 4);
   }
@@ -142,7 +148,7 @@ struct GlEngine::State::FrameRun {
   void captureAccumulators() {
     const uint32_t pixels = plan.pixels;
     const bool isWboit = plan.technique == GlTechnique::Wboit;
-    const uint32_t accumWords = isWboit ? kWboitWords : kMboitWords;
+    const uint32_t accumWords = isWboit ? kWboitWords : mboitWords(plan.method);
     accum = fb.make("accumulators", uint64_t{pixels} * accumWords * 4);
     {  // wboit: revealage 1, the rest 0
       std::vector<float> init(uint64_t{pixels} * accumWords, 0.0f);
@@ -158,6 +164,9 @@ struct GlEngine::State::FrameRun {
       } else {
         glUseProgram(program);
       }
+      if (!isWboit)
+        glProgramUniform1ui(program, loc(program, "uMomentCount"),
+                            static_cast<GLuint>(mboitMomentCount(plan.method.compositing)));
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       fb.bindImage(locks, kBindLocks);
       s.drawScene();
@@ -340,7 +349,11 @@ struct GlEngine::State::FrameRun {
   void resolveAccumulators(ProgramId program) {
     image = fb.make("image", uint64_t{plan.pixels} * 12);
     pass("resolve", [&] {
-      useResolve(s.program(program));
+      const GLuint p = s.program(program);
+      useResolve(p);
+      if (program == ProgramId::MboitResolve)
+        glProgramUniform1ui(p, loc(p, "uMomentCount"),
+                            static_cast<GLuint>(mboitMomentCount(plan.method.compositing)));
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
       dispatchPixels();

@@ -24,8 +24,8 @@ constexpr GlTechniqueInfo kTechniques[] = {
      "wboit_resolve.comp", "accumulators 20 B + lock 4 B", "wboit"},
     {GlTechnique::Mboit, "mboit",
      "moments (accumulate) -> capture (colour, reconstructed transmittance) -> resolve",
-     "mboit_moments.frag, mboit_color.frag", "mboit_resolve.comp", "accumulators 36 B + lock 4 B",
-     "mboit"},
+     "mboit_moments.frag, mboit_color.frag", "mboit_resolve.comp",
+     "accumulators 36 B (4 moments), 44 B (6), 52 B (8) + lock 4 B", "mboit, mboit6, mboit8"},
     {GlTechnique::Mlab, "mlab", "capture (insert, merge the two farthest when full) -> resolve",
      "mlab.frag", "mlab_resolve.comp", "k nodes of 20 B + node count 4 B + lock 4 B", "mlab"},
 };
@@ -80,6 +80,8 @@ std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
       return std::nullopt;
     case Compositing::WeightedBlended:
     case Compositing::MomentBased:
+    case Compositing::MomentBased6:
+    case Compositing::MomentBased8:
       if (m.allocation != AllocationPolicy::NoNodes || m.store != StoreChoice::None ||
           m.occupancyWords != 0)
         return std::nullopt;

@@ -63,8 +63,10 @@ MFR_GL_CONST(uint, kBindNearest, 0u)
 // weighted blended OIT: per pixel sum C w (r, g, b), sum a w, revealage (mfr::WboitPixel)
 MFR_GL_CONST(uint, kWboitWords, 5u)
 MFR_GL_CONST(uint, kBindAccum, 2u)
-// moment-based OIT: per pixel b0, b1..b4, then sum T a c (r, g, b), sum T a (mfr::MboitPixel)
+// moment-based OIT: per pixel b0, b1..bN, then sum T a c (r, g, b), sum T a (mfr::MboitPixel,
+// mfr::PowerMomentPixel): kMboitWords with N = 4, kMboitWordsBase + N for N = 6, 8
 MFR_GL_CONST(uint, kMboitWords, 9u)
+MFR_GL_CONST(uint, kMboitWordsBase, 5u)
 // multi-layer alpha blending: per node depth, premultiplied r, g, b, transmittance (mfr::MlabNode)
 MFR_GL_CONST(uint, kMlabWords, 5u)
 // deep k-buffer: feature accumulators per pixel (n, nearest depth bits and colour, farthest depth

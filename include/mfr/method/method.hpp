@@ -59,6 +59,8 @@ enum class Compositing : uint8_t {
   // The peer methods' own rules (docs/METHODS.md); --composite does not apply to them.
   WeightedBlended,  // wboit: weighted sums and revealage (McGuire & Bavoil 2013), wboit.hpp
   MomentBased,      // mboit: power moments, reconstructed transmittance (Muenstermann 2018)
+  MomentBased6,     // mboit6: the same with 6 power moments (mboit.hpp)
+  MomentBased8,     // mboit8: the same with 8 power moments (mboit.hpp)
   MultiLayerAlpha,  // mlab: front-to-back over of the MultiLayer store's nodes (Salvi 2014)
 };
 

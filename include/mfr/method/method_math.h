@@ -54,11 +54,15 @@ using std::sqrt;
 #define MFR_MATH_CONST(type, name, value) inline constexpr type name = value;
 #define MFR_MATH_FN inline
 #define MFR_INOUT(type) type&
+#define MFR_IN_ARRAY(type, name, n) const type(&name)[n]
+#define MFR_INOUT_ARRAY(type, name, n) type(&name)[n]
 #define MFR_PRECISE
 #else
 #define MFR_MATH_CONST(type, name, value) const type name = value;
 #define MFR_MATH_FN
 #define MFR_INOUT(type) inout type
+#define MFR_IN_ARRAY(type, name, n) type name[n]
+#define MFR_INOUT_ARRAY(type, name, n) inout type name[n]
 #define MFR_PRECISE precise
 #endif
 
@@ -81,6 +85,22 @@ MFR_MATH_CONST(float, kMboitBiasTarget1, 0.0f)
 MFR_MATH_CONST(float, kMboitBiasTarget2, 0.375f)
 MFR_MATH_CONST(float, kMboitBiasTarget3, 0.0f)
 MFR_MATH_CONST(float, kMboitBiasTarget4, 0.375f)
+// MBOIT with 6 and 8 power moments (the paper's sec. 3 generalisation): the bias for float32
+// storage from the paper's supplementary table (6 moments 5e-6, 8 moments 5e-5; 4 moments 5e-7
+// above) and the authors' biasing targets of the normalised even moments (their published shader
+// code, MomentOIT.hlsl, as ported in chrismile/LineVis; the odd moments' targets are 0)
+MFR_MATH_CONST(int, kMboitMaxMoments, 8)
+MFR_MATH_CONST(float, kMboit6Bias, 5e-6f)
+MFR_MATH_CONST(float, kMboit8Bias, 5e-5f)
+MFR_MATH_CONST(float, kMboit6BiasTarget2, 0.48f)
+MFR_MATH_CONST(float, kMboit6BiasTarget4, 0.451f)
+MFR_MATH_CONST(float, kMboit6BiasTarget6, 0.45f)
+MFR_MATH_CONST(float, kMboit8BiasTarget2, 0.75f)
+MFR_MATH_CONST(float, kMboit8BiasTarget4, 0.67666666666666664f)
+MFR_MATH_CONST(float, kMboit8BiasTarget6, 0.63f)
+MFR_MATH_CONST(float, kMboit8BiasTarget8, 0.60030303030303034f)
+// Laguerre's iteration for the support points: at most this many steps per root
+MFR_MATH_CONST(int, kMboitRootIterations, 64)
 // 1e-12 (GLSL has no token pasting for an `lf` suffix: the correctly rounded quotient of exact
 // integers is the same double as the literal)
 MFR_MATH_CONST(double, kMboitTiny, double(1) / (double(1000000) * double(1000000)))
@@ -390,6 +410,168 @@ MFR_MATH_FN vec3 mboitComposite(float b0, vec3 sum, float alphaSum, vec3 backgro
   const float total = exp(-b0);
   MFR_PRECISE vec3 mixed = (1.0f - total) * sum / alphaSum + total * background;
   return mixed;
+}
+
+// ---- moment-based OIT with 2n = 4, 6 or 8 power moments ----------------------------------------
+// The reconstruction of moment shadow mapping generalised as the MBOIT paper does (sec. 3.1): the
+// normalised moments m_0 = 1, m_1..m_2n, biased towards the targets above, form the Hankel matrix
+// B = (m_{i+j}) (n + 1 square); the kernel polynomial c with B c = (1, z, .., z^n) has n real
+// roots z_1..z_n, which with z_0 = z are the support of the canonical representation; the
+// polynomial through (z_0, overestimation) and (z_i, [z_i < z_0]) has the normalised absorbance in
+// front of z as its expectation, sum_j p_j m_j. Everything in double; the roots by Laguerre's
+// method from above the largest (it converges monotonically when every root is real, as here),
+// then deflation. The 4-moment function above is the closed form of the n = 2 case and stays the
+// one mboit calls.
+
+/// The biasing target of normalised moment j (1..count) for `count` (4, 6 or 8) power moments.
+MFR_MATH_FN float mboitBiasTarget(int count, int j) {
+  if (j % 2 == 1) return 0.0f;
+  if (count == 4) return j == 2 ? kMboitBiasTarget2 : kMboitBiasTarget4;
+  if (count == 6)
+    return j == 2 ? kMboit6BiasTarget2 : (j == 4 ? kMboit6BiasTarget4 : kMboit6BiasTarget6);
+  return j == 2
+             ? kMboit8BiasTarget2
+             : (j == 4 ? kMboit8BiasTarget4 : (j == 6 ? kMboit8BiasTarget6 : kMboit8BiasTarget8));
+}
+
+/// The bias for `count` (4, 6 or 8) power moments in float32.
+MFR_MATH_FN float mboitPowerBias(int count) {
+  return count == 4 ? kMboitBias : (count == 6 ? kMboit6Bias : kMboit8Bias);
+}
+
+/// Pass 1 with `count` power moments: b0 += A, moments[j - 1] += A z^j (j = 1..count).
+MFR_MATH_FN void mboitAddPowerMoments(int count, MFR_INOUT(float) b0,
+                                      MFR_INOUT_ARRAY(float, moments, kMboitMaxMoments), float A,
+                                      float z) {
+  MFR_PRECISE float s0 = b0 + A;
+  b0 = s0;
+  MFR_PRECISE float zj = 1.0f;
+  for (int j = 0; j < count; ++j) {
+    MFR_PRECISE float next = zj * z;
+    zj = next;
+    MFR_PRECISE float sj = moments[j] + A * zj;
+    moments[j] = sj;
+  }
+}
+
+/// Transmittance in front of the warped depth z from b0 and moments b_1..b_count (count 4, 6 or 8;
+/// not normalised), with the given bias and overestimation.
+MFR_MATH_FN float mboitTransmittancePower(int count, float b0,
+                                          MFR_IN_ARRAY(float, moments, kMboitMaxMoments), float z,
+                                          float bias, float overestimation) {
+  if (b0 <= 0.0f) return 1.0f;
+  const int n = count / 2;
+  const double beta = double(bias);
+  // normalised, biased moments m[0..count]
+  double m[9];
+  m[0] = 1.0;
+  for (int j = 1; j <= count; ++j)
+    m[j] = (1.0 - beta) * (double(moments[j - 1]) / double(b0)) +
+           beta * double(mboitBiasTarget(count, j));
+  // LDL^T of the Hankel matrix B = (m[i + j]), forward and back substitution of B c = (1, .., z^n)
+  const double z0 = double(z);
+  double L[25];
+  double D[5];
+  double c[5];
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j < i; ++j) {
+      MFR_PRECISE double v = m[i + j];
+      for (int k = 0; k < j; ++k) v -= L[i * 5 + k] * L[j * 5 + k] * D[k];
+      L[i * 5 + j] = v / D[j];
+    }
+    MFR_PRECISE double d = m[2 * i];
+    for (int k = 0; k < i; ++k) d -= L[i * 5 + k] * L[i * 5 + k] * D[k];
+    D[i] = d;
+  }
+  MFR_PRECISE double power = 1.0;
+  for (int i = 0; i <= n; ++i) {
+    MFR_PRECISE double v = power;
+    for (int k = 0; k < i; ++k) v -= L[i * 5 + k] * c[k];
+    c[i] = v;
+    power *= z0;
+  }
+  for (int i = 0; i <= n; ++i) c[i] /= D[i];
+  for (int i = n; i >= 0; --i)
+    for (int k = i + 1; k <= n; ++k) c[i] -= L[k * 5 + i] * c[k];
+  // the support: z0, then the n roots of c (largest first)
+  double x[5];
+  double f[5];
+  x[0] = z0;
+  f[0] = double(overestimation);
+  double a[5];
+  for (int i = 0; i <= n; ++i) a[i] = c[i];
+  int degree = n;
+  for (int r = 1; r <= n; ++r) {
+    MFR_PRECISE double root;
+    if (degree == 1) {
+      root = -a[0] / a[1];
+    } else {
+      // Cauchy's bound: every root lies below it
+      MFR_PRECISE double bound = 0.0;
+      for (int i = 0; i < degree; ++i) bound = max(bound, abs(a[i] / a[degree]));
+      root = 1.0 + bound;
+      const double dd = double(degree);
+      for (int it = 0; it < kMboitRootIterations; ++it) {
+        MFR_PRECISE double value = a[degree];
+        MFR_PRECISE double slope = 0.0;
+        MFR_PRECISE double curve = 0.0;
+        for (int i = degree - 1; i >= 0; --i) {
+          curve = curve * root + slope;
+          slope = slope * root + value;
+          value = value * root + a[i];
+        }
+        if (value == 0.0) break;
+        MFR_PRECISE double G = slope / value;
+        MFR_PRECISE double H = G * G - 2.0 * curve / value;
+        MFR_PRECISE double s = sqrt(max(0.0, (dd - 1.0) * (dd * H - G * G)));
+        MFR_PRECISE double den = G >= 0.0 ? G + s : G - s;
+        if (den == 0.0) break;
+        MFR_PRECISE double step = dd / den;
+        root -= step;
+        if (abs(step) <= kMboitTiny * max(1.0, abs(root))) break;
+      }
+      // deflate: a / (x - root)
+      MFR_PRECISE double carry = a[degree];
+      for (int i = degree - 1; i >= 0; --i) {
+        MFR_PRECISE double next = a[i] + carry * root;
+        a[i] = carry;
+        carry = next;
+      }
+    }
+    x[r] = root;
+    f[r] = root < z0 ? 1.0 : 0.0;
+    degree -= 1;
+  }
+  // separate coincident support points (as the 4-moment closed form does)
+  for (int i = 1; i <= n; ++i) {
+    if (abs(x[i] - z0) < kMboitTiny) x[i] = f[i] > 0.5 ? z0 - kMboitTiny : z0 + kMboitTiny;
+    for (int k = 1; k < i; ++k)
+      if (abs(x[i] - x[k]) < kMboitTiny) x[i] = x[k] - kMboitTiny;
+  }
+  // Newton's divided differences, then the monomial coefficients p of the interpolant
+  double dv[5];
+  for (int i = 0; i <= n; ++i) dv[i] = f[i];
+  for (int level = 1; level <= n; ++level)
+    for (int i = n; i >= level; --i) dv[i] = (dv[i] - dv[i - 1]) / (x[i] - x[i - level]);
+  double poly[5];
+  for (int i = 0; i <= n; ++i) poly[i] = 0.0;
+  poly[0] = dv[n];
+  for (int k = n - 1; k >= 0; --k) {
+    // poly = poly (x - x_k) + dv[k], low coefficients first (the coefficients above the degree
+    // are 0; Mesa 22.3's llvmpipe miscompiled the high-first loop `i = n - k .. 1`: 0 in every
+    // coefficient but the constant)
+    MFR_PRECISE double carry = dv[k];
+    for (int i = 0; i <= n; ++i) {
+      MFR_PRECISE double old = poly[i];
+      poly[i] = carry - x[k] * old;
+      carry = old;
+    }
+  }
+  MFR_PRECISE double absorbance = 0.0;
+  for (int j = 0; j <= n; ++j) absorbance += poly[j] * m[j];
+  MFR_PRECISE double t = doubleExp(-double(b0) * absorbance);
+  if (!isFiniteDouble(t)) return 1.0f;
+  return float(clamp(t, 0.0, 1.0));
 }
 
 // ---- importance (variable k-buffer) ------------------------------------------------------------
