@@ -21,9 +21,11 @@
 //   no slots (k == 0):    0           (nothing passes)
 // so "passes the early k+ test" is (depth bits < cull depth), one signed compare.
 //
-// A tile whose triangles all have untextured, non-masked materials takes the wide path (their
-// alpha test cannot reject, so testing before the surface is the scalar order, and the base colour
-// is the material's); any other tile runs the scalar rasterizeTile on the same sink.
+// A tile whose triangles all have untextured, non-masked materials and no vertex colours takes the
+// wide path (their alpha test cannot reject, so testing before the surface is the scalar order,
+// and the base colour is the material's, constant over the triangle); any other tile runs the
+// scalar rasterizeTile on the same sink, so textured, masked and vertex-coloured triangles give
+// the scalar path's bits by construction.
 #pragma once
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -285,8 +287,9 @@ MFR_TARGET_AVX2 void rasterizeTileAvx2(const RasterFrame& frame, const ShadingIn
   const TileRect r = frame.tileRect(tile);
   sink.beginTile(r, frame.tileSize());
   for (const uint32_t* it = frame.tileBegin(tile); it != frame.tileEnd(tile); ++it) {
-    const ShadeMaterial& m = (*in.materials)[frame.setups()[*it].material];
-    if (m.texture != nullptr || m.mode == AlphaMode::Mask) {
+    const TriangleSetup& t = frame.setups()[*it];
+    const ShadeMaterial& m = (*in.materials)[t.material];
+    if (m.texture != nullptr || m.mode == AlphaMode::Mask || t.hasColor) {
       frame.rasterizeTile<ShadeMode::Full>(tile, sink);
       return;
     }
