@@ -88,9 +88,12 @@ Scene mixedMaterialScene(int size) {
 }
 
 // The mixed scene with vertex colours on every other rectangle (some corners white, alpha below 1
-// on some): tiles with coloured triangles go to the scalar loop, the others stay wide.
+// on some), its masked and textured materials made plain blended ones: every tile takes the wide
+// path, coloured triangles (blended and opaque) included.
 Scene vertexColorScene(int size) {
   Scene s = mixedMaterialScene(size);
+  s.materials[5].alphaMode = AlphaMode::Blend;
+  s.materials[8].baseColorTexture = -1;
   s.colors.assign(s.positions.size(), glm::vec4(1.0f));
   for (size_t v = 0; v < s.colors.size(); ++v)
     if ((v / 6) % 2 == 1)  // two triangles of 3 vertices per rectangle
