@@ -172,6 +172,7 @@ inline Camera vertexColorTilted() {
 struct QuadHit {
   glm::dvec2 point;
   double cosine;
+  double viewDepth;  // distance along the view direction (what the near plane cuts)
 };
 inline QuadHit hitQuad(const Camera& c, int px, int py, int width, int height) {
   const glm::dvec3 eye(c.eye), forward = glm::normalize(glm::dvec3(c.target) - eye);
@@ -183,19 +184,27 @@ inline QuadHit hitQuad(const Camera& c, int px, int py, int width, int height) {
   const glm::dvec3 dir = forward + right * (nx * t * aspect) + up * (ny * t);
   const double s = -eye.z / dir.z;
   const glm::dvec3 p = eye + s * dir;
-  return {{p.x, p.y}, std::abs(dir.z) / glm::length(dir)};
+  return {{p.x, p.y}, std::abs(dir.z) / glm::length(dir), glm::dot(p - eye, forward)};
 }
 
 /// The expected linear colour of pixel (px, py): factor x colour(x) at the surface point, lit by
 /// the headlight 0.2 + 0.8 |n.v|, over `background` by factor alpha x colour alpha (MASK: kept
 /// where that alpha >= 0.5, opaque; OPAQUE: alpha 1). False for pixels not to compare: off the
-/// quad or within 0.02 of its edge, and (MASK) within 0.03 of the cutoff.
+/// quad or within 0.02 of its edge, (MASK) within 0.03 of the cutoff, and within 0.02 of the
+/// camera's near plane when it sets one (nearer: the background).
 inline bool expectedQuadPixel(const Camera& camera, int px, int py, int width, int height,
                               const Rgba& left, const Rgba& right, const Rgba& factor,
                               const std::string& alphaMode, const glm::dvec3& background,
                               glm::dvec3& out) {
   const QuadHit hit = hitQuad(camera, px, py, width, height);
   if (std::abs(hit.point.x) > 0.98 || std::abs(hit.point.y) > 0.98) return false;
+  if (camera.zNear > 0.0f) {
+    if (std::abs(hit.viewDepth - camera.zNear) < 0.02) return false;
+    if (hit.viewDepth < camera.zNear) {
+      out = background;
+      return true;
+    }
+  }
   const double s = (hit.point.x + 1.0) / 2.0;
   Rgba c;
   for (int i = 0; i < 4; ++i) c[i] = left[i] + (right[i] - left[i]) * s;

@@ -138,6 +138,20 @@ INSTANTIATE_TEST_SUITE_P(Formats, VertexColors,
                                            ColorFormat::Unorm8Rgba, ColorFormat::Unorm16Rgb),
                          [](const auto& info) { return std::string(toString(info.param)); });
 
+// The near plane cuts the tilted quad: the clipped polygon's new corners get colours interpolated
+// along its edges (the clipper's), which must continue the same linear colour.
+TEST(VertexColorAlpha, ClippedAtTheNearPlane) {
+  mfr::Camera camera = tilted();
+  camera.zNear = 2.6f;
+  camera.zFar = 10.0f;
+  const Rgba factor{0.9, 1.0, 0.8, 0.75};
+  const mfr::Scene scene =
+      loadText(mfr::test::vertexColorQuadGltf(ColorFormat::FloatRgba, kLeft, kRight,
+                                              material(factor, "BLEND")))
+          .value();
+  EXPECT_GT(expectColors(scene, camera, kLeft, kRight, factor, "BLEND"), 800);
+}
+
 // Vertex alpha takes part in the MASK test: alpha 1 at x = -1 to 0 at x = 1 cuts the quad at x = 0.
 TEST(VertexColorAlpha, MaskCutoffSeesTheVertexAlpha) {
   const Rgba left{0.2, 0.4, 1.0, 1.0}, right{0.9, 0.1, 0.3, 0.0}, factor{1.0, 1.0, 1.0, 1.0};

@@ -149,6 +149,20 @@ TEST_P(GlVertexColors, MaskCutoffSeesTheVertexAlpha) {
   EXPECT_GT(expectColors(g.out, tilted, left, right, factor, "MASK"), 800);
 }
 
+// The near plane cuts the tilted quad: the geometry shader's clipper interpolates the colours as
+// the CPU engine's does.
+TEST_P(GlVertexColors, ClippedAtTheNearPlane) {
+  MFR_GL_ENGINE_OR_SKIP(gl, "auto", GetParam());
+  Camera camera = mfr::test::vertexColorTilted();
+  camera.zNear = 2.6f;
+  camera.zFar = 10.0f;
+  const Rgba factor{0.9, 1.0, 0.8, 0.75};
+  const Scene scene = loadText(mfr::test::vertexColorQuadGltf(
+      ColorFormat::FloatRgba, kLeft, kRight, mfr::test::vertexColorMaterial(factor, "BLEND")));
+  const Rendered g = expectAgreement(*gl, GetParam(), scene, camera, kSize, kSize);
+  EXPECT_GT(expectColors(g.out, camera, kLeft, kRight, factor, "BLEND"), 800);
+}
+
 TEST_P(GlVertexColors, WhiteColorsRenderAsNoColors) {
   MFR_GL_ENGINE_OR_SKIP(gl, "auto", GetParam());
   const Rgba white{1.0, 1.0, 1.0, 1.0};
