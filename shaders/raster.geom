@@ -6,6 +6,8 @@
 // so GL's own rasterizer covers the same pixel centres) with its set-up as flat outputs, from
 // which the fragment shader recomputes the exact integer edge functions and barycentrics.
 layout(triangles) in;
+// 21 vertices x 46 output components (gl_Position 4, gX..gV 27, gC0..gC2 12, gInvArea, gTopLeft,
+// gMaterial) = 966, within GL 4.5's minimum GL_MAX_GEOMETRY_TOTAL_OUTPUT_COMPONENTS of 1024
 layout(triangle_strip, max_vertices = 21) out;
 
 in VertexData {
