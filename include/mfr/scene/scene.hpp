@@ -59,7 +59,7 @@ struct Scene {
 
   std::vector<glm::vec3> positions;  // world space
   std::vector<glm::vec3> normals;    // per vertex, same size as positions (loaders fill flat ones)
-  std::vector<glm::vec2> uvs;        // empty, or same size as positions
+  std::vector<glm::vec2> uvs;  // empty, or same size as positions (KHR_texture_transform applied)
   /// Vertex colours (glTF COLOR_0, PLY red/green/blue/alpha): empty, or one per vertex, linear
   /// RGB and alpha, multiplied into the base colour and alpha. A triangle whose three colours are
   /// all exactly white is shaded without them (hasVertexColor), so a scene without colours and the
