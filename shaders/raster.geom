@@ -6,12 +6,15 @@
 // so GL's own rasterizer covers the same pixel centres) with its set-up as flat outputs, from
 // which the fragment shader recomputes the exact integer edge functions and barycentrics.
 layout(triangles) in;
+// 21 vertices x 46 output components (gl_Position 4, gX..gV 27, gC0..gC2 12, gInvArea, gTopLeft,
+// gMaterial) = 966, within GL 4.5's minimum GL_MAX_GEOMETRY_TOTAL_OUTPUT_COMPONENTS of 1024
 layout(triangle_strip, max_vertices = 21) out;
 
 in VertexData {
   vec4 clip;
   vec3 normal;
   vec2 uv;
+  vec4 color;
 } vIn[];
 
 uniform ivec2 uSize;
@@ -33,8 +36,11 @@ flat out vec3 gN1;
 flat out vec3 gN2;
 flat out vec3 gU;  // uv / w
 flat out vec3 gV;
+flat out vec4 gC0;  // vertex colour / w of each vertex
+flat out vec4 gC1;
+flat out vec4 gC2;
 flat out float gInvArea;
-flat out uint gTopLeft;
+flat out uint gTopLeft;  // edge flags, and kTopLeftHasColor: Scene::hasVertexColor
 flat out uint gMaterial;
 
 // kGuardBand: method_math.h (the CPU set-up's)
@@ -60,11 +66,13 @@ float planeDistance(vec4 c, int plane) {
 vec4 pc[kMaxClipVertices];
 vec3 pn[kMaxClipVertices];
 vec2 puv[kMaxClipVertices];
+vec4 pcol[kMaxClipVertices];
 
 int clipPolygon(int count, uint planes) {
   vec4 tc[kMaxClipVertices];
   vec3 tn[kMaxClipVertices];
   vec2 tuv[kMaxClipVertices];
+  vec4 tcol[kMaxClipVertices];
   for (int plane = 0; plane < 6 && count > 0; ++plane) {
     if ((planes & (1u << uint(plane))) == 0u) continue;
     int outCount = 0;
@@ -76,6 +84,7 @@ int clipPolygon(int count, uint planes) {
         tc[outCount] = pc[i];
         tn[outCount] = pn[i];
         tuv[outCount] = puv[i];
+        tcol[outCount] = pcol[i];
         ++outCount;
       }
       if ((da >= 0.0) != (db >= 0.0)) {
@@ -86,9 +95,11 @@ int clipPolygon(int count, uint planes) {
         precise vec4 c = pc[i] * omt + pc[j] * t;
         precise vec3 n = pn[i] * omt + pn[j] * t;
         precise vec2 uv = puv[i] * omt + puv[j] * t;
+        precise vec4 col = pcol[i] * omt + pcol[j] * t;
         tc[outCount] = c;
         tn[outCount] = n;
         tuv[outCount] = uv;
+        tcol[outCount] = col;
         ++outCount;
       }
     }
@@ -97,6 +108,7 @@ int clipPolygon(int count, uint planes) {
       pc[i] = tc[i];
       pn[i] = tn[i];
       puv[i] = tuv[i];
+      pcol[i] = tcol[i];
     }
   }
   return count;
@@ -118,12 +130,13 @@ int floorDiv256(int a) {
   return a >= 0 ? a / 256 : -((-a + 255) / 256);
 }
 
-void setupAndEmit(int i0, int i1, int i2, uint material) {
+void setupAndEmit(int i0, int i1, int i2, uint material, bool hasColor) {
   int idx[3] = int[3](i0, i1, i2);
   int x[3], y[3];
   float z[3], invW[3];
   vec3 nW[3];
   vec2 uvW[3];
+  vec4 colW[3];
   for (int i = 0; i < 3; ++i) {
     const vec4 c = pc[idx[i]];
     precise double iw = 1.0lf / double(c.w);
@@ -143,6 +156,8 @@ void setupAndEmit(int i0, int i1, int i2, uint material) {
     precise vec2 uv = puv[idx[i]] * invW[i];
     nW[i] = n;
     uvW[i] = uv;
+    precise vec4 col = pcol[idx[i]] * invW[i];
+    colW[i] = col;
   }
   precise double area = double(x[1] - x[0]) * double(y[2] - y[0]) -
                         double(y[1] - y[0]) * double(x[2] - x[0]);
@@ -159,6 +174,7 @@ void setupAndEmit(int i0, int i1, int i2, uint material) {
     tf = invW[1]; invW[1] = invW[2]; invW[2] = tf;
     vec3 t3 = nW[1]; nW[1] = nW[2]; nW[2] = t3;
     vec2 t2 = uvW[1]; uvW[1] = uvW[2]; uvW[2] = t2;
+    vec4 t4 = colW[1]; colW[1] = colW[2]; colW[2] = t4;
     area = -area;
   }
   precise double inv = 1.0lf / area;
@@ -169,6 +185,7 @@ void setupAndEmit(int i0, int i1, int i2, uint material) {
     const int dx = x[b] - x[a], dy = y[b] - y[a];
     if ((dy == 0 && dx > 0) || dy < 0) topLeft |= 1u << uint(i);
   }
+  if (hasColor) topLeft |= kTopLeftHasColor;
   const int minX = max(0, ceilDiv256(min(x[0], min(x[1], x[2])) - 128));
   const int minY = max(0, ceilDiv256(min(y[0], min(y[1], y[2])) - 128));
   const int maxX = min(uSize.x - 1, floorDiv256(max(x[0], max(x[1], x[2])) - 128));
@@ -189,6 +206,9 @@ void setupAndEmit(int i0, int i1, int i2, uint material) {
     gN2 = nW[2];
     gU = vec3(uvW[0].x, uvW[1].x, uvW[2].x);
     gV = vec3(uvW[0].y, uvW[1].y, uvW[2].y);
+    gC0 = colW[0];
+    gC1 = colW[1];
+    gC2 = colW[2];
     gInvArea = invArea;
     gTopLeft = topLeft;
     gMaterial = material;
@@ -202,6 +222,7 @@ void main() {
     pc[i] = vIn[i].clip;
     pn[i] = vIn[i].normal;
     puv[i] = vIn[i].uv;
+    pcol[i] = vIn[i].color;
   }
   uint crossed = 0u;
   for (int plane = 0; plane < 6; ++plane) {
@@ -212,5 +233,9 @@ void main() {
   }
   const int count = crossed != 0u ? clipPolygon(3, crossed) : 3;
   const uint material = triMaterial[gl_PrimitiveIDIn];
-  for (int i = 1; i + 1 < count; ++i) setupAndEmit(0, i, i + 1, material);
+  // Scene::hasVertexColor: some corner is not exactly white (the constant white attribute of a
+  // scene without colours never is)
+  bool hasColor = false;
+  for (int i = 0; i < 3; ++i) hasColor = hasColor || any(notEqual(vIn[i].color, vec4(1.0)));
+  for (int i = 1; i + 1 < count; ++i) setupAndEmit(0, i, i + 1, material, hasColor);
 }

@@ -4,6 +4,7 @@
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec2 inUv;
+layout(location = 3) in vec4 inColor;  // linear RGBA; the constant white without vertex colours
 
 uniform mat4 uViewProj;
 uniform mat3 uViewRot;
@@ -12,6 +13,7 @@ out VertexData {
   vec4 clip;
   vec3 normal;  // view space
   vec2 uv;
+  vec4 color;
 } vOut;
 
 void main() {
@@ -30,5 +32,6 @@ void main() {
   vOut.clip = clip;
   vOut.normal = n;
   vOut.uv = inUv;
+  vOut.color = inColor;
   gl_Position = clip;
 }

@@ -1,8 +1,8 @@
 // Shared part of the fragment shaders of the geometry passes, after the raster part
 // (raster_exact.glsl or raster_native.glsl, which define FragmentData, rasterFragment,
-// fragmentMaterial, fragmentBackFacing, fragmentUv, fragmentNormal and fragmentDepth): back-face
-// culling (the native raster's; the exact raster culls at set-up, as the CPU engine), the alpha
-// test, texture sampling and shading of the CPU engine (include/mfr/cpu/raster_frame_impl.hpp),
+// fragmentMaterial, fragmentBackFacing, fragmentUv, fragmentHasColor, fragmentColor,
+// fragmentNormal and fragmentDepth): back-face culling (the native raster's; the exact raster culls
+// at set-up, as the CPU engine), the alpha test, texture sampling, vertex colours and shading of the CPU engine (include/mfr/cpu/raster_frame_impl.hpp),
 // operation for operation and `precise`.
 uniform vec4 uRay;       // view ray of pixel (x, y): (x * ray.x + ray.y, y * ray.z + ray.w, -1)
 uniform float uAmbient;  // kAmbient
@@ -96,6 +96,10 @@ bool surface(FragmentData f, bool coverageOnly, out vec4 base) {
     precise vec4 b = base * sampleTexture(texture, int(materials[m + 5u]), int(materials[m + 6u]),
                                           materials[m + kMaterialFlagsWord], uv);
     base = b;
+  }
+  if (fragmentHasColor()) {  // the vertex colour, after the texture (RasterFrame::surface)
+    precise vec4 c = base * fragmentColor(f);
+    base = c;
   }
   if (needsAlphaTest) {
     if (base.a < uintBitsToFloat(materials[m + 8u])) return false;

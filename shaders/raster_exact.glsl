@@ -12,6 +12,9 @@ flat in vec3 gN1;
 flat in vec3 gN2;
 flat in vec3 gU;
 flat in vec3 gV;
+flat in vec4 gC0;  // vertex colour / w of each vertex (read when gTopLeft has kTopLeftHasColor)
+flat in vec4 gC1;
+flat in vec4 gC2;
 flat in float gInvArea;
 flat in uint gTopLeft;
 flat in uint gMaterial;
@@ -63,6 +66,20 @@ vec2 fragmentUv(FragmentData f) {
   precise vec2 uvq = vec2(gU.x, gV.x) * f.l0 + vec2(gU.y, gV.y) * f.l1 + vec2(gU.z, gV.z) * f.l2;
   precise vec2 uv = uvq * invQ;
   return uv;
+}
+
+// Scene::hasVertexColor of the source triangle (raster.geom's flag, TriangleSetup::hasColor)
+bool fragmentHasColor() {
+  return (gTopLeft & kTopLeftHasColor) != 0u;
+}
+
+// the perspective-correct vertex colour: (sum l_i c_i / w_i) / (sum l_i / w_i), as RasterFrame::surface
+vec4 fragmentColor(FragmentData f) {
+  precise float q = gInvW.x * f.l0 + gInvW.y * f.l1 + gInvW.z * f.l2;
+  precise float invQ = 1.0 / q;
+  precise vec4 cq = gC0 * f.l0 + gC1 * f.l1 + gC2 * f.l2;
+  precise vec4 c = cq * invQ;
+  return c;
 }
 
 // the view-space normal, unnormalised: sum l_i n_i / w_i (the perspective-correct normal times q,

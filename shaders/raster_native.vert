@@ -4,16 +4,19 @@
 layout(location = 0) in vec3 inPosition;
 layout(location = 1) in vec3 inNormal;
 layout(location = 2) in vec2 inUv;
+layout(location = 3) in vec4 inColor;  // linear RGBA; the constant white without vertex colours
 
 uniform mat4 uViewProj;
 uniform mat3 uViewRot;
 
 out vec3 vNormal;  // view space
 out vec2 vUv;
+out vec4 vColor;
 
 void main() {
   const vec4 clip = uViewProj * vec4(inPosition, 1.0);
   gl_Position = vec4(clip.x, -clip.y, clip.z, clip.w);
   vNormal = uViewRot * inNormal;
   vUv = inUv;
+  vColor = inColor;
 }

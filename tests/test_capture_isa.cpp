@@ -87,6 +87,21 @@ Scene mixedMaterialScene(int size) {
   return s;
 }
 
+// The mixed scene with vertex colours on every other rectangle (some corners white, alpha below 1
+// on some), its masked and textured materials made plain blended ones: every tile takes the wide
+// path, coloured triangles (blended and opaque) included.
+Scene vertexColorScene(int size) {
+  Scene s = mixedMaterialScene(size);
+  s.materials[5].alphaMode = AlphaMode::Blend;
+  s.materials[8].baseColorTexture = -1;
+  s.colors.assign(s.positions.size(), glm::vec4(1.0f));
+  for (size_t v = 0; v < s.colors.size(); ++v)
+    if ((v / 6) % 2 == 1)  // two triangles of 3 vertices per rectangle
+      s.colors[v] = glm::vec4(0.2f + 0.1f * static_cast<float>(v % 7), 1.0f - 0.05f * (v % 11),
+                              static_cast<float>(v % 3) * 0.4f, v % 4 == 0 ? 1.0f : 0.6f);
+  return s;
+}
+
 TEST(CaptureIsa, WidePathCapturesWhatTheScalarPathCaptures) {
   if (detectedIsa() == Isa::Scalar) GTEST_SKIP() << "no AVX2 on this CPU: only the scalar path";
   const IsaGuard guard;
@@ -99,6 +114,7 @@ TEST(CaptureIsa, WidePathCapturesWhatTheScalarPathCaptures) {
   cases.push_back({"layers", proceduralScene("layers?k=4&r=2&pd=0.55"), 97, 83});
   cases.push_back({"hairball", proceduralScene("hairball?strands=250"), 80, 72});
   cases.push_back({"mixed materials", mixedMaterialScene(70), 70, 70});
+  cases.push_back({"vertex colours", vertexColorScene(70), 70, 70});
   cases.push_back({"hot pixels", test::hotPixelScene(24, 400, 7), 24, 24});
   for (const Case& c : cases) {
     const Camera camera = c.scene.defaultCamera ? *c.scene.defaultCamera : test::screenCamera();

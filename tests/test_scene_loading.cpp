@@ -689,7 +689,8 @@ TEST_F(SceneLoading, ObjMissingMtlFileFallsBackToOneDefaultMaterial) {
 // ---------------------------------------------------------------------------------------------
 // PLY
 
-TEST_F(SceneLoading, AsciiPlyLoadsWithQuadsTriangulatedAndOneOpaqueGreyMaterial) {
+// (its red vertex colours are the surface's: tests/test_vertex_color_formats.cpp)
+TEST_F(SceneLoading, AsciiPlyLoadsWithQuadsTriangulatedAndOneOpaqueMaterial) {
   const std::string path = dir.write("quad.ply",
                                      "ply\nformat ascii 1.0\ncomment test\n"
                                      "element vertex 5\nproperty float x\nproperty float y\n"
@@ -705,8 +706,10 @@ TEST_F(SceneLoading, AsciiPlyLoadsWithQuadsTriangulatedAndOneOpaqueGreyMaterial)
   EXPECT_EQ(scene->triangleCount(), 3u);
   EXPECT_EQ(scene->vertexCount(), 5u);  // identical vertices joined again
   ASSERT_EQ(scene->materials.size(), 1u);
-  EXPECT_EQ(scene->materials[0].baseColor, glm::vec4(0.8f, 0.8f, 0.8f, 1.0f));
+  EXPECT_EQ(scene->materials[0].baseColor, glm::vec4(1.0f));  // white: the colours are red
   EXPECT_EQ(scene->materials[0].alphaMode, mfr::AlphaMode::Opaque);
+  ASSERT_EQ(scene->colors.size(), 5u);
+  for (const glm::vec4& c : scene->colors) EXPECT_EQ(c, glm::vec4(1.0f, 0.0f, 0.0f, 1.0f));
   for (const glm::vec3& n : scene->normals) EXPECT_NEAR(n.z, 1.0f, 1e-5f);
 }
 

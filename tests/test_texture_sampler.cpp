@@ -24,6 +24,7 @@
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/scene/load.hpp"
+#include "shared_scenes.hpp"
 
 namespace {
 
@@ -89,10 +90,33 @@ glm::dvec3 expected(double u, double v, int wrapS, int wrapT, bool nearest, bool
          (at(x0, y0 + 1) * (1 - ax) + at(x0 + 1, y0 + 1) * ax) * ay;
 }
 
-/// Renders the quad under `sampler` (null: none) and compares every unambiguous pixel with
-/// `expected`; returns how many pixels were compared.
-int expectSamples(const json* sampler, int wrapS, int wrapT, bool nearest) {
-  auto scene = loadText(mfr::test::texturedQuadGltf(sampler));
+/// KHR_texture_transform's uv' = T * R * S * (u, v, 1) with the matrices as the extension's
+/// specification writes them (row-major 3x3), multiplied out here.
+glm::dvec2 transformUv(const json& t, glm::dvec2 uv) {
+  const json offset = t.value("offset", json::array({0.0, 0.0}));
+  const json scale = t.value("scale", json::array({1.0, 1.0}));
+  const double r = t.value("rotation", 0.0);
+  const double T[3][3] = {
+      {1, 0, offset[0].get<double>()}, {0, 1, offset[1].get<double>()}, {0, 0, 1}};
+  const double R[3][3] = {{std::cos(r), std::sin(r), 0}, {-std::sin(r), std::cos(r), 0}, {0, 0, 1}};
+  const double S[3][3] = {
+      {scale[0].get<double>(), 0, 0}, {0, scale[1].get<double>(), 0}, {0, 0, 1}};
+  double TR[3][3] = {}, M[3][3] = {};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) TR[i][j] += T[i][k] * R[k][j];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) M[i][j] += TR[i][k] * S[k][j];
+  return {M[0][0] * uv.x + M[0][1] * uv.y + M[0][2], M[1][0] * uv.x + M[1][1] * uv.y + M[1][2]};
+}
+
+/// Renders the quad of glTF text `gltf` and compares every unambiguous pixel with `expected` at
+/// the quad's texture coordinate, transformed by `transform` (a KHR_texture_transform object;
+/// null: none); returns how many pixels were compared.
+int expectSamplesOf(const std::string& gltf, int wrapS, int wrapT, bool nearest,
+                    const json* transform = nullptr) {
+  auto scene = loadText(gltf);
   EXPECT_TRUE(scene.ok()) << scene.error().message;
   if (!scene.ok()) return 0;
   auto frame = mfr::RasterFrame::build(*scene, headOn(), mfr::RasterOptions{kSize, kSize, 16, 2});
@@ -107,8 +131,9 @@ int expectSamples(const json* sampler, int wrapS, int wrapT, bool nearest) {
     for (int px = 0; px < kSize; ++px) {
       const double x = 2.0 * (px + 0.5) / kSize - 1.0, y = 1.0 - 2.0 * (py + 0.5) / kSize;
       bool ambiguous = false;
-      const glm::dvec3 e =
-          expected(mfr::test::quadU(x), mfr::test::quadV(y), wrapS, wrapT, nearest, ambiguous);
+      glm::dvec2 uv(mfr::test::quadU(x), mfr::test::quadV(y));
+      if (transform) uv = transformUv(*transform, uv);
+      const glm::dvec3 e = expected(uv.x, uv.y, wrapS, wrapT, nearest, ambiguous);
       if (ambiguous) continue;
       ++compared;
       const glm::vec3 got = out->image.at(px, py);
@@ -122,6 +147,11 @@ int expectSamples(const json* sampler, int wrapS, int wrapT, bool nearest) {
     }
   EXPECT_EQ(wrong, 0) << "of " << compared << " pixels";
   return compared;
+}
+
+/// Renders the quad under `sampler` (null: none); see expectSamplesOf.
+int expectSamples(const json* sampler, int wrapS, int wrapT, bool nearest) {
+  return expectSamplesOf(mfr::test::texturedQuadGltf(sampler), wrapS, wrapT, nearest);
 }
 
 json samplerJson(int wrapS, int wrapT, int magFilter) {
@@ -193,6 +223,145 @@ TEST(TextureSamplerDefaults, UnknownEnumIsAOneLineError) {
     EXPECT_NE(message.find(std::string(field) + " " + std::to_string(value)), std::string::npos)
         << message;
     EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+}
+
+// KHR_texture_transform on the base colour texture (issue 24): offset, rotation and scale applied
+// as the extension's T * R * S to the texture coordinates, before the sampler wraps them; its
+// texCoord picks the coordinate set over the texture's own.
+json withTransform(const json* sampler, const json& transform) {
+  json doc = json::parse(mfr::test::texturedQuadGltf(sampler));
+  doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
+      {"KHR_texture_transform", transform}};
+  doc["extensionsUsed"] = {"KHR_texture_transform"};
+  return doc;
+}
+
+TEST(TextureTransform, OffsetRotationScaleAsTheExtensionsMatrix) {
+  const json transform = {{"offset", {0.25, -0.5}}, {"rotation", 0.3}, {"scale", {0.5, 2.0}}};
+  for (const int filter : {kNearest, kLinear}) {
+    SCOPED_TRACE(filter);
+    const json sampler = samplerJson(kRepeat, kMirror, filter);
+    const int compared = expectSamplesOf(withTransform(&sampler, transform).dump(), kRepeat,
+                                         kMirror, filter == kNearest, &transform);
+    EXPECT_GT(compared, filter == kNearest ? 200 : kSize * kSize - 1);
+  }
+  // required by the file: implemented, so loaded
+  json doc = withTransform(nullptr, transform);
+  doc["extensionsRequired"] = {"KHR_texture_transform"};
+  EXPECT_EQ(expectSamplesOf(doc.dump(), kRepeat, kRepeat, false, &transform), kSize * kSize);
+}
+
+TEST(TextureTransform, TexCoordOverridesTheTexturesSet) {
+  const json sampler = samplerJson(kClamp, kRepeat, kLinear);
+  const json transform = {{"texCoord", 1}, {"rotation", -0.7}, {"offset", {0.1, 0.2}}};
+  json doc = withTransform(&sampler, transform);
+  // TEXCOORD_0 all zeros (an accessor without a buffer view), TEXCOORD_1 the quad's coordinates
+  doc["accessors"].push_back({{"componentType", 5126}, {"count", 4}, {"type", "VEC2"}});
+  auto& attributes = doc["meshes"][0]["primitives"][0]["attributes"];
+  attributes["TEXCOORD_1"] = attributes["TEXCOORD_0"];
+  attributes["TEXCOORD_0"] = doc["accessors"].size() - 1;
+  EXPECT_EQ(expectSamplesOf(doc.dump(), kClamp, kRepeat, false, &transform), kSize * kSize);
+  // the texture's own texCoord without the extension's: set 1 as well, untransformed
+  auto& info = doc["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"];
+  info.erase("extensions");
+  info["texCoord"] = 1;
+  EXPECT_EQ(expectSamplesOf(doc.dump(), kClamp, kRepeat, false), kSize * kSize);
+}
+
+TEST(TextureTransform, MalformedFieldsAreOneLineErrors) {
+  for (const json& transform : {json{{"offset", {0.1}}}, json{{"rotation", "half"}},
+                                json{{"scale", {1.0, "two"}}}, json{{"texCoord", -1}}}) {
+    SCOPED_TRACE(transform.dump());
+    json doc = withTransform(nullptr, transform);
+    doc["materials"][0]["name"] = "turned";
+    auto scene = loadText(doc.dump());
+    ASSERT_FALSE(scene.ok());
+    const std::string& message = scene.error().message;
+    EXPECT_NE(message.find(".gltf: material 0"), std::string::npos) << message;
+    EXPECT_NE(message.find("turned"), std::string::npos) << message;
+    EXPECT_NE(message.find("KHR_texture_transform"), std::string::npos) << message;
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  }
+}
+
+// The Khronos TextureTransformTest (README), seen head-on from far away (|n.v| >= 0.998; world
+// (x, y) at pixel ((x / 1.8 + 1) W / 2, (1 - y / 1.2) H / 2)). Top row: uv (0, 0)-(0.5, 0.5)
+// offset by (0.5, 0), (0, 0.5), (0.5, 0.5) shows UV.png's green "U", blue "V" and cyan "UV"
+// quadrants; the yellow crossed circle (offset not applied) must not show. Bottom row: the arrow
+// (black) of the rotation, scale and combined quads must end next to the green "correct" marker,
+// neither the yellow "not supported" nor the red "error" marker (world positions from the file's
+// nodes).
+TEST(TextureTransform, KhronosTextureTransformTest) {
+  MFR_SHARED_SCENE(path, "khronos-conformance/TextureTransformTest/glTF/TextureTransformTest.gltf");
+  const mfr::Scene scene = mfr::loadScene(path.string()).value();
+  constexpr int W = 480, H = 320;
+  mfr::Camera camera;
+  camera.eye = {0.0f, 0.0f, 20.0f};
+  camera.target = {0.0f, 0.0f, 0.0f};
+  camera.fovYDegrees = static_cast<float>(2.0 * glm::degrees(std::atan(1.2 / 20.0)));
+  auto frame = mfr::RasterFrame::build(scene, camera, mfr::RasterOptions{W, H, 16, 2});
+  ASSERT_TRUE(frame.ok()) << frame.error().message;
+  mfr::RenderOptions options;
+  options.background = glm::vec3(1.0f);
+  const mfr::RenderOutput out =
+      mfr::render(*frame, mfr::methodPreset("abuffer").value(), options).value();
+  auto pixelOf = [&](double x, double y) {
+    return glm::ivec2(static_cast<int>(std::floor((x / 1.8 + 1.0) / 2.0 * W)),
+                      static_cast<int>(std::floor((1.0 - y / 1.2) / 2.0 * H)));
+  };
+  // top row: the inner 80% of each quad
+  const double centres[3] = {-1.1, 0.0, 1.1};
+  const glm::bvec3 quadrant[3] = {{false, true, false}, {false, false, true}, {false, true, true}};
+  for (int q = 0; q < 3; ++q) {
+    SCOPED_TRACE("top quad " + std::to_string(q));
+    const glm::ivec2 lo = pixelOf(centres[q] - 0.4, 0.95), hi = pixelOf(centres[q] + 0.4, 0.15);
+    int expected = 0, yellow = 0, total = 0;
+    for (int y = lo.y; y <= hi.y; ++y)
+      for (int x = lo.x; x <= hi.x; ++x) {
+        const glm::vec3 p = out.image.at(x, y);
+        const glm::bvec3 lit(p.r > 0.3f, p.g > 0.3f, p.b > 0.3f);
+        const glm::bvec3 dark(p.r < 0.05f, p.g < 0.05f, p.b < 0.05f);
+        ++total;
+        bool match = true;
+        for (int c = 0; c < 3; ++c) match = match && (quadrant[q][c] ? lit[c] : dark[c]);
+        expected += match;
+        yellow += lit.r && lit.g && dark.b;
+      }
+    EXPECT_EQ(yellow, 0);
+    EXPECT_GT(expected, total / 2) << "of " << total;  // the white checkmark covers the rest
+  }
+  // bottom row: black pixels within 0.22 of each marker's centre (markers 0.1 or 0.15 wide, at
+  // least 0.37 apart)
+  struct Marker {
+    glm::dvec2 at;
+    double size;
+    bool touched;
+  };
+  const Marker markers[] = {
+      {{-1.1 - 0.0790482, -0.55 - 0.5162675}, 0.075, true},   // rotation: correct
+      {{-1.1 + 0.2778175, -0.55 - 0.2778175}, 0.075, false},  // not supported
+      {{-1.1 + 0.5162675, -0.55 + 0.0790482}, 0.075, false},  // error
+      {{0.0185450, -0.55 - 0.0185450}, 0.05, true},           // scale: correct
+      {{0.2778175, -0.55 - 0.2778175}, 0.075, false},         // not supported
+      {{1.1 - 0.07, -0.55 - 0.25}, 0.05, true},               // all: correct
+  };
+  for (const Marker& m : markers) {
+    SCOPED_TRACE("marker at " + std::to_string(m.at.x) + ", " + std::to_string(m.at.y));
+    const double r = 0.22;  // the tip stops up to ~0.1 short of the marker's edge
+    const glm::ivec2 lo = pixelOf(m.at.x - r, m.at.y + r), hi = pixelOf(m.at.x + r, m.at.y - r);
+    int black = 0;
+    for (int y = std::max(lo.y, 0); y <= std::min(hi.y, H - 1); ++y)
+      for (int x = std::max(lo.x, 0); x <= std::min(hi.x, W - 1); ++x) {
+        const double wx = ((x + 0.5) / W * 2.0 - 1.0) * 1.8, wy = (1.0 - (y + 0.5) / H * 2.0) * 1.2;
+        if (glm::length(glm::dvec2(wx, wy) - m.at) > r) continue;
+        const glm::vec3 p = out.image.at(x, y);
+        black += p.r < 0.05f && p.g < 0.05f && p.b < 0.05f;
+      }
+    if (m.touched)
+      EXPECT_GT(black, 3);
+    else
+      EXPECT_EQ(black, 0);
   }
 }
 

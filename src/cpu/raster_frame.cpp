@@ -48,10 +48,12 @@ struct ClipVertex {
   glm::vec4 clip;
   glm::vec3 normal;  // view space
   glm::vec2 uv;
+  glm::vec4 color;  // linear RGBA (white without vertex colours)
 };
 
 ClipVertex lerp(const ClipVertex& a, const ClipVertex& b, float t) {
-  return {glm::mix(a.clip, b.clip, t), glm::mix(a.normal, b.normal, t), glm::mix(a.uv, b.uv, t)};
+  return {glm::mix(a.clip, b.clip, t), glm::mix(a.normal, b.normal, t), glm::mix(a.uv, b.uv, t),
+          glm::mix(a.color, b.color, t)};
 }
 
 // x/y guard band in NDC units: keeps fixed-point window coordinates below 2^25 at 16384 pixels
@@ -103,7 +105,7 @@ struct SetupContext {
 // a back face that `cullBack` drops.
 bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVertex& v1,
                    const ClipVertex& v2, uint32_t prim, uint32_t material, bool cullBack,
-                   TriangleSetup& t) {
+                   TriangleSetup& t, TriangleColors& colors) {
   const ClipVertex* v[3] = {&v0, &v1, &v2};
   // Clipping leaves |x/w|, |y/w| <= kGuardBand up to float rounding; under extreme projections
   // (a field of view of 1e-20 degrees, coordinates near the float range) that rounding is large
@@ -123,6 +125,7 @@ bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVert
     t.invW[i] = static_cast<float>(invW);
     t.normalW[i] = v[i]->normal * t.invW[i];
     t.uvW[i] = v[i]->uv * t.invW[i];
+    colors.colorW[i] = v[i]->color * t.invW[i];
   }
   int64_t area = (static_cast<int64_t>(t.x[1]) - t.x[0]) * (static_cast<int64_t>(t.y[2]) - t.y[0]) -
                  (static_cast<int64_t>(t.y[1]) - t.y[0]) * (static_cast<int64_t>(t.x[2]) - t.x[0]);
@@ -138,6 +141,7 @@ bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVert
     std::swap(t.invW[1], t.invW[2]);
     std::swap(t.normalW[1], t.normalW[2]);
     std::swap(t.uvW[1], t.uvW[2]);
+    std::swap(colors.colorW[1], colors.colorW[2]);
     area = -area;
   }
   t.invArea = static_cast<float>(1.0 / static_cast<double>(area));
@@ -245,6 +249,7 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
         vertices[i].clip = viewProj * glm::vec4(scene.positions[i], 1.0f);
         vertices[i].normal = viewRot * scene.normals[i];
         vertices[i].uv = scene.uvs.empty() ? glm::vec2(0.0f) : scene.uvs[i];
+        vertices[i].color = scene.colors.empty() ? glm::vec4(1.0f) : scene.colors[i];
       }
     });
   });
@@ -255,6 +260,8 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   constexpr size_t kChunk = 8192;
   const size_t chunks = (triangleCount + kChunk - 1) / kChunk;
   std::vector<std::vector<TriangleSetup>> chunkSetups(chunks);
+  const bool sceneColors = !scene.colors.empty();
+  std::vector<std::vector<TriangleColors>> chunkColors(sceneColors ? chunks : 0);
   arena.execute([&] {
     tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
       std::vector<TriangleSetup>& out = chunkSetups[chunk];
@@ -262,6 +269,7 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
       for (size_t tri = chunk * kChunk; tri < end; ++tri) {
         const uint32_t prim = static_cast<uint32_t>(tri);
         const uint32_t material = scene.triangleMaterial[tri];
+        const bool hasColor = scene.hasVertexColor(tri);
         ClipVertex poly[12] = {vertices[scene.indices[tri * 3 + 0]],
                                vertices[scene.indices[tri * 3 + 1]],
                                vertices[scene.indices[tri * 3 + 2]]};
@@ -277,9 +285,13 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
         const int count = crossed ? clipPolygon(poly, 3, crossed) : 3;
         for (int i = 1; i + 1 < count; ++i) {
           TriangleSetup t;
+          TriangleColors colors;
           if (setupTriangle(ctx, poly[0], poly[i], poly[i + 1], prim, material,
-                            frame.materials_[material].cullBack, t))
+                            frame.materials_[material].cullBack, t, colors)) {
+            t.hasColor = hasColor;
             out.push_back(t);
+            if (sceneColors) chunkColors[chunk].push_back(colors);
+          }
         }
       }
     });
@@ -290,6 +302,13 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   for (auto& c : chunkSetups) {
     frame.setups_.insert(frame.setups_.end(), c.begin(), c.end());
     std::vector<TriangleSetup>().swap(c);
+  }
+  if (sceneColors) {
+    frame.colors_.reserve(total);
+    for (auto& c : chunkColors) {
+      frame.colors_.insert(frame.colors_.end(), c.begin(), c.end());
+      std::vector<TriangleColors>().swap(c);
+    }
   }
 
   // binning: count, prefix sum, fill (primitive order within each tile)

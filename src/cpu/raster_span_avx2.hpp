@@ -22,8 +22,10 @@
 // so "passes the early k+ test" is (depth bits < cull depth), one signed compare.
 //
 // A tile whose triangles all have untextured, non-masked materials takes the wide path (their
-// alpha test cannot reject, so testing before the surface is the scalar order, and the base colour
-// is the material's); any other tile runs the scalar rasterizeTile on the same sink.
+// alpha test cannot reject, so testing before the surface is the scalar order; the base colour is
+// the material's, or for a vertex-coloured triangle the material's times the perspective-correct
+// colour, per lane in the scalar operation order); any other tile runs the scalar rasterizeTile
+// on the same sink.
 #pragma once
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -117,6 +119,15 @@ struct LaneShading {
   [[gnu::always_inline]] MFR_TARGET_AVX2 __m256i shade(const ColorTables& tables, __m256 l1,
                                                        __m256 l2, int x, __m256 dy,
                                                        __m256 dySquared, __m256& ndotv) const {
+    return shadeBase(tables, l1, l2, x, dy, dySquared, ndotv, baseR, baseG, baseB, alpha);
+  }
+
+  /// shade() with a base colour and alpha word per lane (vertex colours).
+  [[gnu::always_inline]] MFR_TARGET_AVX2 __m256i shadeBase(const ColorTables& tables, __m256 l1,
+                                                           __m256 l2, int x, __m256 dy,
+                                                           __m256 dySquared, __m256& ndotv,
+                                                           __m256 r, __m256 g, __m256 b,
+                                                           __m256i alphaWord) const {
     const __m256 one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
     const __m256 minusOne = _mm256_set1_ps(-1.0f);
     const __m256 absMask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
@@ -146,13 +157,77 @@ struct LaneShading {
         _mm256_add_ps(ambient, _mm256_mul_ps(diffuse, _mm256_and_ps(ndotv, absMask)));
     return _mm256_or_si256(
         _mm256_or_si256(
-            detail::encodeSrgb8x8(tables, _mm256_mul_ps(baseR, light)),
-            _mm256_slli_epi32(detail::encodeSrgb8x8(tables, _mm256_mul_ps(baseG, light)), 8)),
+            detail::encodeSrgb8x8(tables, _mm256_mul_ps(r, light)),
+            _mm256_slli_epi32(detail::encodeSrgb8x8(tables, _mm256_mul_ps(g, light)), 8)),
         _mm256_or_si256(
-            _mm256_slli_epi32(detail::encodeSrgb8x8(tables, _mm256_mul_ps(baseB, light)), 16),
-            alpha));
+            _mm256_slli_epi32(detail::encodeSrgb8x8(tables, _mm256_mul_ps(b, light)), 16),
+            alphaWord));
   }
 };
+
+/// A vertex-coloured triangle's base colour on 8 lanes, as RasterFrame::surface computes it: the
+/// perspective-correct colour ((c0 l0 + c1 l1) + c2 l2) / ((1/w0 l0 + 1/w1 l1) + 1/w2 l2) times
+/// the material's colour and alpha (alpha 1 when opaque, the override when set: then constant),
+/// the alpha as packFragmentColor's byte.
+struct LaneColors {
+  __m256 invW0, invW1, invW2;
+  __m256 c[3][4];  // vertex i's colour / w, channel
+  __m256 materialR, materialG, materialB, materialA;
+  bool alphaVaries;
+  __m256i constantAlpha;
+
+  [[gnu::always_inline]] MFR_TARGET_AVX2 LaneColors(const TriangleSetup& t,
+                                                    const TriangleColors& colors,
+                                                    const ShadeMaterial& m, uint32_t alphaByte)
+      : invW0(_mm256_set1_ps(t.invW[0])),
+        invW1(_mm256_set1_ps(t.invW[1])),
+        invW2(_mm256_set1_ps(t.invW[2])),
+        materialR(_mm256_set1_ps(m.color.r)),
+        materialG(_mm256_set1_ps(m.color.g)),
+        materialB(_mm256_set1_ps(m.color.b)),
+        materialA(_mm256_set1_ps(m.alpha)),
+        alphaVaries(m.mode != AlphaMode::Opaque && !m.alphaOverridden),
+        constantAlpha(_mm256_set1_epi32(static_cast<int>(alphaByte))) {
+    for (int i = 0; i < 3; ++i)
+      for (int ch = 0; ch < 4; ++ch) c[i][ch] = _mm256_set1_ps(colors.colorW[i][ch]);
+  }
+
+  /// Channel `ch` of the perspective-correct colour.
+  [[gnu::always_inline]] MFR_TARGET_AVX2 __m256 channel(int ch, __m256 l0, __m256 l1, __m256 l2,
+                                                        __m256 invQ) const {
+    const __m256 sum =
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(c[0][ch], l0), _mm256_mul_ps(c[1][ch], l1)),
+                      _mm256_mul_ps(c[2][ch], l2));
+    return _mm256_mul_ps(sum, invQ);
+  }
+
+  /// The base colour (r, g, b) and alpha word of the lanes at barycentrics (l1, l2).
+  [[gnu::always_inline]] MFR_TARGET_AVX2 void base(__m256 l1, __m256 l2, __m256& r, __m256& g,
+                                                   __m256& b, __m256i& alphaWord) const {
+    const __m256 one = _mm256_set1_ps(1.0f);
+    const __m256 l0 = _mm256_sub_ps(_mm256_sub_ps(one, l1), l2);
+    const __m256 q =
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(invW0, l0), _mm256_mul_ps(invW1, l1)),
+                      _mm256_mul_ps(invW2, l2));
+    const __m256 invQ = _mm256_div_ps(one, q);
+    r = _mm256_mul_ps(materialR, channel(0, l0, l1, l2, invQ));
+    g = _mm256_mul_ps(materialG, channel(1, l0, l1, l2, invQ));
+    b = _mm256_mul_ps(materialB, channel(2, l0, l1, l2, invQ));
+    if (!alphaVaries) {
+      alphaWord = constantAlpha;
+      return;
+    }
+    // packFragmentColor's alpha: min(max(a, 0), 1) (NaN -> 0), * 255 + 0.5, truncated, << 24
+    const __m256 a = _mm256_mul_ps(materialA, channel(3, l0, l1, l2, invQ));
+    const __m256 clamped = _mm256_min_ps(_mm256_max_ps(a, _mm256_setzero_ps()), one);
+    alphaWord = _mm256_slli_epi32(
+        _mm256_cvttps_epi32(
+            _mm256_add_ps(_mm256_mul_ps(clamped, _mm256_set1_ps(255.0f)), _mm256_set1_ps(0.5f))),
+        24);
+  }
+};
+
+inline const TriangleColors kWhite{};  // an uncoloured triangle's (unread) colours
 
 /// One triangle over one tile, 8 pixels at a time (see the file comment).
 template <class Sink>
@@ -189,6 +264,11 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
   const __m256d laneLo = _mm256_setr_pd(0, 1, 2, 3), laneHi = _mm256_setr_pd(4, 5, 6, 7);
   const __m256i laneIndex = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const LaneShading shading(in, t, base, alphaByte);
+  // vertex colours: the base colour and alpha per lane (RasterFrame::surface's order)
+  const bool colored = t.hasColor;
+  const LaneColors laneColors(
+      t, colored ? frame.vertexColors(static_cast<size_t>(&t - frame.setups().data())) : kWhite,
+      material, alphaByte);
 
   Fragment f;
   f.prim = t.prim;
@@ -241,7 +321,15 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
         }
         // shading of the 8 lanes (only the passing ones are used)
         __m256 ndotv;
-        const __m256i rgba = shading.shade(tables, l1, l2, x, dy, dySquared, ndotv);
+        __m256i rgba;
+        if (colored) {
+          __m256 r, g, b;
+          __m256i alphaWord;
+          laneColors.base(l1, l2, r, g, b, alphaWord);
+          rgba = shading.shadeBase(tables, l1, l2, x, dy, dySquared, ndotv, r, g, b, alphaWord);
+        } else {
+          rgba = shading.shade(tables, l1, l2, x, dy, dySquared, ndotv);
+        }
         alignas(32) float depths[8], cosines[8];
         alignas(32) uint32_t words[8];
         _mm256_store_ps(depths, depth);
@@ -285,7 +373,8 @@ MFR_TARGET_AVX2 void rasterizeTileAvx2(const RasterFrame& frame, const ShadingIn
   const TileRect r = frame.tileRect(tile);
   sink.beginTile(r, frame.tileSize());
   for (const uint32_t* it = frame.tileBegin(tile); it != frame.tileEnd(tile); ++it) {
-    const ShadeMaterial& m = (*in.materials)[frame.setups()[*it].material];
+    const TriangleSetup& t = frame.setups()[*it];
+    const ShadeMaterial& m = (*in.materials)[t.material];
     if (m.texture != nullptr || m.mode == AlphaMode::Mask) {
       frame.rasterizeTile<ShadeMode::Full>(tile, sink);
       return;

@@ -75,6 +75,7 @@ void GlEngine::State::setRasterUniforms(GLuint p) const {
   glProgramUniform1f(p, loc(p, "uAmbient"), kAmbient);
   glProgramUniform1f(p, loc(p, "uDiffuse"), 1.0f - kAmbient);
   glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
+  glProgramUniform1ui(p, loc(p, "uVertexColors"), vertexColors ? 1u : 0u);
 }
 
 void GlEngine::State::drawScene() const {
@@ -85,6 +86,8 @@ void GlEngine::State::drawScene() const {
   glDisable(GL_BLEND);
   glDisable(GL_STENCIL_TEST);
   glBindVertexArray(vao);
+  // without vertex colours attribute 3 is not streamed: it reads this constant white
+  if (!vertexColors) glVertexAttrib4f(3, 1.0f, 1.0f, 1.0f, 1.0f);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindMaterials, materials);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTriMaterial, triMaterial);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, colorTables);
@@ -106,8 +109,9 @@ void GlEngine::State::placeCamera(const Camera& cameraIn, const Scene& scene) {
   ray.w = (1.0f - 1.0f / static_cast<float>(height)) * tanHalf;
 }
 
-// positions, normals, uvs (zeros when the scene has none), indices, the vertex array and the
-// triangles' materials
+// positions, normals, uvs (zeros when the scene has none), vertex colours (only when the scene has
+// them: else attribute 3 is the constant white that drawScene sets), indices, the vertex array and
+// the triangles' materials
 void GlEngine::State::uploadGeometry(const Scene& scene) {
   const size_t vertices = scene.positions.size();
   const GLuint positions =
@@ -128,6 +132,14 @@ void GlEngine::State::uploadGeometry(const Scene& scene) {
     glVertexArrayAttribFormat(vao, i, sizes[i], GL_FLOAT, GL_FALSE, 0);
     glVertexArrayAttribBinding(vao, i, i);
     glEnableVertexArrayAttrib(vao, i);
+  }
+  if (vertexColors) {
+    const GLuint colors =
+        upload("vertex colours", vertices * sizeof(glm::vec4), scene.colors.data());
+    glVertexArrayVertexBuffer(vao, 3, colors, 0, static_cast<GLsizei>(sizeof(glm::vec4)));
+    glVertexArrayAttribFormat(vao, 3, 4, GL_FLOAT, GL_FALSE, 0);
+    glVertexArrayAttribBinding(vao, 3, 3);
+    glEnableVertexArrayAttrib(vao, 3);
   }
   glVertexArrayElementBuffer(vao, indices);
   triMaterial = upload("triangle materials", scene.triangleMaterial.size() * 4,
@@ -284,6 +296,7 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   s->height = height;
   s->placeCamera(cameraIn, scene);
   s->raster = raster;
+  s->vertexColors = !scene.colors.empty();
   auto kbufferPrelude = kbufferInterlockPrelude(context, interlock);
   if (!kbufferPrelude) return kbufferPrelude.error();
   State& st = *s;

@@ -59,6 +59,7 @@ struct GlEngine::State {
   bool deviceByImportance = false;
   uint64_t maxBlockBytes = 0;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
   GlRaster raster = GlRaster::Native;
+  bool vertexColors = false;  // the scene has vertex colours (Scene::colors): attribute 3 streams
   std::map<std::string, uint64_t> sceneBytes;
   std::optional<Error> uploadFailure;  // the first scene buffer GL could not allocate
 

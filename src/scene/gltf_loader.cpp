@@ -1,9 +1,10 @@
 // glTF 2.0 loader (.gltf and .glb) on top of tinygltf, following the Khronos glTF 2.0 specification
 // (accessors incl. sparse and normalized integers, node hierarchy with matrix or TRS transforms,
-// triangle primitives, metallic-roughness base colour, alpha modes, doubleSided (Scene::cull;
-// mirroring transforms reverse the winding), perspective cameras) and the
-// KHR_materials_transmission (folded into alpha, see LoadOptions), KHR_mesh_quantization and
-// EXT_mesh_gpu_instancing (one copy of the mesh per instance) extensions.
+// triangle primitives, metallic-roughness base colour, COLOR_0 vertex colours, alpha modes,
+// doubleSided (Scene::cull; mirroring transforms reverse the winding), perspective cameras) and the
+// KHR_materials_transmission (folded into alpha, see LoadOptions), KHR_mesh_quantization,
+// EXT_mesh_gpu_instancing (one copy of the mesh per instance) and KHR_texture_transform (on the
+// base colour texture, applied to the texture coordinates at load) extensions.
 //
 // Images are not decoded while tinygltf parses the file: a custom image callback keeps the encoded
 // bytes, and only images used as a base colour texture are decoded (in parallel) afterwards.
@@ -252,10 +253,12 @@ std::optional<uint64_t> dataUriBytes(const std::string& uri) {
 
 /// The glTF extensions mfr implements: an asset that requires any other must be refused (glTF 2.0
 /// section 3.12). KHR_mesh_quantization only widens the accessor types, which readAccessor reads;
-/// EXT_mesh_gpu_instancing is expanded into one copy of the mesh per instance.
+/// EXT_mesh_gpu_instancing is expanded into one copy of the mesh per instance;
+/// KHR_texture_transform is applied to the base colour texture's coordinates (the only texture mfr
+/// samples).
 bool isImplementedExtension(const std::string& name) {
   return name == "KHR_materials_transmission" || name == "KHR_mesh_quantization" ||
-         name == "EXT_mesh_gpu_instancing";
+         name == "EXT_mesh_gpu_instancing" || name == "KHR_texture_transform";
 }
 
 /// What the JSON says before tinygltf reads it: required extensions mfr implements, buffer views'
@@ -269,8 +272,8 @@ Result<void> checkReferences(const nlohmann::json& doc, GltfFiles& files) {
       if (name.is_string() && !isImplementedExtension(name.get<std::string>()))
         return makeError("requires extension " + quoteInput(name.get<std::string>()) +
                          ", which mfr does not implement (it implements "
-                         "KHR_materials_transmission, KHR_mesh_quantization and "
-                         "EXT_mesh_gpu_instancing)");
+                         "KHR_materials_transmission, KHR_mesh_quantization, "
+                         "EXT_mesh_gpu_instancing and KHR_texture_transform)");
   if (auto it = doc.find("bufferViews"); it != doc.end() && it->is_array())
     for (size_t i = 0; i < it->size(); ++i) {
       const nlohmann::json& view = (*it)[i];
@@ -414,6 +417,29 @@ struct ElementRange {
   size_t stride = 0;
 };
 
+/// The texture coordinates a base colour texture reads: its set (TEXCOORD_n) and the
+/// KHR_texture_transform matrix uv' = T * R * S * uv (identity without the extension), as the two
+/// rows of its 2x3 affine part.
+struct UvTransform {
+  int texCoord = 0;
+  glm::dvec3 row0{1.0, 0.0, 0.0};  // u' = row0 . (u, v, 1)
+  glm::dvec3 row1{0.0, 1.0, 0.0};  // v' = row1 . (u, v, 1)
+
+  /// From the extension's offset (ox, oy), rotation r (radians) and scale (sx, sy): T R S with
+  /// T = [1 0 ox; 0 1 oy], R = [cos r, sin r; -sin r, cos r], S = diag(sx, sy) (the extension's
+  /// specification).
+  static UvTransform fromOffsetRotationScale(int texCoord, glm::dvec2 offset, double rotation,
+                                             glm::dvec2 scale) {
+    const double c = std::cos(rotation), s = std::sin(rotation);
+    return {texCoord, {c * scale.x, s * scale.y, offset.x}, {-s * scale.x, c * scale.y, offset.y}};
+  }
+
+  glm::vec2 apply(double u, double v) const {
+    return {static_cast<float>(row0.x * u + row0.y * v + row0.z),
+            static_cast<float>(row1.x * u + row1.y * v + row1.z)};
+  }
+};
+
 // ---------------------------------------------------------------------------------------------
 
 class GltfSceneBuilder {
@@ -436,6 +462,9 @@ class GltfSceneBuilder {
                                     const std::string& what) const;
   Result<std::vector<double>> readAccessor(int index, int expectedType,
                                            const std::string& what) const;
+  Result<std::vector<double>> readColors(int index, size_t vertexCount,
+                                         const std::string& what) const;
+  Result<UvTransform> baseColorUvTransform(int gltfMaterial) const;
   Result<void> visitNodes();
   Result<void> addMeshInstances(const tinygltf::Node& node, int nodeIndex, const glm::dmat4& world);
   Result<void> addMesh(int meshIndex, const glm::dmat4& world);
@@ -456,6 +485,7 @@ class GltfSceneBuilder {
 
   Scene scene_;
   bool anyUvs_ = false;
+  bool anyColors_ = false;
   std::map<int, uint32_t> materialMap_;   // glTF material (-1: default) -> scene material
   std::map<int, int> imageMap_;           // glTF image -> scene texture
   std::vector<TextureSampler> samplers_;  // per glTF sampler (readSamplers)
@@ -549,6 +579,87 @@ Result<std::vector<double>> GltfSceneBuilder::readAccessor(int index, int expect
   return values;
 }
 
+/// COLOR_0 as linear RGBA (glTF 2.0 section 3.7.2.1: VEC3 or VEC4 of float, normalized unsigned
+/// byte or normalized unsigned short; VEC3 has alpha 1), 4 values per vertex.
+Result<std::vector<double>> GltfSceneBuilder::readColors(int index, size_t vertexCount,
+                                                         const std::string& what) const {
+  if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
+    return fail(what + ": accessor " + std::to_string(index) + " does not exist");
+  const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(index)];
+  const std::string where = what + " (accessor " + std::to_string(index) + ")";
+  if (accessor.type != TINYGLTF_TYPE_VEC3 && accessor.type != TINYGLTF_TYPE_VEC4)
+    return fail(where + ": must be VEC3 or VEC4");
+  const bool validComponents =
+      accessor.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+      (accessor.normalized && (accessor.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+                               accessor.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT));
+  if (!validComponents)
+    return fail(where + ": must be float, normalized unsigned byte or normalized unsigned short");
+  auto read = readAccessor(index, accessor.type, what);
+  if (!read) return read.error();
+  const size_t components = accessor.type == TINYGLTF_TYPE_VEC4 ? 4 : 3;
+  if (read->size() / components != vertexCount) return fail(what + ": count differs");
+  if (components == 4) return read;
+  std::vector<double> rgba(vertexCount * 4, 1.0);
+  for (size_t i = 0; i < vertexCount; ++i)
+    for (size_t c = 0; c < 3; ++c) rgba[4 * i + c] = (*read)[3 * i + c];
+  return rgba;
+}
+
+/// The base colour texture's coordinate set and KHR_texture_transform of glTF material
+/// `gltfMaterial` (a valid index). The transform is applied to the primitive's texture coordinates
+/// at load time: it is affine and every primitive has its own copy of its vertices, read by the
+/// one texture mfr samples, so interpolating the transformed coordinates is transforming the
+/// interpolated ones (docs/GLTF.md), identically for both engines.
+Result<UvTransform> GltfSceneBuilder::baseColorUvTransform(int gltfMaterial) const {
+  const tinygltf::Material& material = model_.materials[static_cast<size_t>(gltfMaterial)];
+  const tinygltf::TextureInfo& info = material.pbrMetallicRoughness.baseColorTexture;
+  UvTransform transform;
+  transform.texCoord = std::max(0, info.texCoord);
+  if (info.index < 0) return transform;
+  const auto ext = info.extensions.find("KHR_texture_transform");
+  if (ext == info.extensions.end()) return transform;
+  const std::string what = "material " + std::to_string(gltfMaterial) + " (" +
+                           quoteInput(material.name, 60) +
+                           ") baseColorTexture KHR_texture_transform";
+  const tinygltf::Value& value = ext->second;
+  if (!value.IsObject()) return fail(what + ": must be an object");
+  auto number = [&](const tinygltf::Value& v, const std::string& field) -> Result<double> {
+    if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble()))
+      return fail(what + ": " + field + " must be a finite number");
+    return v.GetNumberAsDouble();
+  };
+  auto pair = [&](const char* field, glm::dvec2 fallback) -> Result<glm::dvec2> {
+    if (!value.Has(field)) return fallback;
+    const tinygltf::Value& v = value.Get(field);
+    if (!v.IsArray() || v.ArrayLen() != 2)
+      return fail(what + ": " + field + " must be an array of 2 numbers");
+    auto x = number(v.Get(0), std::string(field) + "[0]");
+    if (!x) return x.error();
+    auto y = number(v.Get(1), std::string(field) + "[1]");
+    if (!y) return y.error();
+    return glm::dvec2(*x, *y);
+  };
+  auto offset = pair("offset", glm::dvec2(0.0));
+  if (!offset) return offset.error();
+  auto scale = pair("scale", glm::dvec2(1.0));
+  if (!scale) return scale.error();
+  double rotation = 0.0;
+  if (value.Has("rotation")) {
+    auto r = number(value.Get("rotation"), "rotation");
+    if (!r) return r.error();
+    rotation = *r;
+  }
+  int texCoord = transform.texCoord;
+  if (value.Has("texCoord")) {
+    const tinygltf::Value& t = value.Get("texCoord");
+    if (!t.IsInt() || t.GetNumberAsInt() < 0)
+      return fail(what + ": texCoord must be a non-negative integer");
+    texCoord = t.GetNumberAsInt();
+  }
+  return UvTransform::fromOffsetRotationScale(texCoord, *offset, rotation, *scale);
+}
+
 glm::dmat4 localTransform(const tinygltf::Node& node) {
   if (node.matrix.size() == 16) return glm::make_mat4(node.matrix.data());  // column-major
   glm::dmat4 m(1.0);
@@ -637,9 +748,9 @@ Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int 
     values[a] = std::move(*read);
   }
   if (!count) return addMesh(node.mesh, world);
-  // the scene's vertex data (positions, normals, uvs) and index data (indices, materials)
+  // the scene's vertex data (positions, normals, uvs, colours) and index data (indices, materials)
   const auto sceneBytes = [this] {
-    return scene_.positions.size() * sizeof(glm::vec3) * 3 +
+    return scene_.positions.size() * (sizeof(glm::vec3) * 3 + sizeof(glm::vec4)) +
            scene_.indices.size() * sizeof(uint32_t) * 2;
   };
   const size_t before = sceneBytes();
@@ -725,11 +836,16 @@ Result<void> GltfSceneBuilder::addPrimitive(const tinygltf::Primitive& primitive
     normals = std::move(*read);
   }
 
-  // The texture coordinate set the base colour texture uses (TEXCOORD_0 unless it says otherwise).
-  int texCoord = 0;
-  if (primitive.material >= 0 && static_cast<size_t>(primitive.material) < model_.materials.size())
-    texCoord = std::max(0, model_.materials[static_cast<size_t>(primitive.material)]
-                               .pbrMetallicRoughness.baseColorTexture.texCoord);
+  // The texture coordinate set the base colour texture uses (TEXCOORD_0 unless it says otherwise,
+  // KHR_texture_transform's texCoord over the texture's) and the extension's transform.
+  UvTransform transform;
+  if (primitive.material >= 0 &&
+      static_cast<size_t>(primitive.material) < model_.materials.size()) {
+    auto read = baseColorUvTransform(primitive.material);
+    if (!read) return read.error();
+    transform = *read;
+  }
+  const int texCoord = transform.texCoord;
   std::vector<double> uvs;
   const std::string uvName = "TEXCOORD_" + std::to_string(texCoord);
   if (auto it = primitive.attributes.find(uvName); it != primitive.attributes.end()) {
@@ -737,6 +853,13 @@ Result<void> GltfSceneBuilder::addPrimitive(const tinygltf::Primitive& primitive
     if (!read) return read.error();
     if (read->size() / 2 != vertexCount) return fail(what + ": " + uvName + " count differs");
     uvs = std::move(*read);
+  }
+
+  std::vector<double> colors;  // COLOR_0: linear RGBA, alpha 1 when the accessor is VEC3
+  if (auto it = primitive.attributes.find("COLOR_0"); it != primitive.attributes.end()) {
+    auto read = readColors(it->second, vertexCount, what + " COLOR_0");
+    if (!read) return read.error();
+    colors = std::move(*read);
   }
 
   std::vector<uint32_t> corners;
@@ -779,10 +902,15 @@ Result<void> GltfSceneBuilder::addPrimitive(const tinygltf::Primitive& primitive
       scene_.normals.emplace_back(0.0f);  // filled from the faces below
     }
     scene_.uvs.emplace_back(uvs.empty() ? glm::vec2(0.0f)
-                                        : glm::vec2(static_cast<float>(uvs[2 * i]),
-                                                    static_cast<float>(uvs[2 * i + 1])));
+                                        : transform.apply(uvs[2 * i], uvs[2 * i + 1]));
+    scene_.colors.emplace_back(colors.empty() ? glm::vec4(1.0f)
+                                              : glm::vec4(static_cast<float>(colors[4 * i]),
+                                                          static_cast<float>(colors[4 * i + 1]),
+                                                          static_cast<float>(colors[4 * i + 2]),
+                                                          static_cast<float>(colors[4 * i + 3])));
   }
   anyUvs_ = anyUvs_ || !uvs.empty();
+  anyColors_ = anyColors_ || !colors.empty();
 
   const bool mirrored = det < 0.0;
   const uint32_t material = materialIndex(primitive.material);
@@ -1058,6 +1186,7 @@ Result<Scene> GltfSceneBuilder::build() {
   MFR_TRY(visitNodes());
   MFR_TRY(decodeTextures());
   if (!anyUvs_) scene_.uvs.clear();
+  if (!anyColors_) scene_.colors.clear();
   MFR_TRY(addCameras());
   MFR_TRY(validateScene(scene_));
   return std::move(scene_);

@@ -4,9 +4,12 @@
 // Conventions:
 //  - Texture coordinates are flipped (uv.y = 1 - v): OBJ puts v = 0 at the bottom of the image,
 //    the scene (like glTF) at the top row.
-//  - Kd is the linear base colour; map_Kd is loaded with stb_image to RGBA8 (sRGB as stored),
-//    resolved relative to the directory of the MTL file that declared it. A missing or undecodable
-//    texture is an error naming it.
+//  - Kd is the linear base colour, multiplied by map_Kd (loaded with stb_image to RGBA8, sRGB as
+//    stored), resolved relative to the directory of the MTL file that declared it. A missing or
+//    undecodable texture is an error naming it.
+//  - map_d (an alpha texture: the image's alpha channel when it has one, else its first channel)
+//    multiplies the alpha: it is folded into the alpha channel of the material's one texture
+//    (map_Kd's, or a white one), and the material blends.
 //  - mtllib and map_Kd files must be regular files inside the folder of the file naming them
 //    (LoadOptions::allowOutsideReferences lifts the folder rule); a refused one is an error naming
 //    it, checked before it is opened. A missing MTL file only falls back to the default material.
@@ -29,10 +32,12 @@
 #include <limits>
 #include <map>
 #include <new>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <string_view>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "file_loaders.hpp"
@@ -137,7 +142,7 @@ void restoreNonFiniteCoordinates(const std::string& text, std::vector<float>& ve
 /// A texture file (already resolved): header checked against the size cap and the memory limit
 /// before decoding. `decodedBytes` adds up the textures' bytes so far.
 Result<Texture> loadTexture(const OpenFile& file, const std::string& what, uint64_t memoryLimit,
-                            uint64_t& decodedBytes) {
+                            uint64_t& decodedBytes, int* fileChannels = nullptr) {
   auto bytes = file.read(std::min<uint64_t>(memoryLimit, std::numeric_limits<int>::max()));
   if (!bytes) return bytes.error();
   MFR_TRY(checkPngChunks(bytes->data(), bytes->size(), what));  // before stb trusts a chunk length
@@ -155,6 +160,7 @@ Result<Texture> loadTexture(const OpenFile& file, const std::string& what, uint6
     return makeError("cannot load texture " + what + " (" + quoteInput(file.path().string(), 200) +
                      ")" + (reason ? ": " + oneLine(reason) : std::string()));
   }
+  if (fileChannels) *fileChannels = channels;
   Texture texture;
   texture.width = width;
   texture.height = height;
@@ -250,12 +256,42 @@ Result<ObjData> parseObj(const std::string& path, const std::string& text,
   return obj;
 }
 
-// Materials with their map_Kd textures (each file loaded once).
+// A map_d texture's alpha per texel: the image's alpha channel when it has one (grey + alpha,
+// RGBA), else its first channel (grey, or red), as stored (linear).
+uint8_t mapDAlpha(const Texture& t, size_t texel, int channels) {
+  return channels == 2 || channels == 4 ? t.rgba[texel * 4 + 3] : t.rgba[texel * 4];
+}
+
+// The base colour texture of a material with map_d: map_Kd's colour (white without one) and
+// map_Kd's alpha times map_d's, on map_Kd's texel grid (map_d sampled at the nearest texel
+// centre when the sizes differ), so that the one texture a material has carries both.
+Texture combineAlpha(const Texture* color, const Texture& alpha, int alphaChannels) {
+  Texture out = color ? *color : Texture{alpha.width, alpha.height, {}};
+  if (!color) out.rgba.assign(static_cast<size_t>(out.width) * out.height * 4, 255);
+  for (int y = 0; y < out.height; ++y)
+    for (int x = 0; x < out.width; ++x) {
+      const int ax = static_cast<int>((static_cast<int64_t>(x) * alpha.width) / out.width);
+      const int ay = static_cast<int>((static_cast<int64_t>(y) * alpha.height) / out.height);
+      const uint8_t d = mapDAlpha(
+          alpha, static_cast<size_t>(ay) * alpha.width + static_cast<size_t>(ax), alphaChannels);
+      uint8_t& a = out.rgba[(static_cast<size_t>(y) * out.width + static_cast<size_t>(x)) * 4 + 3];
+      a = static_cast<uint8_t>((a * d + 127) / 255);
+    }
+  return out;
+}
+
+// Materials with their map_Kd and map_d textures (each file decoded once; Kd multiplies map_Kd in
+// the engines, as every base colour factor multiplies its texture).
 Result<void> addObjMaterials(const std::string& path,
                              const std::vector<tinyobj::material_t>& materials,
                              const std::vector<fs::path>& mtlFiles, const LoadOptions& options,
                              uint64_t memoryLimit, Scene& scene) {
-  std::map<std::string, int> textureByPath;
+  struct Decoded {
+    Texture texture;
+    int channels = 4;
+  };
+  std::map<std::string, Decoded> decoded;   // by resolved file
+  std::map<std::string, int> textureByKey;  // map_Kd file [+ "|" + map_d file] -> scene texture
   uint64_t textureBytes = 0;
   for (size_t m = 0; m < materials.size(); ++m) {
     const tinyobj::material_t& src = materials[m];
@@ -264,20 +300,48 @@ Result<void> addObjMaterials(const std::string& path,
     const float alpha = std::clamp(static_cast<float>(src.dissolve), 0.0f, 1.0f);
     material.baseColor = glm::vec4(src.diffuse[0], src.diffuse[1], src.diffuse[2], alpha);
     material.alphaMode = alpha < 1.0f ? AlphaMode::Blend : AlphaMode::Opaque;
-    if (!src.diffuse_texname.empty()) {
-      std::string name = src.diffuse_texname;
+    const fs::path mtlFile = m < mtlFiles.size() ? mtlFiles[m] : fs::path(path);
+    // a texture statement's file, decoded once: its resolved path and the decoded image
+    auto decode = [&](const std::string& texname,
+                      const char* field) -> Result<std::pair<std::string, const Decoded*>> {
+      std::string name = texname;
       std::replace(name.begin(), name.end(), '\\', '/');  // paths written on Windows
-      const fs::path mtlFile = m < mtlFiles.size() ? mtlFiles[m] : fs::path(path);
-      const std::string what = "map_Kd " + quoteInput(name);
+      const std::string what = std::string(field) + " " + quoteInput(name);
       auto file = openReference(mtlFile, name, what, options.allowOutsideReferences);
       if (!file) return makeError(path + ": " + file.error().message);
-      auto it = textureByPath.find(file->path().string());
-      if (it == textureByPath.end()) {
-        auto texture = loadTexture(*file, what, memoryLimit, textureBytes);
+      const std::string key = file->path().string();
+      auto it = decoded.find(key);
+      if (it == decoded.end()) {
+        Decoded d;
+        auto texture = loadTexture(*file, what, memoryLimit, textureBytes, &d.channels);
         if (!texture) return makeError(path + ": " + texture.error().message);
-        it = textureByPath.emplace(file->path().string(), static_cast<int>(scene.textures.size()))
-                 .first;
-        scene.textures.push_back(std::move(*texture));
+        d.texture = std::move(*texture);
+        it = decoded.emplace(key, std::move(d)).first;
+      }
+      return std::pair<std::string, const Decoded*>(key, &it->second);
+    };
+    std::optional<std::pair<std::string, const Decoded*>> color, cutout;
+    if (!src.diffuse_texname.empty()) {
+      auto d = decode(src.diffuse_texname, "map_Kd");
+      if (!d) return d.error();
+      color = *d;
+    }
+    if (!src.alpha_texname.empty()) {
+      auto d = decode(src.alpha_texname, "map_d");
+      if (!d) return d.error();
+      cutout = *d;
+      material.alphaMode = AlphaMode::Blend;  // the alpha varies over the surface
+    }
+    if (color || cutout) {
+      const std::string key = (color ? color->first : std::string("white")) +
+                              (cutout ? "|" + cutout->first : std::string());
+      auto it = textureByKey.find(key);
+      if (it == textureByKey.end()) {
+        Texture texture = cutout ? combineAlpha(color ? &color->second->texture : nullptr,
+                                                cutout->second->texture, cutout->second->channels)
+                                 : color->second->texture;
+        it = textureByKey.emplace(key, static_cast<int>(scene.textures.size())).first;
+        scene.textures.push_back(std::move(texture));
       }
       material.baseColorTexture = it->second;
     }

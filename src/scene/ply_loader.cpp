@@ -2,8 +2,12 @@
 // the file is read into memory and handed to assimp with the "ply" format hint, so no other
 // importer ever looks at it. Polygons split by polygon.hpp (assimp's Triangulate step aborted the
 // process on some files), identical vertices joined; node transforms applied;
-// file normals used when every mesh has them (otherwise computed); vertex colours ignored.
-// PLY has no materials: everything gets one opaque light-grey material.
+// file normals used when every mesh has them (otherwise computed). PLY has no materials: everything
+// gets one material, opaque light grey; with vertex colours (red, green, blue [, alpha]: uchar
+// 0-255 or float 0-1, which assimp hands over as floats in [0, 1]) it is white and the colours
+// are the surface's: red, green and blue are display values, sRGB-encoded (the convention of
+// 8-bit PLY colours from scanners and tools), decoded to linear here; alpha is linear, and any
+// alpha below 1 makes the material blended (docs/GLTF.md, "Other formats").
 //
 // assimp 5.2's PLY importer crashes or spins on malformed files (truncated bodies, corrupted
 // headers, huge element counts, out-of-range face indices), so every file is first checked
@@ -13,6 +17,7 @@
 #include <assimp/scene.h>
 #include <assimp/Importer.hpp>
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -31,6 +36,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "file_loaders.hpp"
+#include "mfr/core/color.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
@@ -342,10 +348,25 @@ glm::mat4 toGlm(const aiMatrix4x4& m) {
   return glm::transpose(glm::make_mat4(&m.a1));  // assimp matrices are row-major
 }
 
+/// A PLY vertex colour as assimp delivers it (uchar / 255 or the file's float) to linear RGBA:
+/// RGB sRGB-decoded (8-bit codes exactly by the decode table), alpha as stored.
+glm::vec4 plyColor(const aiColor4D& c) {
+  auto channel = [](float v) {
+    const float clamped = std::isfinite(v) ? std::clamp(v, 0.0f, 1.0f) : 0.0f;
+    const float code = clamped * 255.0f;
+    if (std::abs(code - std::round(code)) < 1e-3f)
+      return decodeSrgb8(static_cast<uint8_t>(std::lround(code)));
+    return srgbToLinear(clamped);
+  };
+  const float alpha = std::isfinite(c.a) ? std::clamp(c.a, 0.0f, 1.0f) : 1.0f;
+  return {channel(c.r), channel(c.g), channel(c.b), alpha};
+}
+
 struct PlyBuilder {
   const aiScene& ai;
   Scene scene;
   bool allNormals = true;
+  bool anyColors = false;
   std::string error;  // the first face that cannot be triangulated
 
   void visit(const aiNode& node, const glm::mat4& parent, unsigned depth) {
@@ -363,9 +384,13 @@ struct PlyBuilder {
   void addMesh(const aiMesh& mesh, const glm::mat4& world, const glm::mat3& normalMatrix) {
     const auto base = static_cast<uint32_t>(scene.positions.size());
     allNormals = allNormals && mesh.mNormals != nullptr;
+    const aiColor4D* colors = mesh.mColors[0];
+    if (colors && !anyColors) scene.colors.assign(base, glm::vec4(1.0f));
+    anyColors = anyColors || colors != nullptr;
     for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
       const aiVector3D& p = mesh.mVertices[v];
       scene.positions.emplace_back(world * glm::vec4(p.x, p.y, p.z, 1.0f));
+      if (anyColors) scene.colors.push_back(colors ? plyColor(colors[v]) : glm::vec4(1.0f));
       if (mesh.mNormals) {
         const aiVector3D& n = mesh.mNormals[v];
         const glm::vec3 normal = normalMatrix * glm::vec3(n.x, n.y, n.z);
@@ -422,7 +447,7 @@ Result<Scene> loadPly(const std::string& path, const OpenFile& file, const LoadO
       return makeError(path + ": " + (reason.empty() ? "invalid PLY file" : reason));
     }
 
-    PlyBuilder builder{*ai, {}, true, {}};
+    PlyBuilder builder{*ai, {}, true, false, {}};
     builder.scene.name = path;
     uint64_t vertices = 0;
     for (unsigned m = 0; m < ai->mNumMeshes; ++m)
@@ -438,6 +463,11 @@ Result<Scene> loadPly(const std::string& path, const OpenFile& file, const LoadO
     material.name = "default";
     material.baseColor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
     material.alphaMode = AlphaMode::Opaque;
+    if (builder.anyColors) {  // the vertex colours are the surface's colour
+      material.baseColor = glm::vec4(1.0f);
+      for (const glm::vec4& c : scene.colors)
+        if (c.a < 1.0f) material.alphaMode = AlphaMode::Blend;
+    }
     scene.materials.push_back(material);
 
     computeVertexNormals(scene);

@@ -35,6 +35,8 @@ Result<void> validateScene(const Scene& scene) {
     return makeError(name + ": one normal per vertex expected");
   if (!scene.uvs.empty() && scene.uvs.size() != scene.positions.size())
     return makeError(name + ": one texture coordinate per vertex expected");
+  if (!scene.colors.empty() && scene.colors.size() != scene.positions.size())
+    return makeError(name + ": one vertex colour per vertex expected");
   if (scene.materials.empty()) return makeError(name + ": scene has no materials");
   for (uint32_t index : scene.indices)
     if (index >= scene.positions.size())
@@ -66,6 +68,10 @@ Result<void> validateScene(const Scene& scene) {
         return makeError(name + ": material " + quoteInput(m.name) +
                          " has a non-finite base colour");
   }
+  for (size_t i = 0; i < scene.colors.size(); ++i)
+    for (int c = 0; c < 4; ++c)
+      if (!std::isfinite(scene.colors[i][c]))
+        return makeError(name + ": vertex colour " + std::to_string(i) + " is NaN or infinite");
   for (const Texture& t : scene.textures)
     if (t.width <= 0 || t.height <= 0 ||
         t.rgba.size() != static_cast<size_t>(t.width) * static_cast<size_t>(t.height) * 4)

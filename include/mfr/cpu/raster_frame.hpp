@@ -4,7 +4,8 @@
 //     y-down coordinates, which is GL's lower-left-origin rule seen upside down);
 //   - clipping in homogeneous clip space against near and far (z = -w, z = w) and an x/y
 //     guard band;
-//   - perspective-correct attributes, depth = window z in [0, 1] interpolated linearly in screen;
+//   - perspective-correct attributes (normal, uv, vertex colour), depth = window z in [0, 1]
+//     interpolated linearly in screen;
 //   - back faces (clockwise in GL's y-up window coordinates) culled at set-up for the triangles
 //     whose material Scene::cullsBackFaces says so; every other face is kept, whichever side it
 //     shows (transparent geometry shows both sides).
@@ -63,6 +64,15 @@ struct TriangleSetup {
   uint32_t prim;
   uint32_t material;
   uint8_t topLeft;  // bit i set: edge opposite vertex i is a top or left edge
+  /// Scene::hasVertexColor of the source triangle: its vertex colours / w are
+  /// RasterFrame::vertexColors(this set-up) (kept beside the set-ups, so scenes without colours
+  /// pay nothing for them).
+  bool hasColor;
+};
+
+/// The vertex colours / w of one set-up, in the set-up's vertex order (linear RGBA).
+struct TriangleColors {
+  glm::vec4 colorW[3];
 };
 
 enum class ShadeMode {
@@ -119,6 +129,9 @@ class RasterFrame {
   const uint32_t* tileEnd(int tile) const { return binned_.data() + binOffsets_[tile + 1]; }
 
   const std::vector<TriangleSetup>& setups() const { return setups_; }
+  /// The vertex colours / w of set-up `setupIndex` (meaningful when its hasColor is set; the
+  /// frame keeps them only when the scene has colours).
+  const TriangleColors& vertexColors(size_t setupIndex) const { return colors_[setupIndex]; }
 
   /// Rasterizes every triangle binned to `tile`, restricted to the tile. For each covered pixel
   /// centre that survives the alpha test it calls sink.accept(pixel, depth) (an early test before
@@ -155,6 +168,8 @@ class RasterFrame {
   Camera camera_;
   CullMode cull_ = CullMode::Auto;
   std::vector<TriangleSetup> setups_;
+  std::vector<TriangleColors>
+      colors_;  // one per set-up when the scene has vertex colours, else empty
   std::vector<uint32_t> binned_;
   std::vector<uint32_t> binOffsets_;
   std::vector<ShadeMaterial> materials_;

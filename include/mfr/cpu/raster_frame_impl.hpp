@@ -122,10 +122,16 @@ template <ShadeMode Mode>
     if (!needsAlphaTest) return true;
   }
   base = glm::vec4(m.color, m.alpha);
-  if (m.texture != nullptr) {
+  if (m.texture != nullptr || t.hasColor) {
     const float invQ = 1.0f / (t.invW[0] * l0 + t.invW[1] * l1 + t.invW[2] * l2);
-    const glm::vec2 uv = (t.uvW[0] * l0 + t.uvW[1] * l1 + t.uvW[2] * l2) * invQ;
-    base *= detail::sampleTexture(*m.texture, m.sampler, uv);
+    if (m.texture != nullptr) {
+      const glm::vec2 uv = (t.uvW[0] * l0 + t.uvW[1] * l1 + t.uvW[2] * l2) * invQ;
+      base *= detail::sampleTexture(*m.texture, m.sampler, uv);
+    }
+    if (t.hasColor) {  // the perspective-correct vertex colour, after the texture
+      const glm::vec4* c = colors_[static_cast<size_t>(&t - setups_.data())].colorW;
+      base *= (c[0] * l0 + c[1] * l1 + c[2] * l2) * invQ;
+    }
   }
   if (needsAlphaTest) {
     if (base.a < m.cutoff) return false;

@@ -33,6 +33,9 @@ MFR_GL_CONST(uint, kScanItemsPerThread, 4u)           // consecutive elements pe
 MFR_GL_CONST(uint, kResolveGroupSize, 64u)            // resolve: pixels per work group
 MFR_GL_CONST(uint, kResolveLocalNodes, 128u)          // resolve: nodes sorted in a local array
 MFR_GL_CONST(uint, kMaxClipVertices, 12u)             // Sutherland-Hodgman polygon capacity
+// raster.geom's gTopLeft: bits 0-2 the edges' top-left flags, this bit the triangle's vertex
+// colours (mfr::Scene::hasVertexColor, mfr::TriangleSetup::hasColor)
+MFR_GL_CONST(uint, kTopLeftHasColor, 8u)
 
 // binding points: SSBOs (at most 8, GL 4.3's minimum of bindings) and image units (2)
 MFR_GL_CONST(uint, kBindCounts, 0u)        // n(p): r32ui imageBuffer unit (count), SSBO (resolve)

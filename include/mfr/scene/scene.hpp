@@ -59,8 +59,13 @@ struct Scene {
 
   std::vector<glm::vec3> positions;  // world space
   std::vector<glm::vec3> normals;    // per vertex, same size as positions (loaders fill flat ones)
-  std::vector<glm::vec2> uvs;        // empty, or same size as positions
-  std::vector<uint32_t> indices;     // 3 per triangle
+  std::vector<glm::vec2> uvs;  // empty, or same size as positions (KHR_texture_transform applied)
+  /// Vertex colours (glTF COLOR_0, PLY red/green/blue/alpha): empty, or one per vertex, linear
+  /// RGB and alpha, multiplied into the base colour and alpha. A triangle whose three colours are
+  /// all exactly white is shaded without them (hasVertexColor), so a scene without colours and the
+  /// uncoloured triangles of a scene with some render as they did before colours existed.
+  std::vector<glm::vec4> colors;
+  std::vector<uint32_t> indices;           // 3 per triangle
   std::vector<uint32_t> triangleMaterial;  // one per triangle, index into materials
 
   std::vector<Material> materials;
@@ -85,6 +90,16 @@ struct Scene {
   /// cull mode resolved against the material's doubleSided. The one rule every raster applies.
   bool cullsBackFaces(uint32_t material) const {
     return cull == CullMode::Back || (cull == CullMode::Auto && !materials[material].doubleSided);
+  }
+
+  /// Whether the raster multiplies the interpolated vertex colour into triangle `triangle`'s base
+  /// colour: some corner's colour is not exactly white (1, 1, 1, 1). The one rule every raster
+  /// applies (the GL exact raster's geometry shader evaluates it on the same values).
+  bool hasVertexColor(size_t triangle) const {
+    if (colors.empty()) return false;
+    for (int c = 0; c < 3; ++c)
+      if (colors[indices[triangle * 3 + c]] != glm::vec4(1.0f)) return true;
+    return false;
   }
 
   size_t triangleCount() const { return indices.size() / 3; }
