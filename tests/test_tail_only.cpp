@@ -353,6 +353,57 @@ TEST(TailOnly, OnePixelOfOneFragmentIsExactFromItsTail) {
   EXPECT_EQ(e[1], 0.0);
 }
 
+TEST(TailOnly, AOneFragmentTailIsExactSoTheLastFragmentNeedsNoSlot) {
+  // with k = n - 1 the tail holds one fragment: C_tail = c, a_tail = 1 - (1 - a)^1 = a, the over
+  // of that fragment: err(n - 1) = 0 on every random pixel (and err(n - 2) > 0 somewhere)
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  double largestBefore = 0.0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const uint32_t n = 2 + rng() % 6;
+    std::vector<FragmentNode> nodes;
+    for (uint32_t i = 0; i < n; ++i)
+      nodes.push_back(
+          makeNode(u(rng), packFragmentColor({u(rng), u(rng), u(rng)}, 0.1f + 0.8f * u(rng))));
+    std::sort(nodes.begin(), nodes.end());
+    const std::vector<double> e =
+        errorCurve(nodes.data(), n, glm::vec3(1.0f), Compositing::Hybrid, 0);
+    EXPECT_NEAR(e[n - 1], 0.0, 1e-24) << trial;
+    largestBefore = std::max(largestBefore, e[n - 2]);
+  }
+  EXPECT_GT(largestBefore, 1e-3);
+}
+
+TEST(TailOnly, FillVariantsGiveAPixelAtMostNMinusOneSlotsUnderHybrid) {
+  const glm::dvec3 bg(1.0);
+  const std::vector<uint32_t> n = countFragments(quadFrame());
+  uint64_t useful = 0, covered = 0;
+  for (uint32_t c : n) {
+    useful += c > 0 ? c - 1 : 0;
+    covered += c > 0;
+  }
+  for (const char* name : {"vkb-fill", "dkb-fill"}) {
+    const MethodDesc m = hybridPreset(name);
+    RenderOptions o;
+    o.background = glm::vec3(bg);
+    o.budgetBytes = overhead(m) + 8 * useful;  // exactly n(p) - 1 for every pixel
+    auto out = render(quadFrame(), m, o);
+    ASSERT_TRUE(out.ok()) << name << ": " << out.error().message;
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x) {
+        const size_t p = static_cast<size_t>(y) * kSize + x;
+        ASSERT_EQ(out->kMap[p], n[p] > 0 ? n[p] - 1 : 0) << name << " " << x << "," << y;
+        const glm::dvec3 want = exact(layersAt(x, y), bg);  // a one-fragment tail is exact
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(out->image.pixels[p][c], want[c], 2e-5) << name;
+      }
+    // under kbuffer compositing the same budget (here below one node per covered pixel: the
+    // scene has more pixels of one fragment than extra fragments) is refused
+    ASSERT_LT(useful, covered);
+    o.budgetBytes = overhead(hybridPreset(name, Compositing::KBuffer)) + 8 * useful;
+    EXPECT_FALSE(render(quadFrame(), hybridPreset(name, Compositing::KBuffer), o).ok()) << name;
+  }
+}
+
 TEST(TailOnly, PredictedCurvesMayLeaveAPixelWithoutASlotUnderHybrid) {
   // two pixels of 3 fragments: drops 0.5, 0.1 (pixel 0) and 0.2, 0.1 (pixel 1), as sqrt targets
   std::vector<float> predictions(2 * kCurveOutputs, 0.0f);

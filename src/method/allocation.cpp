@@ -9,7 +9,8 @@
 //   importance    k(p) = floor(P(p) F(M)), P(p) = I(p) / sum I (variable k-buffer, Eqs. 1-2); the
 //                 fill variant gives every covered pixel one slot, the rest by importance capped
 //                 at n(p), and hands freed and remainder slots to the pixels with the largest unmet
-//                 importance;
+//                 importance (under hybrid compositing capped at n(p) - 1: a one-fragment tail is
+//                 exact, so the last fragment never needs a slot);
 //   optimal       k(p) from the offline oracle (optimal_allocation.hpp) over an A-buffer pre-pass;
 //   (under hybrid compositing the counted, dynamic, importance and optimal policies may give a
 //   covered pixel k(p) = 0: it is composited from its order-independent tail alone, so their
@@ -345,22 +346,32 @@ Result<void> allocateByImportance(const AllocationInputs& in, const std::vector<
       for (size_t p = 0; p < pixels; ++p)
         k[p] = static_cast<uint64_t>(
             std::floor(importance[p] / total * static_cast<double>(slotsInBudget)));
-  } else if (slotsInBudget < in.covered) {
-    // fill under hybrid compositing with fewer slots than covered pixels (tail-only pixels
-    // allowed): no slot for every pixel first; the water-filling from k = 0 gives them by
-    // importance, the last ones one each to the most important pixels
-    fillByImportance(n, importance, slotsInBudget, k);
   } else {
-    // fill: one slot for every covered pixel first (like DHOIT's allocation), the rest by
-    // importance, capped at n(p), then the freed and remainder slots to the unmet pixels
-    const double share = static_cast<double>(slotsInBudget - in.covered);
-    for (size_t p = 0; p < pixels; ++p) {
-      if (n[p] == 0) continue;
-      const uint64_t byImportance =
-          total > 0.0 ? static_cast<uint64_t>(std::floor(importance[p] / total * share)) : 0;
-      k[p] = 1 + std::min<uint64_t>(n[p] - 1, byImportance);
+    // fill (mfr's variant): the slots a pixel can use are n(p), or n(p) - 1 under hybrid
+    // compositing, where a one-fragment tail is exact (C_tail = c, alpha_tail = a): its last
+    // fragment needs no slot, so a pixel of one fragment needs none
+    std::vector<uint32_t> useful(n);
+    if (in.tailOnly)
+      for (uint32_t& u : useful) u = u > 0 ? u - 1 : 0;
+    uint64_t needing = 0;  // pixels that can use a slot
+    for (uint32_t u : useful) needing += u > 0;
+    if (slotsInBudget >= needing) {
+      // one slot for every such pixel first (like DHOIT's allocation), the rest by importance,
+      // capped at what it can use, then the freed and remainder slots to the unmet pixels
+      const double share = static_cast<double>(slotsInBudget - needing);
+      for (size_t p = 0; p < pixels; ++p) {
+        if (useful[p] == 0) continue;
+        const uint64_t byImportance =
+            total > 0.0 ? static_cast<uint64_t>(std::floor(importance[p] / total * share)) : 0;
+        k[p] = 1 + std::min<uint64_t>(useful[p] - 1, byImportance);
+      }
     }
-    fillByImportance(n, importance, slotsInBudget, k);
+    // (fewer slots than such pixels, under hybrid compositing: the water-filling from k = 0
+    // gives them by importance, the last ones one each to the most important pixels)
+    fillByImportance(useful, importance, slotsInBudget, k);
+    // slots left once every pixel has what it can use: up to n(p) (the last fragment's slot buys
+    // nothing exactly, but its float rounding is the A-buffer's)
+    if (in.tailOnly) fillByImportance(n, importance, slotsInBudget, k);
   }
   a.scratchBytes += k.capacity() * sizeof(uint64_t);
   a.reservedK.resize(pixels);
