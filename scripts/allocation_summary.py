@@ -11,7 +11,10 @@ A case is one scene x view x budget x compositing rule. Per method:
   - failed: the cases where the method could not run (e.g. a share below one node per pixel);
   - wins: for each other method, in how many cases this method's MSE is strictly lower (ties and
     cases where either failed are not counted).
-The tables are given for all cases, and per compositing rule.
+The tables are given for all cases, and per compositing rule. Then one table per rule with a
+column per budget: each method's MSE / optimal there and the cases that ran / were refused (a
+refusal is a budget below what the method needs, e.g. one node per covered pixel under kbuffer
+compositing; under hybrid compositing the per-pixel methods take any share, issue 28).
 """
 import glob
 import html
@@ -91,6 +94,64 @@ def ratio_text(v):
     return "n/a" if v is None else "%.2f" % v
 
 
+def budget_key(label):
+    """budget labels in numeric order ("10%" before "25%"); absolute ones after, as text"""
+    try:
+        return (0, float(label.rstrip("%")), label) if label.endswith("%") else (1, 0.0, label)
+    except ValueError:
+        return (1, 0.0, label)
+
+
+def by_budget(cases, methods, rule):
+    """per budget of `rule`: {method: (mse ratio, ran, refused)}"""
+    budgets = sorted({k[1] for k, c in cases.items() if c["compositing"] == rule}, key=budget_key)
+    out = []
+    for b in budgets:
+        subset = {k: c for k, c in cases.items() if c["compositing"] == rule and k[1] == b}
+        cells = {}
+        for m in methods:
+            ran = refused = 0
+            ratios = []
+            for c in subset.values():
+                run, opt = c["runs"].get(m), c["runs"].get("optimal")
+                if run is None:
+                    continue
+                if "error" in run:
+                    refused += 1
+                    continue
+                ran += 1
+                a, o = value(run, "mse_linear"), value(opt, "mse_linear")
+                if a is not None and o is not None and a > 0 and o > 0:
+                    ratios.append(a / o)
+            cells[m] = (geomean(ratios)[0], ran, refused)
+        out.append((b, cells))
+    return out
+
+
+def budget_markdown(rule, columns, methods):
+    lines = ["", "### %s compositing by budget: MSE / optimal (cases ran / refused)" % rule, "",
+             "| method | " + " | ".join(b for b, _ in columns) + " |",
+             "|---" * (1 + len(columns)) + "|"]
+    for m in methods:
+        cells = []
+        for _, c in columns:
+            ratio, ran, refused = c[m]
+            cells.append("%s (%d / %d)" % (ratio_text(ratio), ran, refused))
+        lines.append("| %s | %s |" % (m, " | ".join(cells)))
+    return lines
+
+
+def budget_html(rule, columns, methods):
+    h = ["<h2>%s compositing by budget: MSE / optimal (cases ran / refused)</h2>" % html.escape(rule),
+         "<table><tr><th>method</th>" + "".join("<th>%s</th>" % html.escape(b) for b, _ in columns)
+         + "</tr>"]
+    for m in methods:
+        h.append("<tr><td><code>%s</code></td>%s</tr>" % (html.escape(m), "".join(
+            "<td>%s (%d / %d)</td>" % (ratio_text(c[m][0]), c[m][1], c[m][2]) for _, c in columns)))
+    h.append("</table>")
+    return h
+
+
 def markdown(title, rows, methods):
     lines = ["", "### " + title, "",
              "| method | MSE / optimal | FLIP / optimal | cases | failed | " +
@@ -122,7 +183,7 @@ def main(out, seconds=None):
         print("allocation_summary: no results.json under %s" % out, file=sys.stderr)
         return 1
     folders = sorted({k[0] for k in cases})
-    budgets = sorted({k[1] for k in cases})
+    budgets = sorted({k[1] for k in cases}, key=budget_key)
     rules = sorted({c["compositing"] for c in cases.values()})
     scenes = sorted({c["scene"] for c in cases.values()})
     sections = [("all cases (%d)" % len(cases), cases)]
@@ -145,6 +206,10 @@ def main(out, seconds=None):
         rows = table(subset, methods)
         md += markdown(title, rows, methods)
         page += html_table(title, rows, methods)
+    for rule in rules:
+        columns = by_budget(cases, methods, rule)
+        md += budget_markdown(rule, columns, methods)
+        page += budget_html(rule, columns, methods)
     page.append("<h2>Reports</h2><ul>")
     for f in folders:
         page.append("<li><a href=\"%s/report.html\">%s</a></li>" % (html.escape(f), html.escape(f)))

@@ -158,7 +158,7 @@ TEST(DeepKBuffer, WideAndScalarPathsPredictTheSameImportanceWithinFloatRounding)
   EXPECT_GT(covered, 1000u);
 }
 
-TEST(DeepKBuffer, SumOfKNeverExceedsTheBudgetAndFillKeepsOnePerCoveredPixel) {
+TEST(DeepKBuffer, SumOfKNeverExceedsTheBudgetAndFillKeepsOneWhereItCounts) {
   const HairballFrame h = hairball();
   for (const char* preset : {"dkb", "dkb-fill"})
     for (uint64_t budget : {500000ull, 800000ull, 2000000ull}) {
@@ -181,8 +181,10 @@ TEST(DeepKBuffer, SumOfKNeverExceedsTheBudgetAndFillKeepsOnePerCoveredPixel) {
         EXPECT_EQ(sumK, std::min(slots, demand)) << budget;
         for (size_t p = 0; p < out.kMap.size(); ++p) {
           EXPECT_LE(out.kMap[p], out.depthComplexity[p]);
-          if (out.depthComplexity[p] > 0) {
-            EXPECT_GE(out.kMap[p], 1u) << "every covered pixel keeps one fragment";
+          // (hybrid compositing: a tail of one fragment is exact, so a pixel of one fragment
+          // needs no slot, issue 28)
+          if (out.depthComplexity[p] > 1) {
+            EXPECT_GE(out.kMap[p], 1u) << "every pixel of two or more fragments keeps one";
           }
         }
       }

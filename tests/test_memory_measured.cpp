@@ -76,12 +76,19 @@ std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const 
     // per covered pixel, the rebuilt curves (a vector per pixel, a double per fragment)
     uint64_t covered = 0;
     for (uint32_t n : out.depthComplexity) covered += n > 0;
+    // (under hybrid compositing every covered pixel's curve starts at k = 0: one more double)
+    const uint64_t fromZero = m.compositing == Compositing::Hybrid ? covered : 0;
     b["oracle_prepass"] = (sizeof(FeatureAccumulator) + 4 * 9) * pixels + (12 + 9) * 4 * covered +
-                          8 * abufferFragments + sizeof(std::vector<double>) * pixels;
+                          8 * (abufferFragments + fromZero) + sizeof(std::vector<double>) * pixels;
   } else if (m.allocation == AllocationPolicy::Optimal) {
     b["oracle_k"] = 4 * pixels;
-    // n(p) and the error curves (the A-buffer is tile-local: one tile's nodes per worker)
-    const uint64_t curves = 8 * abufferFragments + sizeof(std::vector<double>) * pixels;
+    // n(p) and the error curves (the A-buffer is tile-local: one tile's nodes per worker); under
+    // hybrid compositing each covered pixel's curve starts at k = 0, the tail alone (one double)
+    uint64_t covered = 0;
+    for (uint32_t n : out.depthComplexity) covered += n > 0;
+    const uint64_t fromZero = m.compositing == Compositing::Hybrid ? covered : 0;
+    const uint64_t curves =
+        8 * (abufferFragments + fromZero) + sizeof(std::vector<double>) * pixels;
     b["oracle_prepass"] = 4 * pixels + curves;
   }
   return b;

@@ -524,10 +524,12 @@ TEST(MemoryBudget, SmallestSufficientBudgetSucceedsAndOneByteLessIsAnError) {
       const MethodDesc m = presetWithK(preset, std::nullopt, comp);
       const std::string base = baseName(preset);
       const Layout layout = documentedLayout(base, m.occupancyWords, comp);
-      // fixed k needs one slot per pixel, exact allocations one per covered pixel (k = 1)
+      // fixed k needs one slot per pixel, exact allocations one per covered pixel (k = 1) under
+      // kbuffer compositing, none under hybrid (k = 0: every pixel from its tail, issue 28)
       const bool fixed =
           base == "zbuffer" || base == "fkb" || base == "kplus-array" || base == "kplus-heap";
-      const uint64_t slots = base == "abuffer" ? total : fixed ? n.size() : covered;
+      const bool tailOnly = !fixed && base != "abuffer" && comp == Compositing::Hybrid;
+      const uint64_t slots = base == "abuffer" ? total : fixed ? n.size() : tailOnly ? 0 : covered;
       const uint64_t minimum = n.size() * layout.perPixel + layout.image + 8 * slots;
       RenderOptions options;
       options.budgetBytes = minimum;
@@ -536,14 +538,20 @@ TEST(MemoryBudget, SmallestSufficientBudgetSucceedsAndOneByteLessIsAnError) {
                              << " B: " << (fits.ok() ? "" : fits.error().message);
       EXPECT_EQ(fits->stats.bytesUsed, minimum) << m.name;
       if (base != "abuffer") {
-        EXPECT_EQ(fits->stats.globalK, 1u) << m.name;
+        EXPECT_EQ(fits->stats.globalK, tailOnly ? 0u : 1u) << m.name;
+      }
+      if (tailOnly) {
+        EXPECT_EQ(fits->stats.captured, 0u) << m.name;
+        EXPECT_EQ(fits->stats.fragmentSlots, 0u) << m.name;
       }
       options.budgetBytes = minimum - 1;
       const auto tooSmall = render(*frame, m, options);
       ASSERT_FALSE(tooSmall.ok()) << m.name << " with " << minimum - 1 << " B";
-      EXPECT_NE(tooSmall.error().message.find(std::to_string(minimum - 1) + " B"),
-                std::string::npos)
-          << tooSmall.error().message;
+      const std::string& message = tooSmall.error().message;
+      EXPECT_NE(message.find(std::to_string(minimum - 1) + " B"), std::string::npos) << message;
+      // the message names the floor: the per-pixel words, or what one node per pixel needs
+      EXPECT_NE(message.find(std::to_string(minimum) + " B"), std::string::npos) << message;
+      EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     }
 }
 

@@ -309,9 +309,8 @@ TEST(OptimalPreset, BeatsTheOtherAllocationsWithinTheSameBudget) {
   uint64_t sumK = 0;
   for (size_t p = 0; p < optimal.kMap.size(); ++p) {
     sumK += optimal.kMap[p];
-    if (truth.depthComplexity[p] > 0) {
-      EXPECT_GE(optimal.kMap[p], 1u);
-    }
+    // under hybrid compositing a covered pixel may keep no slot (its tail alone, issue 28)
+    EXPECT_LE(optimal.kMap[p], truth.depthComplexity[p]);
   }
   EXPECT_LE(sumK, slots);
   EXPECT_LE(optimal.stats.bytesUsed, 400000u);

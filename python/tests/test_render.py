@@ -485,3 +485,33 @@ def test_gil_is_released_while_rendering():
     worker.join()
     assert timing["render"] > 0.05, "the render is too short to tell"
     assert longest < 0.5 * timing["render"], (longest, timing)
+
+
+def test_hybrid_compositing_takes_budgets_down_to_the_per_pixel_words():
+    # issue 28: under hybrid compositing a pixel without a slot keeps its tail, so a share below
+    # one node per covered pixel runs (some or every pixel tail-only); kbuffer refuses it, saying
+    # why
+    scene = "procedural:smoke"
+    n = mfr.render(scene, method="abuffer", width=W, height=H).depth_complexity
+    covered, fragments = int((n > 0).sum()), int(n.sum())
+    share = 100.0 * covered / fragments / 2  # half a node per covered pixel
+    r = mfr.render(scene, method="optimal", budget=f"{share:.2f}%", width=W, height=H,
+                   composite="hybrid")
+    assert r.stats["bytes_used"] <= r.stats["budget_bytes"]
+    assert int(r.k_map.sum()) <= fragments * share / 100
+    assert int(((r.k_map == 0) & (n > 0)).sum()) >= covered // 2  # tail-only pixels
+    with pytest.raises(mfr.Error, match=r"kbuffer compositing keeps no tail"):
+        mfr.render(scene, method="optimal", budget=f"{share:.2f}%", width=W, height=H,
+                   composite="kbuffer")
+    # one byte below the per-pixel words: refused, naming them; at them: every pixel tail-only
+    with pytest.raises(mfr.Error) as refused:
+        mfr.render(scene, method="kplus-dynamic", budget=1, width=W, height=H, composite="hybrid")
+    floor = int(re.search(r"per-pixel buffers take (\d+) B", str(refused.value)).group(1))
+    assert "floor under hybrid compositing" in str(refused.value)
+    with pytest.raises(mfr.Error, match=rf"^{scene}: budget {floor - 1} B: too small"):
+        mfr.render(scene, method="kplus-dynamic", budget=floor - 1, width=W, height=H,
+                   composite="hybrid")
+    at = mfr.render(scene, method="kplus-dynamic", budget=floor, width=W, height=H,
+                    composite="hybrid")
+    assert at.stats["bytes_used"] == floor and at.stats["fragments_captured"] == 0
+    assert not at.k_map.any()

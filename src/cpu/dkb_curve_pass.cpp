@@ -7,6 +7,7 @@
 
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/learn/model_file.hpp"
+#include "mfr/method/allocation.hpp"
 #include "mfr/method/dkb_curve.hpp"
 #include "mfr/method/dkb_model.hpp"
 
@@ -26,7 +27,10 @@ Result<CurveChoice> predictedCurveK(const RasterFrame& frame, const MethodDesc& 
     out.n[p] = pixels[p].n;
     if (pixels[p].n > 0) covered.push_back(p);
   }
-  if (slots < covered.size()) return out;  // allocate() reports the budget
+  // under hybrid compositing a pixel may keep no slot (its tail alone); else allocate() reports
+  // a budget below one slot per covered pixel
+  const uint32_t firstK = allowsTailOnlyPixels(method) ? 0 : 1;
+  if (firstK == 1 && slots < covered.size()) return out;
   // the network over the covered pixels (rows of 12 features)
   std::vector<float> rows(covered.size() * kDkbFeatureCount);
   for (size_t i = 0; i < covered.size(); ++i) {
@@ -42,10 +46,11 @@ Result<CurveChoice> predictedCurveK(const RasterFrame& frame, const MethodDesc& 
   // the hull allocation over the rebuilt curves
   // (on the frame's workers, like its tile passes; the same k on any number)
   tbb::task_arena(frame.arenaThreads()).execute([&] {
-    out.k = allocateByPredictedCurves(predictions, out.n, slots);
+    out.k = allocateByPredictedCurves(predictions, out.n, slots, firstK);
   });
   out.bytesAllocated = pixels.size() * (sizeof(FeatureAccumulator) + 4 * kCurveOutputs) +
-                       (rows.size() + predicted.size()) * 4 + image.fragments * sizeof(double) +
+                       (rows.size() + predicted.size()) * 4 +
+                       (image.fragments + (firstK == 0 ? covered.size() : 0)) * sizeof(double) +
                        pixels.size() * sizeof(std::vector<double>);
   return out;
 }

@@ -25,20 +25,23 @@
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/cpu/fragment.hpp"
 #include "mfr/cpu/render.hpp"
+#include "mfr/method/allocation.hpp"
 #include "mfr/method/optimal_allocation.hpp"
 
 namespace mfr {
 
 Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 background,
                                           Compositing compositing,
-                                          std::optional<uint64_t> memoryLimitBytes) {
+                                          std::optional<uint64_t> memoryLimitBytes,
+                                          uint32_t firstK) {
   const uint64_t limit = memoryLimitBytes.value_or(defaultMemoryLimit());
   const uint64_t pixels = frame.pixelCount();
-  // n(p) and the curves of `fragments` fragments (8 bytes each, a vector per pixel)
+  // n(p) and the curves of `fragments` fragments (8 bytes each, a vector per pixel, and err(0)
+  // per pixel when the curves start at k = 0)
+  const uint64_t perPixel =
+      sizeof(std::vector<double>) + sizeof(uint32_t) + (firstK == 0 ? sizeof(double) : 0);
   const auto needed = [&](uint64_t fragments) {
-    return saturatingAdd(saturatingAdd(saturatingMul(fragments, sizeof(double)),
-                                       saturatingMul(pixels, sizeof(std::vector<double>))),
-                         saturatingMul(pixels, sizeof(uint32_t)));
+    return saturatingAdd(saturatingMul(fragments, sizeof(double)), saturatingMul(pixels, perPixel));
   };
   const auto check = [&](uint64_t fragments) {
     return checkMemory(needed(fragments), limit,
@@ -65,6 +68,7 @@ Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 ba
   if (needed(0) > limit) return overLimit();
 
   FrameErrorCurves out;
+  out.firstK = firstK;
   out.n.assign(pixels, 0);
   out.curves.resize(pixels);
   std::atomic<uint64_t> fragments{0};
@@ -109,7 +113,7 @@ Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 ba
         FragmentNode* px = nodes.data() + begin;
         std::sort(px, px + n);
         out.n[p] = n;
-        out.curves[p] = errorCurve(px, n, background, compositing);
+        out.curves[p] = errorCurve(px, n, background, compositing, firstK);
       }
   });
   if (over) {
@@ -129,17 +133,20 @@ Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 ba
 
 Result<OracleChoice> optimalK(const RasterFrame& frame, const MethodDesc& method,
                               const RenderOptions& options, uint64_t slots) {
-  auto oracle =
-      frameErrorCurves(frame, options.background, method.compositing, options.memoryLimitBytes);
+  // under hybrid compositing a pixel may keep no slot: the curves start at its tail alone
+  const uint32_t firstK = allowsTailOnlyPixels(method) ? 0 : 1;
+  auto oracle = frameErrorCurves(frame, options.background, method.compositing,
+                                 options.memoryLimitBytes, firstK);
   if (!oracle) return makeError(method.name + ": the oracle's pre-pass: " + oracle.error().message);
   OracleChoice out;
   out.bytesAllocated = oracle->bytesAllocated;
-  if (slots < oracle->coveredPixels) {
+  if (firstK == 1 && slots < oracle->coveredPixels) {
     out.n = std::move(oracle->n);
     return out;
   }
   OracleOptions oo;
   oo.publishedGreedy = method.publishedGreedy;
+  oo.firstK = firstK;
   // on the frame's workers, like its tile passes (the allocation is the same on any number)
   OracleAllocation a;
   tbb::task_arena(frame.arenaThreads()).execute([&] {

@@ -9,8 +9,12 @@
 //   importance    k(p) = floor(P(p) F(M)), P(p) = I(p) / sum I (variable k-buffer, Eqs. 1-2); the
 //                 fill variant gives every covered pixel one slot, the rest by importance capped
 //                 at n(p), and hands freed and remainder slots to the pixels with the largest unmet
-//                 importance;
+//                 importance (under hybrid compositing capped at n(p) - 1: a one-fragment tail is
+//                 exact, so the last fragment never needs a slot);
 //   optimal       k(p) from the offline oracle (optimal_allocation.hpp) over an A-buffer pre-pass;
+//   (under hybrid compositing the counted, dynamic, importance and optimal policies may give a
+//   covered pixel k(p) = 0: it is composited from its order-independent tail alone, so their
+//   budget floor is the per-pixel words; allowsTailOnlyPixels, issue 28)
 //   unbounded     k(p) = n(p) (A-buffer / S-buffer);
 //   no nodes      k(p) = 0 (wboit, mboit: per-pixel accumulators only; the budget must cover them).
 // Node bytes are the memory model's S_f (8, or 20 for mlab's nodes).
@@ -95,6 +99,22 @@ void fillByImportance(const std::vector<uint32_t>& n, const std::vector<float>& 
   }
 }
 
+bool allowsTailOnlyPixels(const MethodDesc& method) {
+  if (method.compositing != Compositing::Hybrid) return false;
+  switch (method.allocation) {
+    case AllocationPolicy::CountedK:
+    case AllocationPolicy::DynamicK:
+    case AllocationPolicy::Importance:
+    case AllocationPolicy::Optimal:
+      return true;
+    case AllocationPolicy::Unbounded:
+    case AllocationPolicy::FixedK:
+    case AllocationPolicy::NoNodes:
+      return false;
+  }
+  return false;
+}
+
 Result<uint64_t> budgetSlots(const PixelLayout& frame, const MethodDesc& method,
                              const MemoryModel& memory, std::optional<uint64_t> budget) {
   const uint64_t pixels = frame.pixels();
@@ -107,6 +127,14 @@ Result<uint64_t> budgetSlots(const PixelLayout& frame, const MethodDesc& method,
                        ")");
     return uint64_t{0};
   }
+  if (allowsTailOnlyPixels(method)) {  // hybrid: a pixel without a slot keeps its tail
+    if (budget && *budget < overhead)
+      return makeError("budget " + bytesText(*budget) + ": too small for " + name + " at " +
+                       sizeText(frame) + " (its per-pixel buffers take " + bytesText(overhead) +
+                       ", the floor under hybrid compositing, where a pixel without a slot is "
+                       "composited from its tail alone)");
+    return budget ? memory.fragmentSlots(*budget, pixels) : UINT64_MAX;
+  }
   if (budget && *budget < overhead + memory.node)
     return makeError("budget " + bytesText(*budget) + ": too small for " + name + " at " +
                      sizeText(frame) + " (its per-pixel buffers take " + bytesText(overhead) +
@@ -116,12 +144,22 @@ Result<uint64_t> budgetSlots(const PixelLayout& frame, const MethodDesc& method,
 
 namespace {
 
-// the budget cannot give one node to every (covered) pixel
+// the budget cannot give one node to every (covered) pixel; for a policy that could go lower under
+// hybrid compositing, the message says why this rule cannot
 Error tooSmallFor(const PixelLayout& frame, const MethodDesc& method, const MemoryModel& memory,
                   uint64_t budget, const char* which, uint64_t count) {
+  const uint64_t overhead = memory.overhead(frame.pixels());
+  MethodDesc hybrid = method;
+  hybrid.compositing = Compositing::Hybrid;
+  const std::string why =
+      allowsTailOnlyPixels(hybrid)
+          ? ": kbuffer compositing keeps no tail, so a pixel without a slot would lose all its "
+            "fragments; under hybrid compositing the floor is the per-pixel words, " +
+                bytesText(overhead)
+          : "";
   return makeError("budget " + bytesText(budget) + ": too small for one fragment per " + which +
                    " with " + method.name + " at " + sizeText(frame) + " (needs " +
-                   bytesText(memory.overhead(frame.pixels()) + count * memory.node) + ")");
+                   bytesText(overhead + count * memory.node) + why + ")");
 }
 
 }  // namespace
@@ -134,12 +172,19 @@ Result<uint32_t> boundedK(const PixelLayout& frame, const MethodDesc& method,
   auto slots = budgetSlots(frame, method, memory, budget);
   if (!slots) return slots.error();
   const uint64_t slotsInBudget = *slots;
+  const bool tailOnly = allowsTailOnlyPixels(method);  // k = 0 may be the answer
   uint64_t k = 0;
   if (method.allocation == AllocationPolicy::CountedK && method.k) {
     k = *method.k;
   } else if (method.allocation == AllocationPolicy::CountedK) {
     if (!budget) return makeError(name + ": needs a budget or an explicit k");
     k = std::max<uint64_t>(1, std::min<uint64_t>(slotsInBudget / pixels, 1u << 20));
+    // k = 1 needs a node per covered pixel (F(M) / |P| >= 1 always has it): else tail only, or
+    // under kbuffer compositing too small
+    if (slotsInBudget < counts.covered)
+      return tailOnly
+                 ? Result<uint32_t>(uint32_t{0})
+                 : tooSmallFor(frame, method, memory, *budget, "covered pixel", counts.covered);
   } else {
     if (!budget && !method.k) return makeError(name + ": needs a budget");
     MFR_CHECK(counts.histogram.size() == kHistogramBins);
@@ -156,6 +201,7 @@ Result<uint32_t> boundedK(const PixelLayout& frame, const MethodDesc& method,
         need += histogram[bin] * std::min(bin, candidate);
       if (need <= slotsInBudget) k = candidate;
     }
+    if (k == 0 && tailOnly) return uint32_t{0};  // every pixel tail-only
     if (k == 0) return tooSmallFor(frame, method, memory, *budget, "covered pixel", counts.covered);
   }
   if (k == 0) return makeError(name + ": k must be at least 1");
@@ -181,7 +227,7 @@ Result<void> checkCoveredPixels(const PixelLayout& frame, const MethodDesc& meth
   auto inBudget = budgetSlots(frame, method, memory, budget);
   if (!inBudget) return inBudget.error();
   if (!budget) return makeError(method.name + ": needs a budget");
-  if (*inBudget < covered)
+  if (*inBudget < covered && !allowsTailOnlyPixels(method))
     return tooSmallFor(frame, method, memory, *budget, "covered pixel", covered);
   return {};
 }
@@ -209,6 +255,7 @@ struct AllocationInputs {
   const std::vector<uint32_t>& n;
   uint64_t slotsInBudget;
   uint64_t covered;  // pixels with n(p) > 0
+  bool tailOnly;     // allowsTailOnlyPixels: k(p) = 0 allowed for a covered pixel
 
   Error tooSmall(const char* which, uint64_t count) const {
     return tooSmallFor(frame, method, memory, *budget, which, count);
@@ -290,7 +337,7 @@ Result<void> allocateByImportance(const AllocationInputs& in, const std::vector<
   const uint64_t pixels = in.frame.pixels();
   const uint64_t slotsInBudget = in.slotsInBudget;
   if (!in.budget) return makeError(in.method.name + ": needs a budget");
-  if (slotsInBudget < in.covered) return in.tooSmall("covered pixel", in.covered);
+  if (slotsInBudget < in.covered && !in.tailOnly) return in.tooSmall("covered pixel", in.covered);
   double total = 0.0;
   for (float i : importance) total += i;
   std::vector<uint64_t> k(pixels, 0);
@@ -300,16 +347,31 @@ Result<void> allocateByImportance(const AllocationInputs& in, const std::vector<
         k[p] = static_cast<uint64_t>(
             std::floor(importance[p] / total * static_cast<double>(slotsInBudget)));
   } else {
-    // fill: one slot for every covered pixel first (like DHOIT's allocation), the rest by
-    // importance, capped at n(p), then the freed and remainder slots to the unmet pixels
-    const double share = static_cast<double>(slotsInBudget - in.covered);
-    for (size_t p = 0; p < pixels; ++p) {
-      if (n[p] == 0) continue;
-      const uint64_t byImportance =
-          total > 0.0 ? static_cast<uint64_t>(std::floor(importance[p] / total * share)) : 0;
-      k[p] = 1 + std::min<uint64_t>(n[p] - 1, byImportance);
+    // fill (mfr's variant): the slots a pixel can use are n(p), or n(p) - 1 under hybrid
+    // compositing, where a one-fragment tail is exact (C_tail = c, alpha_tail = a): its last
+    // fragment needs no slot, so a pixel of one fragment needs none
+    std::vector<uint32_t> useful(n);
+    if (in.tailOnly)
+      for (uint32_t& u : useful) u = u > 0 ? u - 1 : 0;
+    uint64_t needing = 0;  // pixels that can use a slot
+    for (uint32_t u : useful) needing += u > 0;
+    if (slotsInBudget >= needing) {
+      // one slot for every such pixel first (like DHOIT's allocation), the rest by importance,
+      // capped at what it can use, then the freed and remainder slots to the unmet pixels
+      const double share = static_cast<double>(slotsInBudget - needing);
+      for (size_t p = 0; p < pixels; ++p) {
+        if (useful[p] == 0) continue;
+        const uint64_t byImportance =
+            total > 0.0 ? static_cast<uint64_t>(std::floor(importance[p] / total * share)) : 0;
+        k[p] = 1 + std::min<uint64_t>(useful[p] - 1, byImportance);
+      }
     }
-    fillByImportance(n, importance, slotsInBudget, k);
+    // (fewer slots than such pixels, under hybrid compositing: the water-filling from k = 0
+    // gives them by importance, the last ones one each to the most important pixels)
+    fillByImportance(useful, importance, slotsInBudget, k);
+    // slots left once every pixel has what it can use: up to n(p) (the last fragment's slot buys
+    // nothing exactly, but its float rounding is the A-buffer's)
+    if (in.tailOnly) fillByImportance(n, importance, slotsInBudget, k);
   }
   a.scratchBytes += k.capacity() * sizeof(uint64_t);
   a.reservedK.resize(pixels);
@@ -327,7 +389,9 @@ Result<void> allocateByImportance(const AllocationInputs& in, const std::vector<
 Result<void> allocateOptimal(const AllocationInputs& in, const std::vector<uint32_t>& oracleK,
                              Allocation& a) {
   if (!in.budget) return makeError(in.method.name + ": needs a budget");
-  if (in.slotsInBudget < in.covered) return in.tooSmall("covered pixel", in.covered);
+  if (in.slotsInBudget < in.covered && !in.tailOnly)
+    return in.tooSmall("covered pixel", in.covered);
+  MFR_CHECK_EQ(oracleK.size(), in.frame.pixels());
   for (size_t p = 0; p < in.frame.pixels(); ++p) {
     a.capacity[p] = oracleK[p];
     a.slots += oracleK[p];
@@ -375,7 +439,8 @@ Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
   }
   uint64_t covered = 0;
   for (uint32_t c : n) covered += c > 0;
-  const AllocationInputs in{frame, method, memory, budget, n, *inBudget, covered};
+  const AllocationInputs in{frame, method,    memory,  budget,
+                            n,     *inBudget, covered, allowsTailOnlyPixels(method)};
 
   switch (method.allocation) {
     case AllocationPolicy::Unbounded:

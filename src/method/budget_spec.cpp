@@ -7,6 +7,7 @@
 
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
+#include "mfr/method/allocation.hpp"
 
 namespace mfr {
 namespace {
@@ -19,8 +20,10 @@ std::string percentText(double p) {
 }
 
 // nodes the policy must be able to give: one per pixel (fixed k: k per pixel), one per covered
-// pixel, or every fragment (A-buffer)
+// pixel, or every fragment (A-buffer); none when a covered pixel may go without a slot (hybrid
+// compositing: its tail alone, allowsTailOnlyPixels)
 uint64_t nodesNeeded(const MethodDesc& method, const FrameCounts& counts) {
+  if (allowsTailOnlyPixels(method)) return 0;
   switch (method.allocation) {
     case AllocationPolicy::NoNodes:
       return 0;
@@ -136,10 +139,18 @@ Result<uint64_t> resolveBudget(const BudgetSpec& spec, const MethodDesc& method,
                        : method.allocation == AllocationPolicy::FixedK
                            ? "one node per pixel"
                            : "one node per covered pixel";
+    // a policy that would take any share under hybrid compositing: say why this rule does not
+    MethodDesc hybrid = method;
+    hybrid.compositing = Compositing::Hybrid;
+    const char* why = allowsTailOnlyPixels(hybrid)
+                          ? "; kbuffer compositing keeps no tail, so a pixel without a slot would "
+                            "lose all its fragments: hybrid compositing takes any share"
+                          : "";
     return makeError("budget " + spec.label + ": too small for " + method.name + " at " + size +
                      " (" + what + " needs at least " +
                      (std::isfinite(smallest) ? percentText(smallest) + "%" : "a fragment") +
-                     " of the A-buffer's " + std::to_string(counts.fragments) + " nodes)");
+                     " of the A-buffer's " + std::to_string(counts.fragments) + " nodes" + why +
+                     ")");
   }
   return memory.overhead(counts.pixels) + relativeNodeBytes(spec.percent, counts);
 }

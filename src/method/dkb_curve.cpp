@@ -58,12 +58,22 @@ std::vector<double> curveFromPrediction(const float* prediction, uint32_t n) {
 }
 
 std::vector<uint32_t> allocateByPredictedCurves(const std::vector<float>& predictions,
-                                                const std::vector<uint32_t>& n, uint64_t slots) {
+                                                const std::vector<uint32_t>& n, uint64_t slots,
+                                                uint32_t firstK) {
   MFR_CHECK(predictions.size() == n.size() * kCurveOutputs);
+  MFR_CHECK_LE(firstK, 1u);
   std::vector<std::vector<double>> curves(n.size());
-  for (size_t p = 0; p < n.size(); ++p)
-    curves[p] = curveFromPrediction(predictions.data() + p * kCurveOutputs, n[p]);
-  return allocateOptimalHull(curves, slots);
+  for (size_t p = 0; p < n.size(); ++p) {
+    std::vector<double> c = curveFromPrediction(predictions.data() + p * kCurveOutputs, n[p]);
+    if (firstK == 0 && !c.empty()) {  // err(0): the first drop again (see the header)
+      const double firstDrop = c.size() > 1 ? c[0] - c[1] : 0.0;
+      c.insert(c.begin(), c[0] + firstDrop);
+    }
+    curves[p] = std::move(c);
+  }
+  OracleOptions options;
+  options.firstK = firstK;
+  return allocateOptimalHull(curves, slots, options);
 }
 
 }  // namespace mfr

@@ -17,9 +17,10 @@
 namespace mfr {
 
 std::vector<double> errorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3 background,
-                               Compositing compositing) {
-  std::vector<double> err(n, 0.0);
-  if (n == 0) return err;
+                               Compositing compositing, uint32_t firstK) {
+  MFR_CHECK_LE(firstK, 1u);
+  if (n == 0) return {};
+  std::vector<double> err(n + 1 - firstK, 0.0);
   // prefix: core colour and transmittance; suffix: tail sums (the calling thread's scratch, reused
   // from pixel to pixel: the oracle calls this once per covered pixel)
   thread_local std::vector<glm::dvec3> core, tailColor;
@@ -49,9 +50,9 @@ std::vector<double> errorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3
     return core[k] + T[k] * (alpha * colour + (1.0 - alpha) * bg);
   };
   const glm::dvec3 exact = hybrid(n);
-  for (uint32_t k = 1; k <= n; ++k) {
+  for (uint32_t k = firstK; k <= n; ++k) {
     const glm::dvec3 d = exact - hybrid(k);
-    err[k - 1] = glm::dot(d, d);
+    err[k - firstK] = glm::dot(d, d);
   }
   return err;
 }
@@ -61,10 +62,10 @@ std::vector<double> hybridErrorCurve(const FragmentNode* sorted, uint32_t n, glm
 }
 
 double allocationError(const std::vector<std::vector<double>>& curves,
-                       const std::vector<uint32_t>& k) {
+                       const std::vector<uint32_t>& k, uint32_t firstK) {
   double total = 0.0;
   for (size_t p = 0; p < curves.size(); ++p)
-    if (!curves[p].empty()) total += curves[p][k[p] - 1];
+    if (!curves[p].empty()) total += curves[p][k[p] - firstK];
   return total;
 }
 
@@ -453,9 +454,34 @@ std::vector<uint32_t> allocateOptimalHull(const std::vector<std::vector<double>>
   return allocateOptimalHull(curves, slots, OracleOptions{});
 }
 
+namespace {
+
+// Curves from k = 0 (options.firstK = 0) as curves from k' = k + 1 = 1: the same problem with one
+// more slot per covered pixel; then k = k' - 1 for every covered pixel.
+uint64_t shiftedSlots(const std::vector<std::vector<double>>& curves, uint64_t slots,
+                      const OracleOptions& options) {
+  MFR_CHECK_LE(options.firstK, 1u);
+  if (options.firstK == 1) return slots;
+  uint64_t covered = 0;
+  for (const std::vector<double>& c : curves) covered += !c.empty();
+  return slots > UINT64_MAX - covered ? UINT64_MAX : slots + covered;
+}
+
+void unshift(const std::vector<std::vector<double>>& curves, const OracleOptions& options,
+             std::vector<uint32_t>& k) {
+  if (options.firstK == 1) return;
+  for (size_t p = 0; p < curves.size(); ++p)
+    if (!curves[p].empty()) --k[p];
+}
+
+}  // namespace
+
 std::vector<uint32_t> allocateOptimalHull(const std::vector<std::vector<double>>& curves,
                                           uint64_t slots, const OracleOptions& options) {
-  return hullAllocation(curves, slots, options.hullChunkSegments).k;
+  std::vector<uint32_t> k =
+      hullAllocation(curves, shiftedSlots(curves, slots, options), options.hullChunkSegments).k;
+  unshift(curves, options, k);
+  return k;
 }
 
 bool errorCurveIsConvex(const std::vector<double>& e) {
@@ -466,8 +492,11 @@ bool errorCurveIsConvex(const std::vector<double>& e) {
   return true;
 }
 
-OracleAllocation allocateOptimal(const std::vector<std::vector<double>>& curves, uint64_t slots,
-                                 const OracleOptions& options) {
+namespace {
+
+// allocateOptimal over curves from k = 1
+OracleAllocation allocateOptimalFromOne(const std::vector<std::vector<double>>& curves,
+                                        uint64_t slots, const OracleOptions& options) {
   OracleAllocation out;
   uint64_t fragments = 0;
   {
@@ -576,6 +605,16 @@ OracleAllocation allocateOptimal(const std::vector<std::vector<double>>& curves,
     out.error = greedyError;
     out.solver = "greedy";
   }
+  return out;
+}
+
+}  // namespace
+
+OracleAllocation allocateOptimal(const std::vector<std::vector<double>>& curves, uint64_t slots,
+                                 const OracleOptions& options) {
+  OracleAllocation out =
+      allocateOptimalFromOne(curves, shiftedSlots(curves, slots, options), options);
+  unshift(curves, options, out.k);
   return out;
 }
 

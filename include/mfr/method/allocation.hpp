@@ -47,12 +47,22 @@ struct CountSummary {
 };
 CountSummary summarizeCounts(const std::vector<uint32_t>& fragmentCounts);
 
+/// Whether the method may give a covered pixel no slot, k(p) = 0 (issue 28): under hybrid
+/// compositing such a pixel is composited from its order-independent tail alone, so the policies
+/// that allocate per pixel from a count pass (counted k, dynamic k, importance, optimal) take any
+/// budget down to the per-pixel words. Kbuffer compositing has no tail (a pixel without a slot
+/// would lose all its fragments): one node per covered pixel stays its floor. Fixed k and the
+/// A-buffer keep theirs under either rule.
+bool allowsTailOnlyPixels(const MethodDesc& method);
+
 /// allocate()'s first check, before any pass: the per-pixel words (and, unless the method keeps
-/// no nodes, one node) fit the budget. F(M) in nodes (UINT64_MAX without a budget).
+/// no nodes or allowsTailOnlyPixels, one node) fit the budget. F(M) in nodes (UINT64_MAX without
+/// a budget).
 Result<uint64_t> budgetSlots(const PixelLayout& layout, const MethodDesc& method,
                              const MemoryModel& memory, std::optional<uint64_t> budget);
 /// The global k of a counted-k (explicit or F(M) / |P|) or dynamic-k (the largest k whose
-/// sum of min(n(p), k) fits F(M), from the histogram) allocation, with allocate()'s errors.
+/// sum of min(n(p), k) fits F(M), from the histogram) allocation, with allocate()'s errors; 0
+/// (every pixel tail-only) when no k >= 1 fits and allowsTailOnlyPixels.
 Result<uint32_t> boundedK(const PixelLayout& layout, const MethodDesc& method,
                           const MemoryModel& memory, std::optional<uint64_t> budget,
                           const CountSummary& counts);
@@ -60,8 +70,8 @@ Result<uint32_t> boundedK(const PixelLayout& layout, const MethodDesc& method,
 Result<void> checkBoundedSlots(const PixelLayout& layout, const MethodDesc& method,
                                const MemoryModel& memory, std::optional<uint64_t> budget,
                                uint32_t k, uint64_t slots);
-/// allocate()'s checks of an importance or optimal allocation: a budget, one node per covered
-/// pixel.
+/// allocate()'s checks of an importance or optimal allocation: a budget, and one node per covered
+/// pixel unless allowsTailOnlyPixels.
 Result<void> checkCoveredPixels(const PixelLayout& layout, const MethodDesc& method,
                                 const MemoryModel& memory, std::optional<uint64_t> budget,
                                 uint64_t covered);
@@ -69,8 +79,8 @@ Result<void> checkCoveredPixels(const PixelLayout& layout, const MethodDesc& met
 /// Turns the policy, the budget and (when a count pass ran) n(p) into k(p) and offsets.
 /// `fragmentCounts`: n(p) (empty when the method does not count); `importance`: I(p) of the
 /// importance policies; `oracleK`: the optimal policy's k(p). Errors (one line): a budget too
-/// small for the per-pixel words and one node per (covered) pixel, a bounded policy with neither
-/// budget nor k, an explicit k that does not fit.
+/// small for the per-pixel words and (unless allowsTailOnlyPixels) one node per (covered) pixel,
+/// a bounded policy with neither budget nor k, an explicit k that does not fit.
 Result<Allocation> allocate(const PixelLayout& layout, const MethodDesc& method,
                             const MemoryModel& memory, std::optional<uint64_t> budget,
                             const std::vector<uint32_t>& fragmentCounts,

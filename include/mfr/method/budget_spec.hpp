@@ -10,7 +10,9 @@
 // floor(floor(s * 8 * N) / S_f) nodes (floor(s * N) for 8-byte nodes). A share is the smallest
 // that works when it buys one node per pixel the policy must serve: every pixel for fixed k, every
 // covered pixel (n(p) > 0) for the others; the A-buffer needs 100%; wboit and mboit, which keep no
-// nodes, work at any share.
+// nodes, work at any share, and so do the per-pixel policies (counted, dynamic, importance,
+// optimal) under hybrid compositing, where a pixel without a slot keeps its tail
+// (allowsTailOnlyPixels, allocation.hpp; issue 28).
 #pragma once
 
 #include <cstdint>
@@ -62,7 +64,8 @@ struct FrameCounts {
 uint64_t relativeNodeBytes(double percent, const FrameCounts& counts);
 
 /// The smallest share (percent, rounded up to 0.01) with which `method` gets one node per pixel it
-/// must serve (see above); 0 for methods without nodes, 100 for the A-buffer.
+/// must serve (see above); 0 for methods without nodes and for allowsTailOnlyPixels, 100 for the
+/// A-buffer.
 double smallestWorkingPercent(const MethodDesc& method, const MemoryModel& memory,
                               const FrameCounts& counts);
 

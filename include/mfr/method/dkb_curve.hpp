@@ -49,8 +49,12 @@ std::vector<double> curveFromPrediction(const float* prediction, uint32_t n);
 
 /// k(p) for `slots` = F(M) >= the covered pixels: the hull allocator (allocateOptimalHull) over
 /// the curves rebuilt from `predictions` (9 per pixel, pixel-major) and n(p). 0 where n(p) = 0;
-/// 1 <= k(p) <= n(p) elsewhere; sum k <= slots.
+/// firstK <= k(p) <= n(p) elsewhere; sum k <= slots. `firstK` 0 (hybrid compositing, a pixel may
+/// keep no slot; any slots then): the network predicts no err(0), so the curve is extended by its
+/// first drop, err(0) = err(1) + (err(1) - err(2)) (0 drop when n(p) = 1, where the tail alone is
+/// exact), a stand-in until a model predicts it.
 std::vector<uint32_t> allocateByPredictedCurves(const std::vector<float>& predictions,
-                                                const std::vector<uint32_t>& n, uint64_t slots);
+                                                const std::vector<uint32_t>& n, uint64_t slots,
+                                                uint32_t firstK = 1);
 
 }  // namespace mfr

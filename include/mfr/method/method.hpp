@@ -82,7 +82,8 @@ struct MethodDesc {
   std::shared_ptr<const learn::Model> model;
   /// Importance allocation: one slot for every covered pixel, the rest by importance capped at
   /// n(p), and the freed and floor() remainder slots to the pixels with the largest unmet
-  /// importance (vkb-fill), instead of the paper's exact rule.
+  /// importance (vkb-fill), instead of the paper's exact rule. Under hybrid compositing the cap is
+  /// n(p) - 1 (a tail of one fragment is exact) and a pixel of one fragment gets no slot.
   bool fillUnusedSlots = false;
   /// Optimal allocation: DHOIT's Algorithm 1 as published instead of the convex-hull allocator.
   bool publishedGreedy = false;

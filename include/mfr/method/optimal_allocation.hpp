@@ -22,6 +22,10 @@
 //     "core", a few pixels near the multiplier, where non-convex curves matter) finds the true
 //     minimum. When the core is too large for the programme's cell limit, the better of the hull
 //     and the published greedy is returned and the bound with its gap is reported.
+// Under hybrid compositing a pixel may keep no slot at all (its tail alone, issue 28): the curves
+// then start at k = 0 (OracleOptions::firstK = 0, index k) and allocateOptimal and
+// allocateOptimalHull solve the same problem over k' = k + 1 with F + (covered pixels) slots,
+// which is the same minimum (the bound too) with every covered pixel's k one lower.
 // Presets optimal / optimal-greedy run them on an exact A-buffer pre-pass (optimal_oracle.hpp).
 // allocateOptimalHull and allocateOptimal run their per-pixel passes on the calling oneTBB task
 // arena's workers (the CPU engine calls them in an arena of its thread count); the result is the
@@ -43,13 +47,16 @@ namespace mfr {
 std::vector<double> hybridErrorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3 background);
 
 /// The same for either compositing rule: with kbuffer compositing the fragments beyond k are
-/// dropped (the oracle is then optimal for the k-buffer's resolve instead).
+/// dropped (the oracle is then optimal for the k-buffer's resolve instead). `firstK` 0 starts the
+/// curve at k = 0 (index k; err(0) is the tail alone under hybrid compositing), n + 1 values;
+/// empty for n = 0 either way.
 std::vector<double> errorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3 background,
-                               Compositing compositing);
+                               Compositing compositing, uint32_t firstK = 1);
 
-/// Sum of err over pixels for an allocation (k = 0 only for empty curves).
+/// Sum of err over pixels for an allocation of curves starting at k = firstK (k = 0 for empty
+/// curves).
 double allocationError(const std::vector<std::vector<double>>& curves,
-                       const std::vector<uint32_t>& k);
+                       const std::vector<uint32_t>& k, uint32_t firstK = 1);
 
 std::vector<uint32_t> allocateOptimalGreedy(const std::vector<std::vector<double>>& curves,
                                             uint64_t slots);
@@ -67,6 +74,9 @@ struct OracleOptions {
   /// The hull allocator sorts the segments below the critical one in chunks of at least this
   /// many (the result does not depend on it; tests lower it to cover the chunking).
   uint64_t hullChunkSegments = uint64_t{1} << 20;
+  /// The k of each curve's first value: 1 (every covered pixel keeps a slot), or 0 (hybrid
+  /// compositing: a pixel may keep none, err(0) being its tail alone; see the top).
+  uint32_t firstK = 1;
 };
 
 /// allocateOptimalHull with the chunking of `options` (the same k for any chunk size).
@@ -75,7 +85,7 @@ std::vector<uint32_t> allocateOptimalHull(const std::vector<std::vector<double>>
 
 /// An allocation with what is known of its distance to the true minimum.
 struct OracleAllocation {
-  std::vector<uint32_t> k;  // per pixel; 0 for empty curves
+  std::vector<uint32_t> k;  // per pixel; 0 for empty curves (and tail-only pixels, firstK = 0)
   double error = 0.0;       // sum_p err_p(k_p)
   /// Proven lower bound on the minimum total error: the minimum itself when `exact`, else the
   /// Lagrangian (hull) bound. error - lowerBound is the reported gap (0 when exact).
@@ -88,8 +98,9 @@ struct OracleAllocation {
   double gap() const { return error - lowerBound; }
 };
 
-/// The optimal k-buffer's allocation with its bound (see the comment at the top). Requires
-/// slots >= the number of non-empty curves (one fragment per covered pixel).
+/// The optimal k-buffer's allocation with its bound (see the comment at the top). With
+/// options.firstK = 1 it requires slots >= the number of non-empty curves (one fragment per
+/// covered pixel); with firstK = 0 any slots.
 OracleAllocation allocateOptimal(const std::vector<std::vector<double>>& curves, uint64_t slots,
                                  const OracleOptions& options = {});
 
