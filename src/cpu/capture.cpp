@@ -162,7 +162,7 @@ struct LaneCaptureSink {
     inner.counters.generated += generated;
     inner.counters.culledKPlus += culled;
   }
-  bool acceptLane(uint32_t p, float depth, bool passesKPlus) {
+  [[gnu::always_inline]] bool acceptLane(uint32_t p, float depth, bool passesKPlus) {
     ++inner.counters.generated;
     if (Occupancy && inner.occupancy->culls(p, depth)) {
       ++inner.counters.culledOccupancy;
@@ -174,7 +174,9 @@ struct LaneCaptureSink {
     }
     return true;
   }
-  void emitLane(const Fragment& f, int32_t* cull) {
+  // inlined into the (AVX2) lane kernel: a call to this baseline code would run its SSE
+  // instructions with the kernel's upper register halves dirty
+  [[gnu::always_inline]] void emitLane(const Fragment& f, int32_t* cull) {
     if constexpr (KPlus) {
       // a full max-heap: the k+ test and the root replacement without branches on the data
       // (max_heap_replace.hpp); everything else through the scalar sink
@@ -221,7 +223,7 @@ struct LaneHybridSink {
   void beginTile(const TileRect&, int tileSize) { noCull.assign(tileSize, INT32_MAX); }
   int32_t* cullDepthRow(int) { return noCull.data(); }
   void countEarly(uint32_t generated, uint32_t) { inner.counters.generated += generated; }
-  void emitLane(const Fragment& f, int32_t*) { inner.emit(f); }
+  [[gnu::always_inline]] void emitLane(const Fragment& f, int32_t*) { inner.emit(f); }
   // the scalar protocol, for the tiles the lanes do not take (textured, alpha-masked)
   bool accept(uint32_t p, float depth) { return inner.accept(p, depth); }
   void emit(const Fragment& f) { inner.emit(f); }

@@ -2,14 +2,22 @@
 // (k+-buffer paper, Vasilakis & Fudos 2014, sec. 3.2 and Algorithm 3: the k+ test runs before
 // the fragment is shaded, against the pixel's current maximum).
 //
-// Per row span of a triangle, 8 pixels at a time:
-//   1. barycentrics and depth of the 8 pixel centres: the edge values are exact integers, carried
+// Per row of a triangle, 8 pixels at a time:
+//   1. the covered pixels: a triangle at most 8 pixels wide in the tile tests the three exact edge
+//      values of the row's 8 lanes (one compare each, no span set-up), a wider one finds the row
+//      span (coveredSpan, the scalar rasterizeRect's bounds);
+//   2. barycentrics and depth of the 8 pixel centres: the edge values are exact integers, carried
 //      in doubles (exact below 2^53) and rounded once to float, like the scalar int64 -> float;
-//   2. the k+ test on all 8 (kbuffer compositing; a hybrid sink's cull depths are all INT32_MAX,
+//   3. the k+ test on all 8 (kbuffer compositing; a hybrid sink's cull depths are all INT32_MAX,
 //      since it shades every fragment): each pixel of the tile has a 32-bit "cull depth" (below),
 //      compared with the 8 depths' bits at once;
-//   3. shading (n.v, headlight, sRGB encode with the colour tables as gathers) on the 8 lanes;
-//   4. the surviving lanes, in x order, go to the sink's scalar insertion.
+//   4. a step with at least kDirectLanes passing lanes is shaded as it is; fewer (a small or thin
+//      triangle has one to three pixels per row) are packed with the next rows' (PendingLanes)
+//      and shaded 8 at a time, the rest at the triangle's end: a triangle reaches a pixel at most
+//      once, so no early test of another of its pixels depends on the deferred insertions;
+//   5. shading (n.v, headlight, sRGB encode with the colour tables as gathers) on the 8 lanes,
+//      each lane with its own pixel (x, y); the surviving lanes, in order, go to the sink's scalar
+//      insertion (inlined: a call into baseline SSE code with the upper halves dirty is slow).
 // Every float operation is the scalar path's, in the same order, without FMA contraction (the
 // function is compiled for "avx2" only, so there is no fused multiply-add to contract into):
 // the captured fragments, counters and images are bit-identical to the scalar path's.
@@ -117,14 +125,14 @@ struct LaneShading {
 
   /// The packed colour words of pixels x .. x + 7 at barycentrics (l1, l2); their n.v in `ndotv`.
   [[gnu::always_inline]] MFR_TARGET_AVX2 __m256i shade(const ColorTables& tables, __m256 l1,
-                                                       __m256 l2, int x, __m256 dy,
+                                                       __m256 l2, __m256 px, __m256 dy,
                                                        __m256 dySquared, __m256& ndotv) const {
-    return shadeBase(tables, l1, l2, x, dy, dySquared, ndotv, baseR, baseG, baseB, alpha);
+    return shadeBase(tables, l1, l2, px, dy, dySquared, ndotv, baseR, baseG, baseB, alpha);
   }
 
   /// shade() with a base colour and alpha word per lane (vertex colours).
   [[gnu::always_inline]] MFR_TARGET_AVX2 __m256i shadeBase(const ColorTables& tables, __m256 l1,
-                                                           __m256 l2, int x, __m256 dy,
+                                                           __m256 l2, __m256 px, __m256 dy,
                                                            __m256 dySquared, __m256& ndotv,
                                                            __m256 r, __m256 g, __m256 b,
                                                            __m256i alphaWord) const {
@@ -132,7 +140,6 @@ struct LaneShading {
     const __m256 minusOne = _mm256_set1_ps(-1.0f);
     const __m256 absMask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
     const __m256 ambient = _mm256_set1_ps(kAmbient), diffuse = _mm256_set1_ps(1.0f - kAmbient);
-    const __m256i laneIndex = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
     const __m256 l0 = _mm256_sub_ps(_mm256_sub_ps(one, l1), l2);
     const __m256 nx = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(n0x, l0), _mm256_mul_ps(n1x, l1)),
                                     _mm256_mul_ps(n2x, l2));
@@ -140,7 +147,6 @@ struct LaneShading {
                                     _mm256_mul_ps(n2y, l2));
     const __m256 nz = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(n0z, l0), _mm256_mul_ps(n1z, l1)),
                                     _mm256_mul_ps(n2z, l2));
-    const __m256 px = _mm256_cvtepi32_ps(_mm256_add_epi32(_mm256_set1_epi32(x), laneIndex));
     const __m256 dx = _mm256_add_ps(_mm256_mul_ps(px, rayScaleX), rayBiasX);
     const __m256 nn =
         _mm256_mul_ps(_mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(nx, nx), _mm256_mul_ps(ny, ny)),
@@ -227,12 +233,138 @@ struct LaneColors {
   }
 };
 
-inline const TriangleColors kWhite{};  // an uncoloured triangle's (unread) colours
+/// packFragmentColor's alpha byte (in place, << 24) of `a`: min(max(a, 0), 1) with NaN -> 0, then
+/// * 255 + 0.5 truncated, the same float operations without the colour encode.
+inline uint32_t alphaWordOf(float a) {
+  float c = a > 0.0f ? a : 0.0f;  // maxps(a, 0): NaN and -0 give +0
+  c = c < 1.0f ? c : 1.0f;        // minps(c, 1)
+  return static_cast<uint32_t>(static_cast<int32_t>(c * 255.0f + 0.5f)) << 24;
+}
 
-/// One triangle over one tile, 8 pixels at a time (see the file comment).
-template <class Sink>
+/// Lane index tables for the left-packing of passing lanes: entry m holds, 3 bits per slot, the
+/// lanes set in m in increasing order.
+struct LeftPackTable {
+  uint32_t v[256];
+  constexpr LeftPackTable() : v{} {
+    for (int m = 0; m < 256; ++m) {
+      uint32_t packed = 0;
+      int n = 0;
+      for (int lane = 0; lane < 8; ++lane)
+        if ((m >> lane) & 1) packed |= static_cast<uint32_t>(lane) << (3 * n++);
+      v[m] = packed;
+    }
+  }
+};
+inline constexpr LeftPackTable kLeftPack{};
+
+/// The fragments of one triangle that passed the early tests and wait for shading, packed so that
+/// the 8 shading lanes serve fragments of several rows (a small triangle has one or two pixels per
+/// row). A pixel is reached at most once per triangle, so deferring its shading and insertion to
+/// the end of the triangle changes no test of another of its pixels.
+struct PendingLanes {
+  alignas(32) float l1[16] = {}, l2[16] = {}, depth[16] = {};
+  alignas(32) int32_t x[16] = {}, y[16] = {};
+  int n = 0;
+
+  [[gnu::always_inline]] MFR_TARGET_AVX2 void append(__m256 l1v, __m256 l2v, __m256 depthv, int x0,
+                                                     int y0, uint32_t bits) {
+    const __m256i index =
+        _mm256_and_si256(_mm256_srlv_epi32(_mm256_set1_epi32(static_cast<int>(kLeftPack.v[bits])),
+                                           _mm256_setr_epi32(0, 3, 6, 9, 12, 15, 18, 21)),
+                         _mm256_set1_epi32(7));
+    const __m256i xv = _mm256_add_epi32(_mm256_set1_epi32(x0), index);
+    _mm256_storeu_ps(l1 + n, _mm256_permutevar8x32_ps(l1v, index));
+    _mm256_storeu_ps(l2 + n, _mm256_permutevar8x32_ps(l2v, index));
+    _mm256_storeu_ps(depth + n, _mm256_permutevar8x32_ps(depthv, index));
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(x + n), xv);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(y + n), _mm256_set1_epi32(y0));
+    n += std::popcount(bits);
+  }
+
+  /// Moves lanes 8 .. n - 1 to 0 .. n - 9 (after the first 8 were shaded).
+  [[gnu::always_inline]] MFR_TARGET_AVX2 void dropFirst8() {
+    _mm256_store_ps(l1, _mm256_load_ps(l1 + 8));
+    _mm256_store_ps(l2, _mm256_load_ps(l2 + 8));
+    _mm256_store_ps(depth, _mm256_load_ps(depth + 8));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(x),
+                       _mm256_load_si256(reinterpret_cast<const __m256i*>(x + 8)));
+    _mm256_store_si256(reinterpret_cast<__m256i*>(y),
+                       _mm256_load_si256(reinterpret_cast<const __m256i*>(y + 8)));
+    n -= 8;
+  }
+};
+
+/// Shades 8 lanes (barycentrics l1, l2 at pixels (x, y)) and hands the lanes set in `bits` to the
+/// sink, in lane order.
+template <bool Colored, class Sink>
+[[gnu::always_inline]] inline MFR_TARGET_AVX2 void shadeEmit(
+    const RasterFrame& frame, const ShadingInputs& in, const LaneShading& shading,
+    const LaneColors* colors, __m256 l1, __m256 l2, __m256 depth, __m256i xv, __m256i yv,
+    uint32_t bits, uint32_t prim, const TileRect& tile, Sink& sink) {
+  const __m256 px = _mm256_cvtepi32_ps(xv);
+  const __m256 py = _mm256_cvtepi32_ps(yv);
+  // the scalar path's y * rayScaleY + rayBiasY and its square, per lane
+  const __m256 dy =
+      _mm256_add_ps(_mm256_mul_ps(py, _mm256_set1_ps(in.rayScaleY)), _mm256_set1_ps(in.rayBiasY));
+  const __m256 dySquared = _mm256_mul_ps(dy, dy);
+  __m256 ndotv;
+  __m256i rgba;
+  if constexpr (Colored) {
+    __m256 r, g, b;
+    __m256i alphaWord;
+    colors->base(l1, l2, r, g, b, alphaWord);
+    rgba = shading.shadeBase(*in.tables, l1, l2, px, dy, dySquared, ndotv, r, g, b, alphaWord);
+  } else {
+    (void)colors;
+    rgba = shading.shade(*in.tables, l1, l2, px, dy, dySquared, ndotv);
+  }
+  alignas(32) float depths[8], cosines[8];
+  alignas(32) uint32_t words[8];
+  alignas(32) int32_t xs[8], ys[8];
+  _mm256_store_ps(depths, depth);
+  _mm256_store_ps(cosines, ndotv);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(words), rgba);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(xs), xv);
+  _mm256_store_si256(reinterpret_cast<__m256i*>(ys), yv);
+  const uint32_t width = static_cast<uint32_t>(frame.width());
+  Fragment f;
+  f.prim = prim;
+  for (; bits != 0; bits &= bits - 1) {
+    const int lane = std::countr_zero(bits);
+    f.pixel = static_cast<uint32_t>(ys[lane]) * width + static_cast<uint32_t>(xs[lane]);
+    f.depth = depths[lane];
+    f.rgba = words[lane];
+    f.ndotv = cosines[lane];
+    sink.emitLane(f, sink.cullDepthRow(ys[lane] - tile.y0) + (xs[lane] - tile.x0));
+  }
+}
+
+/// shadeEmit() of the first `count` pending lanes.
+template <bool Colored, class Sink>
+[[gnu::always_inline]] inline MFR_TARGET_AVX2 void emitPending(
+    const RasterFrame& frame, const ShadingInputs& in, const LaneShading& shading,
+    const LaneColors* colors, const PendingLanes& p, int count, uint32_t prim, const TileRect& tile,
+    Sink& sink) {
+  shadeEmit<Colored>(frame, in, shading, colors, _mm256_load_ps(p.l1), _mm256_load_ps(p.l2),
+                     _mm256_load_ps(p.depth),
+                     _mm256_load_si256(reinterpret_cast<const __m256i*>(p.x)),
+                     _mm256_load_si256(reinterpret_cast<const __m256i*>(p.y)), (1u << count) - 1u,
+                     prim, tile, sink);
+}
+
+/// A step with at least this many passing lanes is shaded as it is, fewer wait in PendingLanes.
+inline constexpr int kDirectLanes = 4;  // 2 and 3 measured slower on the dragon
+
+/// One triangle over one tile (see the file comment): per row the covered lanes, their depths and
+/// early tests on 8 lanes; the passing ones are packed across rows and shaded 8 at a time. A
+/// triangle at most 8 pixels wide in the tile finds its covered lanes from the three edge values
+/// of the row's 8 lanes (exact integers in doubles, the same set as rasterizeRect's span), a wider
+/// one from the row span (coveredSpan).
+template <bool Colored, class Sink>
 MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingInputs& in,
-                                       const TriangleSetup& t, const TileRect& tile, Sink& sink) {
+                                       const TriangleSetup& t, const TileRect& tile,
+                                       const LaneShading& shading, const LaneColors* colors,
+                                       PendingLanes& pending, Sink& sink) {
   const int x0 = std::max(tile.x0, t.minX), y0 = std::max(tile.y0, t.minY);
   const int x1 = std::min(tile.x1, t.maxX), y1 = std::min(tile.y1, t.maxY);
   if (x0 > x1 || y0 > y1) return;
@@ -248,14 +380,6 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
     bias[i] = (t.topLeft >> i) & 1 ? 0 : -1;
     row[i] = B * (py0 - t.y[a]) + A * (px0 - t.x[a]) + bias[i];
   }
-  // per-triangle constants: the base colour (untextured and not masked: RasterFrame::surface
-  // gives the material's colour and alpha, 1 when opaque, the override when set) and alpha byte
-  const ShadeMaterial& material = (*in.materials)[t.material];
-  glm::vec4 base(material.color, material.alpha);
-  if (material.mode == AlphaMode::Opaque) base.a = 1.0f;
-  if (material.alphaOverridden) base.a = material.overrideAlpha;
-  const ColorTables& tables = *in.tables;
-  const uint32_t alphaByte = packFragmentColor(tables, glm::vec3(0.0f), base.a) & 0xff000000u;
   const float dz1 = t.z[1] - t.z[0], dz2 = t.z[2] - t.z[0];
 
   const __m256 invArea = _mm256_set1_ps(t.invArea);
@@ -263,104 +387,129 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
   const __m256 z0v = _mm256_set1_ps(t.z[0]), dz1v = _mm256_set1_ps(dz1), dz2v = _mm256_set1_ps(dz2);
   const __m256d laneLo = _mm256_setr_pd(0, 1, 2, 3), laneHi = _mm256_setr_pd(4, 5, 6, 7);
   const __m256i laneIndex = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const LaneShading shading(in, t, base, alphaByte);
-  // vertex colours: the base colour and alpha per lane (RasterFrame::surface's order)
-  const bool colored = t.hasColor;
-  const LaneColors laneColors(
-      t, colored ? frame.vertexColors(static_cast<size_t>(&t - frame.setups().data())) : kWhite,
-      material, alphaByte);
+  const __m256i laneBit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  // lane * step of each edge, exact
+  const __m256d st0 = _mm256_set1_pd(static_cast<double>(stepX[0]));
+  const __m256d st1 = _mm256_set1_pd(static_cast<double>(stepX[1]));
+  const __m256d st2 = _mm256_set1_pd(static_cast<double>(stepX[2]));
+  const bool narrow = x1 - x0 < 8;
 
-  Fragment f;
-  f.prim = t.prim;
-  for (int y = y0; y <= y1; ++y) {
-    int xs = x0, xe = x1;  // the covered span, exactly as rasterizeRect
-    coveredSpan(row, stepX, x0, x1, xs, xe);
-    if (xs <= xe) {
-      const int64_t skip = xs - x0;
-      // edge values less their bias, exact integers in doubles
-      const double w1s = static_cast<double>(row[1] + skip * stepX[1] - bias[1]);
-      const double w2s = static_cast<double>(row[2] + skip * stepX[2] - bias[2]);
-      const __m256d st1 = _mm256_set1_pd(static_cast<double>(stepX[1]));
-      const __m256d st2 = _mm256_set1_pd(static_cast<double>(stepX[2]));
-      const float dyScalar = static_cast<float>(y) * in.rayScaleY + in.rayBiasY;
-      const __m256 dy = _mm256_set1_ps(dyScalar);
-      const __m256 dySquared = _mm256_set1_ps(dyScalar * dyScalar);
+  // The early tests of the lanes `covered` (bit i: pixel x + i) at edge values less their bias
+  // (w1lo .. w2hi); the passing lanes go to `pending`, 8 of them at a time to shading.
+  auto lanes = [&](int x, int y, uint32_t covered, __m256d w1lo, __m256d w1hi, __m256d w2lo,
+                   __m256d w2hi, int32_t* cull) __attribute__((target("avx2"), always_inline)) {
+    const __m256i valid = _mm256_cmpeq_epi32(
+        _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(covered)), laneBit), laneBit);
+    const __m256 w1 = _mm256_set_m128(_mm256_cvtpd_ps(w1hi), _mm256_cvtpd_ps(w1lo));
+    const __m256 w2 = _mm256_set_m128(_mm256_cvtpd_ps(w2hi), _mm256_cvtpd_ps(w2lo));
+    const __m256 l1 = _mm256_mul_ps(w1, invArea);
+    const __m256 l2 = _mm256_mul_ps(w2, invArea);
+    const __m256 z =
+        _mm256_add_ps(_mm256_add_ps(z0v, _mm256_mul_ps(l1, dz1v)), _mm256_mul_ps(l2, dz2v));
+    // z > 0 ? min(z, 1) : 0 (NaN -> 0): max returns its second operand on NaN and on +-0
+    const __m256 depth = _mm256_min_ps(_mm256_max_ps(z, zero), one);
+    const __m256i depthBits = _mm256_castps_si256(depth);
+    const int32_t* cullAt = cull + (x - tile.x0);
+    const __m256i cullDepth = _mm256_maskload_epi32(reinterpret_cast<const int*>(cullAt), valid);
+    const __m256i pass = _mm256_and_si256(valid, _mm256_cmpgt_epi32(cullDepth, depthBits));
+    uint32_t passBits =
+        static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(pass))) & covered;
+    if constexpr (Sink::kCullsInLanes) {
+      // per-lane tests in the scalar order (occupancy before k+), for the counters
+      alignas(32) float depths[8];
+      _mm256_store_ps(depths, depth);
       const uint32_t rowPixel = static_cast<uint32_t>(y) * static_cast<uint32_t>(frame.width());
-      int32_t* cull = sink.cullDepthRow(y - tile.y0);
-      for (int x = xs; x <= xe; x += 8) {
-        const int lanes = std::min(8, xe - x + 1);
-        const __m256i valid = _mm256_cmpgt_epi32(_mm256_set1_epi32(lanes), laneIndex);
-        const double k = static_cast<double>(x - xs);
-        // w = w_start + (k + lane) * step, exact (|w| < 2^51)
-        const __m256d k1 = _mm256_set1_pd(w1s), k2 = _mm256_set1_pd(w2s);
-        const __m256d kk = _mm256_set1_pd(k);
-        const __m256d w1lo = _mm256_add_pd(k1, _mm256_mul_pd(_mm256_add_pd(kk, laneLo), st1));
-        const __m256d w1hi = _mm256_add_pd(k1, _mm256_mul_pd(_mm256_add_pd(kk, laneHi), st1));
-        const __m256d w2lo = _mm256_add_pd(k2, _mm256_mul_pd(_mm256_add_pd(kk, laneLo), st2));
-        const __m256d w2hi = _mm256_add_pd(k2, _mm256_mul_pd(_mm256_add_pd(kk, laneHi), st2));
-        const __m256 w1 = _mm256_set_m128(_mm256_cvtpd_ps(w1hi), _mm256_cvtpd_ps(w1lo));
-        const __m256 w2 = _mm256_set_m128(_mm256_cvtpd_ps(w2hi), _mm256_cvtpd_ps(w2lo));
-        const __m256 l1 = _mm256_mul_ps(w1, invArea);
-        const __m256 l2 = _mm256_mul_ps(w2, invArea);
-        const __m256 z =
-            _mm256_add_ps(_mm256_add_ps(z0v, _mm256_mul_ps(l1, dz1v)), _mm256_mul_ps(l2, dz2v));
-        // z > 0 ? min(z, 1) : 0 (NaN -> 0): max returns its second operand on NaN and on +-0
-        const __m256 depth = _mm256_min_ps(_mm256_max_ps(z, zero), one);
-        const __m256i depthBits = _mm256_castps_si256(depth);
-        const int32_t* cullAt = cull + (x - tile.x0);
-        const __m256i cullDepth =
-            _mm256_maskload_epi32(reinterpret_cast<const int*>(cullAt), valid);
-        const __m256i pass = _mm256_and_si256(valid, _mm256_cmpgt_epi32(cullDepth, depthBits));
-        const uint32_t validBits = (1u << lanes) - 1u;
-        uint32_t passBits =
-            static_cast<uint32_t>(_mm256_movemask_ps(_mm256_castsi256_ps(pass))) & validBits;
-        if constexpr (!Sink::kCullsInLanes) {
-          sink.countEarly(static_cast<uint32_t>(lanes),
-                          static_cast<uint32_t>(lanes) - std::popcount(passBits));
-          if (passBits == 0) continue;
-        }
-        // shading of the 8 lanes (only the passing ones are used)
-        __m256 ndotv;
-        __m256i rgba;
-        if (colored) {
-          __m256 r, g, b;
-          __m256i alphaWord;
-          laneColors.base(l1, l2, r, g, b, alphaWord);
-          rgba = shading.shadeBase(tables, l1, l2, x, dy, dySquared, ndotv, r, g, b, alphaWord);
-        } else {
-          rgba = shading.shade(tables, l1, l2, x, dy, dySquared, ndotv);
-        }
-        alignas(32) float depths[8], cosines[8];
-        alignas(32) uint32_t words[8];
-        _mm256_store_ps(depths, depth);
-        _mm256_store_ps(cosines, ndotv);
-        _mm256_store_si256(reinterpret_cast<__m256i*>(words), rgba);
-        if constexpr (Sink::kCullsInLanes) {
-          // per-lane tests in the scalar order (occupancy before k+), for the counters
-          for (int lane = 0; lane < lanes; ++lane) {
-            f.pixel = rowPixel + static_cast<uint32_t>(x + lane);
-            if (!sink.acceptLane(f.pixel, depths[lane], (passBits >> lane) & 1u)) continue;
-            f.depth = depths[lane];
-            f.rgba = words[lane];
-            f.ndotv = cosines[lane];
-            sink.emitLane(f, cull + (x + lane - tile.x0));
-          }
-        } else {
-          while (passBits != 0) {
-            const int lane = std::countr_zero(passBits);
-            passBits &= passBits - 1;
-            f.pixel = rowPixel + static_cast<uint32_t>(x + lane);
-            f.depth = depths[lane];
-            f.rgba = words[lane];
-            f.ndotv = cosines[lane];
-            sink.emitLane(f, cull + (x + lane - tile.x0));
-          }
+      uint32_t accepted = 0;
+      for (uint32_t bits = covered; bits != 0; bits &= bits - 1) {
+        const int lane = std::countr_zero(bits);
+        if (sink.acceptLane(rowPixel + static_cast<uint32_t>(x + lane), depths[lane],
+                            (passBits >> lane) & 1u))
+          accepted |= 1u << lane;
+      }
+      passBits = accepted;
+    } else {
+      const uint32_t generated = static_cast<uint32_t>(std::popcount(covered));
+      sink.countEarly(generated, generated - static_cast<uint32_t>(std::popcount(passBits)));
+    }
+    if (passBits == 0) return;
+    if (std::popcount(passBits) >= kDirectLanes) {  // enough lanes to shade the step as it is
+      shadeEmit<Colored>(frame, in, shading, colors, l1, l2, depth,
+                         _mm256_add_epi32(_mm256_set1_epi32(x), laneIndex), _mm256_set1_epi32(y),
+                         passBits, t.prim, tile, sink);
+      return;
+    }
+    pending.append(l1, l2, depth, x, y, passBits);
+    if (pending.n >= 8) {
+      emitPending<Colored>(frame, in, shading, colors, pending, 8, t.prim, tile, sink);
+      pending.dropFirst8();
+    }
+  };
+
+  if (narrow) {
+    // the row's lanes x0 .. x1 at once: edge values row[i] + lane * stepX[i] (bias included)
+    const uint32_t inRect = (1u << (x1 - x0 + 1)) - 1u;
+    const __m256d s0lo = _mm256_mul_pd(laneLo, st0), s0hi = _mm256_mul_pd(laneHi, st0);
+    const __m256d s1lo = _mm256_mul_pd(laneLo, st1), s1hi = _mm256_mul_pd(laneHi, st1);
+    const __m256d s2lo = _mm256_mul_pd(laneLo, st2), s2hi = _mm256_mul_pd(laneHi, st2);
+    const __m256d zeroD = _mm256_setzero_pd();
+    for (int y = y0; y <= y1; ++y) {
+      const __m256d r0 = _mm256_set1_pd(static_cast<double>(row[0]));
+      const __m256d r1 = _mm256_set1_pd(static_cast<double>(row[1]));
+      const __m256d r2 = _mm256_set1_pd(static_cast<double>(row[2]));
+      const __m256d e0lo = _mm256_add_pd(r0, s0lo), e0hi = _mm256_add_pd(r0, s0hi);
+      const __m256d e1lo = _mm256_add_pd(r1, s1lo), e1hi = _mm256_add_pd(r1, s1hi);
+      const __m256d e2lo = _mm256_add_pd(r2, s2lo), e2hi = _mm256_add_pd(r2, s2hi);
+      const __m256d inLo = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(e0lo, zeroD, _CMP_GE_OQ),
+                                                       _mm256_cmp_pd(e1lo, zeroD, _CMP_GE_OQ)),
+                                         _mm256_cmp_pd(e2lo, zeroD, _CMP_GE_OQ));
+      const __m256d inHi = _mm256_and_pd(_mm256_and_pd(_mm256_cmp_pd(e0hi, zeroD, _CMP_GE_OQ),
+                                                       _mm256_cmp_pd(e1hi, zeroD, _CMP_GE_OQ)),
+                                         _mm256_cmp_pd(e2hi, zeroD, _CMP_GE_OQ));
+      const uint32_t covered = (static_cast<uint32_t>(_mm256_movemask_pd(inLo)) |
+                                (static_cast<uint32_t>(_mm256_movemask_pd(inHi)) << 4)) &
+                               inRect;
+      if (covered != 0) {
+        // less the bias (exact: integers below 2^53)
+        const __m256d b1 = _mm256_set1_pd(static_cast<double>(bias[1]));
+        const __m256d b2 = _mm256_set1_pd(static_cast<double>(bias[2]));
+        lanes(x0, y, covered, _mm256_sub_pd(e1lo, b1), _mm256_sub_pd(e1hi, b1),
+              _mm256_sub_pd(e2lo, b2), _mm256_sub_pd(e2hi, b2), sink.cullDepthRow(y - tile.y0));
+      }
+      row[0] += stepY[0];
+      row[1] += stepY[1];
+      row[2] += stepY[2];
+    }
+  } else {
+    for (int y = y0; y <= y1; ++y) {
+      int xs = x0, xe = x1;  // the covered span, exactly as rasterizeRect
+      coveredSpan(row, stepX, x0, x1, xs, xe);
+      if (xs <= xe) {
+        const int64_t skip = xs - x0;
+        // edge values less their bias, exact integers in doubles
+        const double w1s = static_cast<double>(row[1] + skip * stepX[1] - bias[1]);
+        const double w2s = static_cast<double>(row[2] + skip * stepX[2] - bias[2]);
+        int32_t* cull = sink.cullDepthRow(y - tile.y0);
+        for (int x = xs; x <= xe; x += 8) {
+          const int n = std::min(8, xe - x + 1);
+          const double k = static_cast<double>(x - xs);
+          // w = w_start + (k + lane) * step, exact (|w| < 2^51)
+          const __m256d k1 = _mm256_set1_pd(w1s), k2 = _mm256_set1_pd(w2s);
+          const __m256d kk = _mm256_set1_pd(k);
+          lanes(x, y, (1u << n) - 1u,
+                _mm256_add_pd(k1, _mm256_mul_pd(_mm256_add_pd(kk, laneLo), st1)),
+                _mm256_add_pd(k1, _mm256_mul_pd(_mm256_add_pd(kk, laneHi), st1)),
+                _mm256_add_pd(k2, _mm256_mul_pd(_mm256_add_pd(kk, laneLo), st2)),
+                _mm256_add_pd(k2, _mm256_mul_pd(_mm256_add_pd(kk, laneHi), st2)), cull);
         }
       }
+      row[0] += stepY[0];
+      row[1] += stepY[1];
+      row[2] += stepY[2];
     }
-    row[0] += stepY[0];
-    row[1] += stepY[1];
-    row[2] += stepY[2];
+  }
+  if (pending.n > 0) {
+    emitPending<Colored>(frame, in, shading, colors, pending, pending.n, t.prim, tile, sink);
+    pending.n = 0;
   }
 }
 
@@ -380,8 +529,25 @@ MFR_TARGET_AVX2 void rasterizeTileAvx2(const RasterFrame& frame, const ShadingIn
       return;
     }
   }
-  for (const uint32_t* it = frame.tileBegin(tile); it != frame.tileEnd(tile); ++it)
-    rasterizeRectAvx2(frame, in, frame.setups()[*it], r, sink);
+  PendingLanes pending;
+  for (const uint32_t* it = frame.tileBegin(tile); it != frame.tileEnd(tile); ++it) {
+    const TriangleSetup& t = frame.setups()[*it];
+    // the base colour (untextured and not masked: RasterFrame::surface gives the material's
+    // colour and alpha, 1 when opaque, the override when set) and its alpha byte
+    const ShadeMaterial& material = (*in.materials)[t.material];
+    glm::vec4 base(material.color, material.alpha);
+    if (material.mode == AlphaMode::Opaque) base.a = 1.0f;
+    if (material.alphaOverridden) base.a = material.overrideAlpha;
+    const uint32_t alphaByte = alphaWordOf(base.a);
+    const LaneShading shading(in, t, base, alphaByte);
+    if (t.hasColor) {
+      // vertex colours: the base colour and alpha per lane (RasterFrame::surface's order)
+      const LaneColors colors(t, frame.vertexColors(*it), material, alphaByte);
+      rasterizeRectAvx2<true>(frame, in, t, r, shading, &colors, pending, sink);
+    } else {
+      rasterizeRectAvx2<false>(frame, in, t, r, shading, nullptr, pending, sink);
+    }
+  }
 }
 
 #undef MFR_TARGET_AVX2
