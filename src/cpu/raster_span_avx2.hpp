@@ -520,15 +520,15 @@ template <class Sink>
 MFR_TARGET_AVX2 void rasterizeTileAvx2(const RasterFrame& frame, const ShadingInputs& in, int tile,
                                        Sink& sink) {
   const TileRect r = frame.tileRect(tile);
-  sink.beginTile(r, frame.tileSize());
   for (const uint32_t* it = frame.tileBegin(tile); it != frame.tileEnd(tile); ++it) {
     const TriangleSetup& t = frame.setups()[*it];
     const ShadeMaterial& m = (*in.materials)[t.material];
     if (m.texture != nullptr || m.mode == AlphaMode::Mask) {
-      frame.rasterizeTile<ShadeMode::Full>(tile, sink);
+      frame.rasterizeTile<ShadeMode::Full>(tile, sink);  // no cull depths: all scalar
       return;
     }
   }
+  sink.beginTile(r, frame.tileSize());
   PendingLanes pending;
   for (const uint32_t* it = frame.tileBegin(tile); it != frame.tileEnd(tile); ++it) {
     const TriangleSetup& t = frame.setups()[*it];
