@@ -296,7 +296,7 @@ struct PendingLanes {
 
 /// Shades 8 lanes (barycentrics l1, l2 at pixels (x, y)) and hands the lanes set in `bits` to the
 /// sink, in lane order.
-template <bool Colored, class Sink>
+template <bool Colored, bool OneRow, class Sink>
 [[gnu::always_inline]] inline MFR_TARGET_AVX2 void shadeEmit(
     const RasterFrame& frame, const ShadingInputs& in, const LaneShading& shading,
     const LaneColors* colors, __m256 l1, __m256 l2, __m256 depth, __m256i xv, __m256i yv,
@@ -329,13 +329,26 @@ template <bool Colored, class Sink>
   const uint32_t width = static_cast<uint32_t>(frame.width());
   Fragment f;
   f.prim = prim;
-  for (; bits != 0; bits &= bits - 1) {
-    const int lane = std::countr_zero(bits);
-    f.pixel = static_cast<uint32_t>(ys[lane]) * width + static_cast<uint32_t>(xs[lane]);
-    f.depth = depths[lane];
-    f.rgba = words[lane];
-    f.ndotv = cosines[lane];
-    sink.emitLane(f, sink.cullDepthRow(ys[lane] - tile.y0) + (xs[lane] - tile.x0));
+  if constexpr (OneRow) {  // lane i is pixel (xs[0] + i, ys[0])
+    const uint32_t first = static_cast<uint32_t>(ys[0]) * width + static_cast<uint32_t>(xs[0]);
+    int32_t* cull = sink.cullDepthRow(ys[0] - tile.y0) + (xs[0] - tile.x0);
+    for (; bits != 0; bits &= bits - 1) {
+      const int lane = std::countr_zero(bits);
+      f.pixel = first + static_cast<uint32_t>(lane);
+      f.depth = depths[lane];
+      f.rgba = words[lane];
+      f.ndotv = cosines[lane];
+      sink.emitLane(f, cull + lane);
+    }
+  } else {
+    for (; bits != 0; bits &= bits - 1) {
+      const int lane = std::countr_zero(bits);
+      f.pixel = static_cast<uint32_t>(ys[lane]) * width + static_cast<uint32_t>(xs[lane]);
+      f.depth = depths[lane];
+      f.rgba = words[lane];
+      f.ndotv = cosines[lane];
+      sink.emitLane(f, sink.cullDepthRow(ys[lane] - tile.y0) + (xs[lane] - tile.x0));
+    }
   }
 }
 
@@ -345,11 +358,11 @@ template <bool Colored, class Sink>
     const RasterFrame& frame, const ShadingInputs& in, const LaneShading& shading,
     const LaneColors* colors, const PendingLanes& p, int count, uint32_t prim, const TileRect& tile,
     Sink& sink) {
-  shadeEmit<Colored>(frame, in, shading, colors, _mm256_load_ps(p.l1), _mm256_load_ps(p.l2),
-                     _mm256_load_ps(p.depth),
-                     _mm256_load_si256(reinterpret_cast<const __m256i*>(p.x)),
-                     _mm256_load_si256(reinterpret_cast<const __m256i*>(p.y)), (1u << count) - 1u,
-                     prim, tile, sink);
+  shadeEmit<Colored, false>(frame, in, shading, colors, _mm256_load_ps(p.l1), _mm256_load_ps(p.l2),
+                            _mm256_load_ps(p.depth),
+                            _mm256_load_si256(reinterpret_cast<const __m256i*>(p.x)),
+                            _mm256_load_si256(reinterpret_cast<const __m256i*>(p.y)),
+                            (1u << count) - 1u, prim, tile, sink);
 }
 
 /// A step with at least this many passing lanes is shaded as it is, fewer wait in PendingLanes.
@@ -433,9 +446,9 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
     }
     if (passBits == 0) return;
     if (std::popcount(passBits) >= kDirectLanes) {  // enough lanes to shade the step as it is
-      shadeEmit<Colored>(frame, in, shading, colors, l1, l2, depth,
-                         _mm256_add_epi32(_mm256_set1_epi32(x), laneIndex), _mm256_set1_epi32(y),
-                         passBits, t.prim, tile, sink);
+      shadeEmit<Colored, true>(frame, in, shading, colors, l1, l2, depth,
+                               _mm256_add_epi32(_mm256_set1_epi32(x), laneIndex),
+                               _mm256_set1_epi32(y), passBits, t.prim, tile, sink);
       return;
     }
     pending.append(l1, l2, depth, x, y, passBits);
