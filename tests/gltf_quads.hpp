@@ -40,6 +40,13 @@ inline std::string base64Encode(const std::string& bytes) {
 
 /// The glTF text of `quads`, in order (quad i is mesh primitive i, so primitive order = list
 /// order). Positions, +z normals and 16-bit indices share one buffer.
+/// A glTF document's "buffers": the one buffer `bin`, embedded as a base64 data URI.
+inline nlohmann::json gltfEmbeddedBuffer(const std::string& bin) {
+  return nlohmann::json::array(
+      {{{"byteLength", bin.size()},
+        {"uri", "data:application/octet-stream;base64," + base64Encode(bin)}}});
+}
+
 inline std::string gltfWithQuads(const std::vector<GltfQuad>& quads) {
   using nlohmann::json;
   std::string bin;
@@ -89,9 +96,7 @@ inline std::string gltfWithQuads(const std::vector<GltfQuad>& quads) {
   doc["materials"] = materials;
   doc["accessors"] = accessors;
   doc["bufferViews"] = views;
-  doc["buffers"] =
-      json::array({{{"byteLength", bin.size()},
-                    {"uri", "data:application/octet-stream;base64," + base64Encode(bin)}}});
+  doc["buffers"] = gltfEmbeddedBuffer(bin);
   for (const GltfQuad& q : quads)
     if (q.material.contains("extensions") &&
         q.material["extensions"].contains("KHR_materials_transmission")) {

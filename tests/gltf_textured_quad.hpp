@@ -111,9 +111,7 @@ inline std::string texturedQuadGltf(const nlohmann::json* sampler) {
   doc["textures"] = json::array({texture});
   doc["accessors"] = accessors;
   doc["bufferViews"] = views;
-  doc["buffers"] =
-      json::array({{{"byteLength", bin.size()},
-                    {"uri", "data:application/octet-stream;base64," + base64Encode(bin)}}});
+  doc["buffers"] = gltfEmbeddedBuffer(bin);
   return doc.dump();
 }
 

@@ -16,7 +16,9 @@
 #include <nlohmann/json.hpp>
 
 #include "gltf_quads.hpp"
+#include "mfr/core/image.hpp"
 #include "mfr/scene/camera.hpp"
+#include "quad_checks.hpp"
 
 namespace mfr::test {
 
@@ -137,25 +139,11 @@ inline std::string vertexColorQuadGltf(ColorFormat format, const std::array<doub
   doc["meshes"] = json::array({{{"primitives", json::array({primitive})}}});
   doc["accessors"] = accessors;
   doc["bufferViews"] = views;
-  doc["buffers"] =
-      json::array({{{"byteLength", bin.size()},
-                    {"uri", "data:application/octet-stream;base64," + base64Encode(bin)}}});
+  doc["buffers"] = gltfEmbeddedBuffer(bin);
   return doc.dump();
 }
 
 using Rgba = std::array<double, 4>;
-
-/// Head-on camera whose view is exactly the quad (|n.v| within 3e-4 of 1).
-inline Camera vertexColorHeadOn() {
-  Camera camera;
-  camera.fovYDegrees = 2.0f;
-  const float d = 1.0f / std::tan(glm::radians(1.0f));
-  camera.eye = {0.0f, 0.0f, d};
-  camera.target = {0.0f, 0.0f, 0.0f};
-  camera.zNear = 0.5f * d;
-  camera.zFar = 2.0f * d;
-  return camera;
-}
 
 /// Seen from the side and above: depth changes strongly across the quad, so screen-linear
 /// (affine) interpolation of the colour would be visibly wrong.
@@ -220,6 +208,25 @@ inline bool expectedQuadPixel(const Camera& camera, int px, int py, int width, i
   if (alphaMode == "OPAQUE") alpha = 1.0;
   out = lit * alpha + background * (1.0 - alpha);
   return true;
+}
+
+/// Every pixel of a size x size `image` that expectedQuadPixel names against its expectation
+/// (expectLinearPixel). Returns the pixels compared.
+inline int expectQuadColors(const ImageRGB& image, const Camera& camera, int size, const Rgba& left,
+                            const Rgba& right, const Rgba& factor, const std::string& alphaMode,
+                            const glm::dvec3& background) {
+  int compared = 0, wrong = 0;
+  for (int py = 0; py < size; ++py)
+    for (int px = 0; px < size; ++px) {
+      glm::dvec3 e;
+      if (!expectedQuadPixel(camera, px, py, size, size, left, right, factor, alphaMode, background,
+                             e))
+        continue;
+      ++compared;
+      expectLinearPixel(image.at(px, py), e, px, py, wrong);
+    }
+  EXPECT_EQ(wrong, 0) << "of " << compared << " pixels";
+  return compared;
 }
 
 /// A glTF material: factor, alpha mode, double-sided (cutoff 0.5 for MASK).

@@ -17,6 +17,7 @@
 
 #include "gltf_quads.hpp"
 #include "mfr/scene/load.hpp"
+#include "quad_checks.hpp"
 #include "shared_scenes.hpp"
 
 namespace {
@@ -61,19 +62,12 @@ std::string instancedGltf(const std::vector<float>& translation, const std::vect
               {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}}}},
               {"accessors", accessors},
               {"bufferViews", views},
-              {"buffers",
-               {{{"byteLength", bin.size()},
-                 {"uri", "data:application/octet-stream;base64," + mfr::test::base64Encode(bin)}}}}}
+              {"buffers", mfr::test::gltfEmbeddedBuffer(bin)}}
       .dump();
 }
 
 mfr::Result<mfr::Scene> load(const std::string& text) {
-  const fs::path path =
-      fs::temp_directory_path() / ("mfr_instancing_" + std::to_string(::getpid()) + ".gltf");
-  std::ofstream(path) << text;
-  auto scene = mfr::loadScene(path.string());
-  fs::remove(path);
-  return scene;
+  return mfr::test::loadGltfText(text, "mfr_instancing");
 }
 
 /// The scene's triangle t as three positions.

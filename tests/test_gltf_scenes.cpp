@@ -51,9 +51,7 @@ std::string twoScenes(int defaultScene) {
               {"meshes", meshes},
               {"accessors", accessors},
               {"bufferViews", views},
-              {"buffers",
-               {{{"byteLength", bin.size()},
-                 {"uri", "data:application/octet-stream;base64," + mfr::test::base64Encode(bin)}}}}}
+              {"buffers", mfr::test::gltfEmbeddedBuffer(bin)}}
       .dump();
 }
 

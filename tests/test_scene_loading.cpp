@@ -22,6 +22,7 @@
 #include "mfr/scene/load.hpp"
 #include "mfr/scene/procedural.hpp"
 #include "shared_scenes.hpp"
+#include "temp_dir.hpp"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -31,33 +32,10 @@ namespace {
 // ---------------------------------------------------------------------------------------------
 // Test helpers: temporary files, base64, a minimal PNG encoder and a glTF document builder.
 
-class TempDir {
+/// This file's scratch folders (temp_dir.hpp).
+class TempDir : public mfr::test::TempDir {
  public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    std::random_device random;
-    path_ = fs::temp_directory_path() /
-            ("mfr_scene_loading_" + std::to_string(random()) + "_" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-
-  /// Writes `content` to `name` (sub-directories created) and returns the full path.
-  std::string write(const std::string& name, const std::string& content) const {
-    const fs::path file = path_ / name;
-    fs::create_directories(file.parent_path());
-    std::ofstream(file, std::ios::binary) << content;
-    return file.string();
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
+  TempDir() : mfr::test::TempDir("mfr_scene_loading") {}
 };
 
 std::string base64(const std::string& bytes) {

@@ -24,6 +24,7 @@
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/scene/load.hpp"
+#include "quad_checks.hpp"
 #include "shared_scenes.hpp"
 
 namespace {
@@ -35,24 +36,12 @@ constexpr int kRepeat = 10497, kClamp = 33071, kMirror = 33648, kNearest = 9728,
 constexpr int kSize = 64;  // image side: the quad fills it, 4 pixels per texel across u
 
 mfr::Result<mfr::Scene> loadText(const std::string& text) {
-  const fs::path path =
-      fs::temp_directory_path() / ("mfr_sampler_" + std::to_string(::getpid()) + ".gltf");
-  std::ofstream(path) << text;
-  auto scene = mfr::loadScene(path.string());
-  fs::remove(path);
-  return scene;
+  return mfr::test::loadGltfText(text, "mfr_sampler");
 }
 
 /// Head-on camera whose view is exactly the quad (x, y in [-1, 1]).
 mfr::Camera headOn() {
-  mfr::Camera camera;
-  camera.fovYDegrees = 2.0f;
-  const float d = 1.0f / std::tan(glm::radians(1.0f));
-  camera.eye = {0.0f, 0.0f, d};
-  camera.target = {0.0f, 0.0f, 0.0f};
-  camera.zNear = 0.5f * d;
-  camera.zFar = 2.0f * d;
-  return camera;
+  return mfr::test::headOnQuadCamera();
 }
 
 /// Texel index i wrapped into [0, n), written independently of method_math::wrapTexel.
@@ -136,14 +125,8 @@ int expectSamplesOf(const std::string& gltf, int wrapS, int wrapT, bool nearest,
       const glm::dvec3 e = expected(uv.x, uv.y, wrapS, wrapT, nearest, ambiguous);
       if (ambiguous) continue;
       ++compared;
-      const glm::vec3 got = out->image.at(px, py);
-      // sRGB8 fragment colours: at most half a code (0.0045 in linear at 1), |n.v| >= 0.9997
-      const bool close = std::abs(got.r - e.r) < 0.01 && std::abs(got.g - e.g) < 0.01 &&
-                         std::abs(got.b - e.b) < 0.01;
-      if (!close && ++wrong <= 5)
-        ADD_FAILURE() << "pixel (" << px << ", " << py << "): got (" << got.r << ", " << got.g
-                      << ", " << got.b << "), expected (" << e.r << ", " << e.g << ", " << e.b
-                      << ")";
+      // |n.v| >= 0.9997 head-on
+      mfr::test::expectLinearPixel(out->image.at(px, py), e, px, py, wrong);
     }
   EXPECT_EQ(wrong, 0) << "of " << compared << " pixels";
   return compared;

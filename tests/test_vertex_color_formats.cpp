@@ -19,34 +19,17 @@
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/scene/load.hpp"
+#include "quad_checks.hpp"
+#include "temp_dir.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-class TempDir {
+/// This file's scratch folders (temp_dir.hpp).
+class TempDir : public mfr::test::TempDir {
  public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    std::random_device random;
-    path_ = fs::temp_directory_path() /
-            ("mfr_color_formats_" + std::to_string(random()) + "_" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  std::string write(const std::string& name, const std::string& content) const {
-    std::ofstream(path_ / name, std::ios::binary) << content;
-    return (path_ / name).string();
-  }
-  std::string file(const std::string& name) const { return (path_ / name).string(); }
-
- private:
-  fs::path path_;
+  TempDir() : mfr::test::TempDir("mfr_color_formats") {}
 };
 
 /// The sRGB transfer function's inverse (IEC 61966-2-1), in double.
@@ -57,26 +40,8 @@ double srgbDecode(double v) {
 constexpr int kSize = 32;
 const glm::dvec3 kBackground{0.25, 0.5, 0.75};
 
-/// Head-on view of the square x, y in [-1, 1], z = 0 filling the image (|n.v| within 3e-4 of 1).
-mfr::Camera headOn() {
-  mfr::Camera camera;
-  camera.fovYDegrees = 2.0f;
-  const float d = 1.0f / std::tan(glm::radians(1.0f));
-  camera.eye = {0.0f, 0.0f, d};
-  camera.target = {0.0f, 0.0f, 0.0f};
-  camera.zNear = 0.5f * d;
-  camera.zFar = 2.0f * d;
-  return camera;
-}
-
 mfr::RenderOutput renderHeadOn(const mfr::Scene& scene) {
-  auto frame = mfr::RasterFrame::build(scene, headOn(), mfr::RasterOptions{kSize, kSize, 16, 2});
-  EXPECT_TRUE(frame.ok()) << frame.error().message;
-  mfr::RenderOptions options;
-  options.background = glm::vec3(kBackground);
-  auto out = mfr::render(*frame, mfr::methodPreset("abuffer").value(), options);
-  EXPECT_TRUE(out.ok()) << out.error().message;
-  return std::move(*out);
+  return mfr::test::renderAbuffer(scene, mfr::test::headOnQuadCamera(), kSize, kBackground);
 }
 
 /// A PLY square x, y in [-1, 1] whose four corners have the colour properties `header` declares

@@ -40,59 +40,30 @@ constexpr int kSize = 64;
 const glm::dvec3 kBackground{0.5, 0.25, 0.75};
 
 mfr::Result<mfr::Scene> loadText(const std::string& text) {
-  const fs::path path =
-      fs::temp_directory_path() / ("mfr_vertex_colors_" + std::to_string(::getpid()) + ".gltf");
-  std::ofstream(path) << text;
-  auto scene = mfr::loadScene(path.string());
-  fs::remove(path);
-  return scene;
+  return mfr::test::loadGltfText(text, "mfr_vertex_colors");
 }
 
 mfr::Camera headOn() {
-  return mfr::test::vertexColorHeadOn();
+  return mfr::test::headOnQuadCamera();
 }
 mfr::Camera tilted() {
   return mfr::test::vertexColorTilted();
 }
 
 mfr::RenderOutput renderScene(const mfr::Scene& scene, const mfr::Camera& camera) {
-  auto frame = mfr::RasterFrame::build(scene, camera, mfr::RasterOptions{kSize, kSize, 16, 2});
-  EXPECT_TRUE(frame.ok()) << frame.error().message;
-  mfr::RenderOptions options;
-  options.background = glm::vec3(kBackground);
-  auto out = mfr::render(*frame, mfr::methodPreset("abuffer").value(), options);
-  EXPECT_TRUE(out.ok()) << out.error().message;
-  return std::move(*out);
+  return mfr::test::renderAbuffer(scene, camera, kSize, kBackground);
 }
 
 json material(const Rgba& factor, const std::string& alphaMode) {
   return mfr::test::vertexColorMaterial(factor, alphaMode);
 }
 
-/// Compares every pixel mfr::test::expectedQuadPixel names with its expectation. Returns the
-/// pixels compared.
+/// Renders `scene` and compares every pixel mfr::test::expectedQuadPixel names with its
+/// expectation. Returns the pixels compared.
 int expectColors(const mfr::Scene& scene, const mfr::Camera& camera, const Rgba& left,
                  const Rgba& right, const Rgba& factor, const std::string& alphaMode) {
-  const mfr::RenderOutput out = renderScene(scene, camera);
-  int compared = 0, wrong = 0;
-  for (int py = 0; py < kSize; ++py)
-    for (int px = 0; px < kSize; ++px) {
-      glm::dvec3 e;
-      if (!mfr::test::expectedQuadPixel(camera, px, py, kSize, kSize, left, right, factor,
-                                        alphaMode, kBackground, e))
-        continue;
-      ++compared;
-      const glm::vec3 got = out.image.at(px, py);
-      // sRGB8 fragment colours (half a code: 0.0045 in linear at 1), 8-bit alpha
-      const bool close = std::abs(got.r - e.r) < 0.01 && std::abs(got.g - e.g) < 0.01 &&
-                         std::abs(got.b - e.b) < 0.01;
-      if (!close && ++wrong <= 5)
-        ADD_FAILURE() << "pixel (" << px << ", " << py << "): got (" << got.r << ", " << got.g
-                      << ", " << got.b << "), expected (" << e.r << ", " << e.g << ", " << e.b
-                      << ")";
-    }
-  EXPECT_EQ(wrong, 0) << "of " << compared << " pixels";
-  return compared;
+  return mfr::test::expectQuadColors(renderScene(scene, camera).image, camera, kSize, left, right,
+                                     factor, alphaMode, kBackground);
 }
 
 const Rgba kLeft{1.0, 0.2, 0.0, 1.0}, kRight{0.1, 0.9, 0.7, 0.3};

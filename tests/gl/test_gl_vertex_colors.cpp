@@ -39,11 +39,7 @@ const glm::dvec3 kBackground{0.5, 0.25, 0.75};
 const Rgba kLeft{1.0, 0.2, 0.0, 1.0}, kRight{0.1, 0.9, 0.7, 0.3};
 
 Scene loadText(const std::string& text) {
-  const fs::path path =
-      fs::temp_directory_path() / ("mfr_gl_vertex_colors_" + std::to_string(::getpid()) + ".gltf");
-  std::ofstream(path) << text;
-  auto scene = loadScene(path.string());
-  fs::remove(path);
+  auto scene = mfr::test::loadGltfText(text, "mfr_gl_vertex_colors");
   EXPECT_TRUE(scene.ok()) << scene.error().message;
   return std::move(scene.value());
 }
@@ -98,24 +94,8 @@ Rendered expectAgreement(Engine& gl, const std::string& raster, const Scene& sce
 /// sRGB8 fragment colours and 8-bit alpha). Returns the pixels compared.
 int expectColors(const RenderOutput& out, const Camera& camera, const Rgba& left, const Rgba& right,
                  const Rgba& factor, const std::string& alphaMode) {
-  int compared = 0, wrong = 0;
-  for (int py = 0; py < kSize; ++py)
-    for (int px = 0; px < kSize; ++px) {
-      glm::dvec3 e;
-      if (!mfr::test::expectedQuadPixel(camera, px, py, kSize, kSize, left, right, factor,
-                                        alphaMode, kBackground, e))
-        continue;
-      ++compared;
-      const glm::vec3 got = out.image.at(px, py);
-      const bool close = std::abs(got.r - e.r) < 0.01 && std::abs(got.g - e.g) < 0.01 &&
-                         std::abs(got.b - e.b) < 0.01;
-      if (!close && ++wrong <= 5)
-        ADD_FAILURE() << "pixel (" << px << ", " << py << "): got (" << got.r << ", " << got.g
-                      << ", " << got.b << "), expected (" << e.r << ", " << e.g << ", " << e.b
-                      << ")";
-    }
-  EXPECT_EQ(wrong, 0) << "of " << compared << " pixels";
-  return compared;
+  return mfr::test::expectQuadColors(out.image, camera, kSize, left, right, factor, alphaMode,
+                                     kBackground);
 }
 
 class GlVertexColors : public ::testing::TestWithParam<const char*> {};
@@ -129,7 +109,7 @@ TEST_P(GlVertexColors, EveryFormatMatchesTheExpectedColours) {
     const Rgba blendFactor{0.8, 0.6, 1.0, 0.9}, opaqueFactor{1.0, 0.7, 0.9, 1.0};
     const Scene blended = loadText(mfr::test::vertexColorQuadGltf(
         f, kLeft, kRight, mfr::test::vertexColorMaterial(blendFactor, "BLEND")));
-    const Camera headOn = mfr::test::vertexColorHeadOn(), tilted = mfr::test::vertexColorTilted();
+    const Camera headOn = mfr::test::headOnQuadCamera(), tilted = mfr::test::vertexColorTilted();
     Rendered g = expectAgreement(*gl, GetParam(), blended, headOn, kSize, kSize);
     EXPECT_GT(expectColors(g.out, headOn, left, right, blendFactor, "BLEND"), 3000);
     const Scene opaque = loadText(mfr::test::vertexColorQuadGltf(
