@@ -1,14 +1,17 @@
-// Moment-based OIT, pass 2 (mfr::MboitPixel::addColor / mboitTransmittance and
-// mfr::PowerMomentPixel::addColor: method_math.h's mboitTransmittance, mboitTransmittancePower
-// and mboitAddColor): the transmittance in front of the fragment reconstructed from the pixel's
-// N moments (biased Hankel system in double, the canonical N/2 + 1 point distribution,
-// kMboitOverestimation), then T a c and T a added to the pixel's accumulator under the spin-lock.
-// GLSL has no double exp: the final exp is float (method_math.h's doubleExp).
+// Moment-based OIT, pass 2 (mfr::MboitPixel::addColor / mboitTransmittance,
+// mfr::PowerMomentPixel::addColor and mfr::TrigMomentPixel::addColor: method_math.h's
+// mboitTransmittance, mboitTransmittancePower, mboitTransmittanceTrig and mboitAddColor): the
+// transmittance in front of the fragment reconstructed from the pixel's moments (power: biased
+// Hankel system in double, the canonical N/2 + 1 point distribution; trigonometric: the Toeplitz
+// system and N/2 roots on the unit circle; kMboitOverestimation), then T a c and T a added to the
+// pixel's accumulator under the spin-lock. GLSL has no double exp: the final exp is float
+// (method_math.h's doubleExp).
 layout(std430, binding = kBindAccum) coherent buffer Accum {
   float accum[];  // kMboitWordsBase + N per pixel (mboit_moments.frag)
 };
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
-uniform uint uMomentCount;  // N: 4, 6 or 8
+uniform uint uMomentCount;     // N: 4, 6 or 8
+uniform uint uTrigonometric;  // 1: N / 2 trigonometric moments (mboitTransmittanceTrig)
 
 float transmittance(uint i, float z) {
   if (uMomentCount == 4u)
@@ -17,6 +20,11 @@ float transmittance(uint i, float z) {
   float m[kMboitMaxMoments];
   for (uint j = 0u; j < uint(kMboitMaxMoments); ++j)
     m[j] = j < uMomentCount ? accum[i + 1u + j] : 0.0;
+  if (uTrigonometric != 0u) {
+    const int complexCount = int(uMomentCount / 2u);
+    return mboitTransmittanceTrig(complexCount, accum[i], m, z, mboitTrigBias(complexCount),
+                                  kMboitOverestimation);
+  }
   const int count = int(uMomentCount);
   return mboitTransmittancePower(count, accum[i], m, z, mboitPowerBias(count),
                                  kMboitOverestimation);

@@ -1,20 +1,23 @@
 // Per-pixel memory (pixel p; bindings in shared_layout.h), both MBOIT passes:
 //
-//   accum  (kBindAccum, W = kMboitWordsBase + N floats: N = uMomentCount = 4, 6 or 8 moments)
+//   accum  (kBindAccum, W = kMboitWordsBase + N floats: N = uMomentCount = 4, 6 or 8 moments;
+//           with uTrigonometric, N / 2 = 3 or 4 complex moments as real and imaginary parts)
 //     [Wp + 0] b0   [Wp + 1..N] b1..bN (this pass)   [Wp + N+1..N+3] sum T a c   [Wp + N+4] sum T a
 //   uLocks (kBindLocks, r32ui, 4 B)   the per-pixel spin-lock around the update
 //
 // Bytes per pixel: 36, 44 or 52 (moments and accumulators) + 4 (lock); no nodes.
 //
 // Moment-based OIT, pass 1 (Muenstermann et al. 2018; mfr::MboitPixel::addMoments and
-// mfr::PowerMomentPixel::addMoments, method_math.h's mboitAbsorbance, mboitWarpDepth,
-// mboitAddMoments and mboitAddPowerMoments): each fragment adds its absorbance
-// A = -ln(1 - min(a, kMboitMaxAlpha)) times 1, z, .., z^N (z = 2 d - 1) to the pixel's moments
-// under the pixel's spin-lock. Sums in arrival order (see wboit.frag).
+// mfr::PowerMomentPixel::addMoments, mfr::TrigMomentPixel::addMoments, method_math.h's
+// mboitAbsorbance, mboitWarpDepth, mboitAddMoments, mboitAddPowerMoments and
+// mboitAddTrigMoments): each fragment adds its absorbance A = -ln(1 - min(a, kMboitMaxAlpha))
+// times 1, z, .., z^N (z = 2 d - 1), or times 1 and e^(i k phi(z)), to the pixel's moments under
+// the pixel's spin-lock. Sums in arrival order (see wboit.frag).
 layout(std430, binding = kBindAccum) coherent buffer Accum {
   float accum[];  // kMboitWordsBase + N per pixel: b0, b1..bN, sum T a c (r, g, b), sum T a
 };
-uniform uint uMomentCount;  // N: 4, 6 or 8
+uniform uint uMomentCount;     // N: 4, 6 or 8
+uniform uint uTrigonometric;  // 1: N / 2 trigonometric moments (mboitAddTrigMoments)
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
 
 void main() {
@@ -46,7 +49,10 @@ void main() {
         float m[kMboitMaxMoments];
         for (uint j = 0u; j < uint(kMboitMaxMoments); ++j)
           m[j] = j < uMomentCount ? accum[i + 1u + j] : 0.0;
-        mboitAddPowerMoments(int(uMomentCount), s0, m, A, z);
+        if (uTrigonometric != 0u)
+          mboitAddTrigMoments(int(uMomentCount / 2u), s0, m, A, z);
+        else
+          mboitAddPowerMoments(int(uMomentCount), s0, m, A, z);
         accum[i] = s0;
         for (uint j = 0u; j < uMomentCount; ++j) accum[i + 1u + j] = m[j];
       }

@@ -164,9 +164,12 @@ struct GlEngine::State::FrameRun {
       } else {
         glUseProgram(program);
       }
-      if (!isWboit)
+      if (!isWboit) {
         glProgramUniform1ui(program, loc(program, "uMomentCount"),
                             static_cast<GLuint>(mboitMomentCount(plan.method.compositing)));
+        glProgramUniform1ui(program, loc(program, "uTrigonometric"),
+                            mboitTrigonometric(plan.method.compositing) ? 1u : 0u);
+      }
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       fb.bindImage(locks, kBindLocks);
       s.drawScene();

@@ -25,7 +25,8 @@ constexpr GlTechniqueInfo kTechniques[] = {
     {GlTechnique::Mboit, "mboit",
      "moments (accumulate) -> capture (colour, reconstructed transmittance) -> resolve",
      "mboit_moments.frag, mboit_color.frag", "mboit_resolve.comp",
-     "accumulators 36 B (4 moments), 44 B (6), 52 B (8) + lock 4 B", "mboit, mboit6, mboit8"},
+     "accumulators 36 B (4 moments), 44 B (6 power or 3 trigonometric), 52 B (8 or 4) + lock 4 B",
+     "mboit, mboit6, mboit8, mboit-trig3, mboit-trig4"},
     {GlTechnique::Mlab, "mlab", "capture (insert, merge the two farthest when full) -> resolve",
      "mlab.frag", "mlab_resolve.comp", "k nodes of 20 B + node count 4 B + lock 4 B", "mlab"},
 };
@@ -82,6 +83,8 @@ std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
     case Compositing::MomentBased:
     case Compositing::MomentBased6:
     case Compositing::MomentBased8:
+    case Compositing::MomentBasedTrig3:
+    case Compositing::MomentBasedTrig4:
       if (m.allocation != AllocationPolicy::NoNodes || m.store != StoreChoice::None ||
           m.occupancyWords != 0)
         return std::nullopt;

@@ -26,6 +26,12 @@
 // represented exactly up to the bias), method_math.h's mboitAddPowerMoments and
 // mboitTransmittancePower; bias 5e-6 and 5e-5 (the paper's supplementary table for float32) and
 // the authors' biasing vectors (their published shader code). Storage 44 and 52 B per pixel.
+// mboit-trig3 and mboit-trig4: the same two passes with 3 and 4 trigonometric moments (the
+// paper's sec. 3.2): the depth as a phase on the unit circle (a wrapping zone of pi / 10), the
+// moments A e^(i k phi) as real and imaginary parts, the Toeplitz reconstruction of the authors'
+// TrigonometricMomentMath (method_math.h's mboitAddTrigMoments and mboitTransmittanceTrig; roots
+// by Weierstrass' iteration in double); bias 8e-7 and 1.5e-6 (the supplementary's float32 rows).
+// Storage 44 and 52 B per pixel, as mboit6 and mboit8.
 // The 4-moment constants were checked against the same sources: bias 5e-7 and the target
 // (0, 0.375, 0, 0.375) are the supplementary's and the authors' code's; overestimation 0.25 is
 // the setting of the authors' demo and of the public ports (PixelSyncOIT, LineVis's first
@@ -118,6 +124,40 @@ struct PowerMomentPixel {
 };
 static_assert(sizeof(PowerMomentPixel<6>) == 44 && sizeof(PowerMomentPixel<8>) == 52);
 
+/// One pixel's buffers with Count (3 or 4) trigonometric moments: b0, the moments' real and
+/// imaginary parts, the four accumulators: (1 + 2 Count + 4) floats, the sizes of mboit6 / mboit8.
+template <int Count>
+struct TrigMomentPixel {
+  static_assert(Count == 3 || Count == 4);
+  float b0 = 0.0f;
+  float moments[2 * Count] = {};                 // Re b_1, Im b_1, .., Re b_Count, Im b_Count
+  float r = 0.0f, g = 0.0f, b = 0.0f, a = 0.0f;  // pass 2: sum T a c, sum T a
+
+  void addMoments(float depth, float alpha) {
+    if (alpha <= 0.0f) return;
+    float all[method_math::kMboitMaxMoments] = {};
+    for (int j = 0; j < 2 * Count; ++j) all[j] = moments[j];
+    method_math::mboitAddTrigMoments(Count, b0, all, mboitAbsorbance(alpha), mboitWarpDepth(depth));
+    for (int j = 0; j < 2 * Count; ++j) moments[j] = all[j];
+  }
+  float transmittanceAt(float depth) const {
+    float all[method_math::kMboitMaxMoments] = {};
+    for (int j = 0; j < 2 * Count; ++j) all[j] = moments[j];
+    return method_math::mboitTransmittanceTrig(Count, b0, all, mboitWarpDepth(depth),
+                                               method_math::mboitTrigBias(Count),
+                                               kMboitOverestimation);
+  }
+  void addColor(float depth, uint32_t rgba) {
+    const glm::vec4 c = unpackFragmentColor(rgba);
+    if (c.a <= 0.0f) return;
+    method_math::mboitAddColor(r, g, b, a, glm::vec3(c), transmittanceAt(depth) * c.a);
+  }
+  glm::vec3 composite(glm::vec3 background) const {
+    return method_math::mboitComposite(b0, glm::vec3(r, g, b), a, background);
+  }
+};
+static_assert(sizeof(TrigMomentPixel<3>) == 44 && sizeof(TrigMomentPixel<4>) == 52);
+
 /// The moments pass, then the capture weighting each fragment by its reconstructed transmittance:
 /// what every power-moment peer method does with its Pixel.
 template <class Pixel>
@@ -159,13 +199,47 @@ struct Mboit8Method : MomentPasses<PowerMomentPixel<8>> {
   }
 };
 
-/// The power moments a moment-based rule keeps: 4 (mboit), 6 (mboit6), 8 (mboit8); 0 for any
-/// other rule. The GL engine's one moment technique runs all three by this count.
+/// mboit-trig3: 3 trigonometric moments, 44 bytes per pixel.
+struct MboitTrig3Method : MomentPasses<TrigMomentPixel<3>> {
+  static constexpr Compositing kRule = Compositing::MomentBasedTrig3;
+  static constexpr const char* kRuleName = "moment-based-trig-3";
+  static PresetInfo preset() {
+    return {"mboit-trig3", "moment-based OIT, 3 trigonometric moments (Muenstermann et al. 2018)",
+            "3 trigonometric moments of ln-transmittance per pixel, no fragment nodes"};
+  }
+};
+
+/// mboit-trig4: 4 trigonometric moments, 52 bytes per pixel.
+struct MboitTrig4Method : MomentPasses<TrigMomentPixel<4>> {
+  static constexpr Compositing kRule = Compositing::MomentBasedTrig4;
+  static constexpr const char* kRuleName = "moment-based-trig-4";
+  static PresetInfo preset() {
+    return {"mboit-trig4", "moment-based OIT, 4 trigonometric moments (Muenstermann et al. 2018)",
+            "4 trigonometric moments of ln-transmittance per pixel, no fragment nodes"};
+  }
+};
+
+/// The floats of moments a moment-based rule keeps besides b0: 4 (mboit), 6 (mboit6, and
+/// mboit-trig3's three complex moments), 8 (mboit8, mboit-trig4); 0 for any other rule. The GL
+/// engine's one moment technique runs all five by this count and mboitTrigonometric.
 inline int mboitMomentCount(Compositing c) {
-  return c == Compositing::MomentBased    ? 4
-         : c == Compositing::MomentBased6 ? 6
-         : c == Compositing::MomentBased8 ? 8
-                                          : 0;
+  switch (c) {
+    case Compositing::MomentBased:
+      return 4;
+    case Compositing::MomentBased6:
+    case Compositing::MomentBasedTrig3:
+      return 6;
+    case Compositing::MomentBased8:
+    case Compositing::MomentBasedTrig4:
+      return 8;
+    default:
+      return 0;
+  }
+}
+
+/// True for the trigonometric moment rules.
+inline bool mboitTrigonometric(Compositing c) {
+  return c == Compositing::MomentBasedTrig3 || c == Compositing::MomentBasedTrig4;
 }
 
 /// mboit as a peer method (peer_method.hpp): the moments pass, then the capture weighting each

@@ -43,6 +43,7 @@ namespace mfr::method_math {
 using uint = uint32_t;
 using vec2 = glm::vec2;
 using vec3 = glm::vec3;
+using dvec2 = glm::dvec2;
 using std::abs;
 using std::clamp;
 using std::exp;
@@ -99,6 +100,26 @@ MFR_MATH_CONST(float, kMboit8BiasTarget2, 0.75f)
 MFR_MATH_CONST(float, kMboit8BiasTarget4, 0.67666666666666664f)
 MFR_MATH_CONST(float, kMboit8BiasTarget6, 0.63f)
 MFR_MATH_CONST(float, kMboit8BiasTarget8, 0.60030303030303034f)
+// MBOIT with 3 and 4 trigonometric moments (the paper's sec. 3.2): the bias for float32 storage
+// from the paper's supplementary table (2, 3, 4 trigonometric moments: 4e-7, 8e-7, 1.5e-6; the
+// values PixelSyncOIT's OIT_MBOIT.cpp records beside its own settings); the wrapping zone of
+// angle pi / 10 (the authors' default, momentsingraphics.de "A brief postscript on MBOIT",
+// 2018, which gives their computeWrappingZoneParameters): a warped depth z in [-1, 1] maps to the
+// phase (z + 1) (pi - angle / 2) in [0, 2 pi - angle]; a support point whose circle parameter
+// (mboitCircleParameter, in [0, 8)) lies in the zone [zone begin, 7] adds a linear ramp
+// kMboitTrigZoneSlope x + kMboitTrigZoneOffset to its weight. The constants are those of the
+// authors' function for that angle: phase scale pi - pi / 20, zone begin = 6 + cos(pi / 10) -
+// sin(pi / 10), slope 1 / (7 - begin), offset 1 - 7 slope.
+MFR_MATH_CONST(float, kMboitTrig3Bias, 8e-7f)
+MFR_MATH_CONST(float, kMboitTrig4Bias, 1.5e-6f)
+MFR_MATH_CONST(float, kMboitTrigPhaseScale, 2.9845130209103035f)
+MFR_MATH_CONST(float, kMboitTrigZoneSlope, 2.7936044933348416f)
+MFR_MATH_CONST(float, kMboitTrigZoneOffset, -18.555231453343893f)
+// pi in double: the float nearest pi less its (float-rounded) excess, the same double on both
+// sides (within 4e-15 of pi)
+MFR_MATH_CONST(double, kMboitPi, double(3.14159274f) - double(8.74227766e-8f))
+// terms of the sine and cosine series (|t| <= pi: the next term is below 1e-18)
+MFR_MATH_CONST(int, kMboitSeriesTerms, 16)
 // Laguerre's iteration for the support points: at most this many steps per root
 MFR_MATH_CONST(int, kMboitRootIterations, 64)
 // 1e-12 (GLSL has no token pasting for an `lf` suffix: the correctly rounded quotient of exact
@@ -569,6 +590,202 @@ MFR_MATH_FN float mboitTransmittancePower(int count, float b0,
   }
   MFR_PRECISE double absorbance = 0.0;
   for (int j = 0; j <= n; ++j) absorbance += poly[j] * m[j];
+  MFR_PRECISE double t = doubleExp(-double(b0) * absorbance);
+  if (!isFiniteDouble(t)) return 1.0f;
+  return float(clamp(t, 0.0, 1.0));
+}
+
+// ---- moment-based OIT with n = 3 or 4 trigonometric moments -------------------------------------
+// The paper's sec. 3.2: the moments b_k = sum_i A_i e^(i k phi_i) (k = 1..n, stored as their real
+// and imaginary parts, float32) of the absorbance on the unit circle; the reconstruction is that
+// of the authors' TrigonometricMomentMath: the normalised moments scaled by 1 - bias form the
+// Hermitian Toeplitz matrix T = (b_(i - j)) (n + 1 square, b_(-k) = conj(b_k)); its LDL^H
+// factorisation solves T c = (1, w, .., w^n) at the query point w = e^(i phi); the polynomial
+// sum_k conj(c_k) x^k has n roots on the unit circle, which with w carry the canonical
+// representation; the polynomial through (w, overestimation) and (root, weight of the root: 1 in
+// front of w by the circle parameter, plus the wrapping zone's ramp) has the normalised absorbance
+// in front of w as its expectation Re sum_k p_k b_k. Everything in double (complex numbers as
+// dvec2); the roots by the Weierstrass (Durand-Kerner) iteration; e^(i phi) by the series below,
+// the same double operations on both sides.
+
+MFR_MATH_FN dvec2 complexMul(dvec2 a, dvec2 b) {
+  MFR_PRECISE double re = a.x * b.x - a.y * b.y;
+  MFR_PRECISE double im = a.x * b.y + a.y * b.x;
+  return dvec2(re, im);
+}
+
+MFR_MATH_FN dvec2 complexDiv(dvec2 a, dvec2 b) {
+  MFR_PRECISE double n = b.x * b.x + b.y * b.y;
+  MFR_PRECISE double re = (a.x * b.x + a.y * b.y) / n;
+  MFR_PRECISE double im = (a.y * b.x - a.x * b.y) / n;
+  return dvec2(re, im);
+}
+
+MFR_MATH_FN dvec2 complexConj(dvec2 a) {
+  return dvec2(a.x, -a.y);
+}
+
+/// e^(i phase) for phase in [0, 2 pi]: the series of cos and sin of phase - pi, negated.
+MFR_MATH_FN dvec2 mboitCircle(double phase) {
+  MFR_PRECISE double t = phase - kMboitPi;
+  MFR_PRECISE double t2 = t * t;
+  MFR_PRECISE double c = 1.0;
+  MFR_PRECISE double s = t;
+  MFR_PRECISE double termC = 1.0;
+  MFR_PRECISE double termS = t;
+  for (int k = 1; k <= kMboitSeriesTerms; ++k) {
+    const double twoK = double(2 * k);
+    termC = -termC * t2 / ((twoK - 1.0) * twoK);
+    termS = -termS * t2 / (twoK * (twoK + 1.0));
+    c += termC;
+    s += termS;
+  }
+  return dvec2(-c, -s);
+}
+
+/// The phase of the warped depth z: (z + 1) kMboitTrigPhaseScale.
+MFR_MATH_FN double mboitTrigPhase(float z) {
+  MFR_PRECISE double phase = (double(z) + 1.0) * double(kMboitTrigPhaseScale);
+  return phase;
+}
+
+/// The authors' circleToParameter: grows monotonically with the angle of the unit vector p over
+/// [0, 2 pi), in [0, 8).
+MFR_MATH_FN double mboitCircleParameter(dvec2 p) {
+  MFR_PRECISE double r = abs(p.y) - abs(p.x);
+  r = p.x < 0.0 ? 2.0 - r : r;
+  r = p.y < 0.0 ? 6.0 - r : r;
+  return r;
+}
+
+/// The bias for `count` (3 or 4) trigonometric moments in float32.
+MFR_MATH_FN float mboitTrigBias(int count) {
+  return count == 3 ? kMboitTrig3Bias : kMboitTrig4Bias;
+}
+
+/// Pass 1 with `count` (3 or 4) trigonometric moments: b0 += A, moments[2k - 2] += A cos(k phi),
+/// moments[2k - 1] += A sin(k phi) (k = 1..count), phi the phase of z.
+MFR_MATH_FN void mboitAddTrigMoments(int count, MFR_INOUT(float) b0,
+                                     MFR_INOUT_ARRAY(float, moments, kMboitMaxMoments), float A,
+                                     float z) {
+  MFR_PRECISE float s0 = b0 + A;
+  b0 = s0;
+  const dvec2 w = mboitCircle(mboitTrigPhase(z));
+  dvec2 wk = w;
+  for (int k = 0; k < count; ++k) {
+    MFR_PRECISE float re = moments[2 * k] + A * float(wk.x);
+    MFR_PRECISE float im = moments[2 * k + 1] + A * float(wk.y);
+    moments[2 * k] = re;
+    moments[2 * k + 1] = im;
+    wk = complexMul(wk, w);
+  }
+}
+
+/// Transmittance in front of the warped depth z from b0 and `count` (3 or 4) trigonometric
+/// moments (not normalised; real and imaginary parts), with the given bias and overestimation.
+MFR_MATH_FN float mboitTransmittanceTrig(int count, float b0,
+                                         MFR_IN_ARRAY(float, moments, kMboitMaxMoments), float z,
+                                         float bias, float overestimation) {
+  if (b0 <= 0.0f) return 1.0f;
+  const int n = count;
+  const double scale = 1.0 - double(bias);
+  // the normalised, scaled moments b[0..n], b[0] = 1
+  dvec2 b[5];
+  b[0] = dvec2(1.0, 0.0);
+  for (int k = 1; k <= n; ++k)
+    b[k] = dvec2(double(moments[2 * k - 2]) / double(b0) * scale,
+                 double(moments[2 * k - 1]) / double(b0) * scale);
+  // LDL^H of the Toeplitz matrix T[i][j] = b[i - j] (i >= j): L[i][j] for j < i, D[i] real
+  dvec2 L[25];
+  double D[5];
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j < i; ++j) {
+      dvec2 v = b[i - j];
+      for (int k = 0; k < j; ++k) v -= D[k] * complexMul(L[i * 5 + k], complexConj(L[j * 5 + k]));
+      L[i * 5 + j] = v / D[j];
+    }
+    MFR_PRECISE double d = 1.0;
+    for (int k = 0; k < i; ++k) {
+      const dvec2 l = L[i * 5 + k];
+      d -= D[k] * (l.x * l.x + l.y * l.y);
+    }
+    D[i] = d;
+  }
+  // solve T c = (1, w, .., w^n): L y = e, then D, then L^H c = D^-1 y
+  const dvec2 w = mboitCircle(mboitTrigPhase(z));
+  dvec2 c[5];
+  dvec2 power = dvec2(1.0, 0.0);
+  for (int i = 0; i <= n; ++i) {
+    dvec2 v = power;
+    for (int k = 0; k < i; ++k) v -= complexMul(L[i * 5 + k], c[k]);
+    c[i] = v;
+    power = complexMul(power, w);
+  }
+  for (int i = 0; i <= n; ++i) c[i] /= D[i];
+  for (int i = n; i >= 0; --i)
+    for (int k = i + 1; k <= n; ++k) c[i] -= complexMul(complexConj(L[k * 5 + i]), c[k]);
+  // the roots of sum_k conj(c_k) x^k, monic: a_k = conj(c_k) / conj(c_n)
+  dvec2 a[5];
+  for (int k = 0; k <= n; ++k) a[k] = complexDiv(complexConj(c[k]), complexConj(c[n]));
+  dvec2 x[5];
+  x[0] = w;
+  const dvec2 seed = dvec2(0.375, 0.875);  // exact in float: the same double on both sides
+  dvec2 guess = seed;
+  for (int r = 1; r <= n; ++r) {
+    x[r] = guess;
+    guess = complexMul(guess, seed);
+  }
+  for (int it = 0; it < kMboitRootIterations; ++it) {
+    MFR_PRECISE double largest = 0.0;
+    for (int r = 1; r <= n; ++r) {
+      // p(x_r) / prod_(s != r) (x_r - x_s)
+      dvec2 value = a[n];
+      for (int k = n - 1; k >= 0; --k) value = complexMul(value, x[r]) + a[k];
+      dvec2 den = dvec2(1.0, 0.0);
+      for (int s = 1; s <= n; ++s)
+        if (s != r) den = complexMul(den, x[r] - x[s]);
+      if (den.x == 0.0 && den.y == 0.0) continue;
+      const dvec2 step = complexDiv(value, den);
+      x[r] -= step;
+      largest = max(largest, abs(step.x) + abs(step.y));
+    }
+    if (largest <= kMboitTiny) break;
+  }
+  // the weights: overestimation at w, 1 for a root in front of w, plus the wrapping zone's ramp
+  double f[5];
+  f[0] = double(overestimation);
+  const double reference = mboitCircleParameter(w);
+  for (int r = 1; r <= n; ++r) {
+    const double parameter = mboitCircleParameter(x[r]);
+    MFR_PRECISE double ramp =
+        parameter * double(kMboitTrigZoneSlope) + double(kMboitTrigZoneOffset);
+    f[r] = (parameter < reference ? 1.0 : 0.0) + clamp(ramp, 0.0, 1.0);
+  }
+  // separate coincident support points
+  for (int r = 1; r <= n; ++r)
+    for (int s = 0; s < r; ++s) {
+      const dvec2 d = x[r] - x[s];
+      if (abs(d.x) + abs(d.y) < kMboitTiny) x[r] += dvec2(kMboitTiny, kMboitTiny);
+    }
+  // Newton's divided differences (complex), then the monomial coefficients of the interpolant
+  dvec2 dv[5];
+  for (int i = 0; i <= n; ++i) dv[i] = dvec2(f[i], 0.0);
+  for (int level = 1; level <= n; ++level)
+    for (int i = n; i >= level; --i) dv[i] = complexDiv(dv[i] - dv[i - 1], x[i] - x[i - level]);
+  dvec2 poly[5];
+  for (int i = 0; i <= n; ++i) poly[i] = dvec2(0.0, 0.0);
+  poly[0] = dv[n];
+  for (int k = n - 1; k >= 0; --k) {
+    // poly = poly (x - x_k) + dv[k], low coefficients first (see mboitTransmittancePower)
+    dvec2 carry = dv[k];
+    for (int i = 0; i <= n; ++i) {
+      const dvec2 old = poly[i];
+      poly[i] = carry - complexMul(x[k], old);
+      carry = old;
+    }
+  }
+  MFR_PRECISE double absorbance = 0.0;
+  for (int k = 0; k <= n; ++k) absorbance += complexMul(b[k], poly[k]).x;
   MFR_PRECISE double t = doubleExp(-double(b0) * absorbance);
   if (!isFiniteDouble(t)) return 1.0f;
   return float(clamp(t, 0.0, 1.0));

@@ -46,7 +46,8 @@ struct PeerList {
     (f.template operator()<Peers>(), ...);
   }
 };
-using PeerMethods = PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Method, MlabMethod>;
+using PeerMethods = PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Method, MboitTrig3Method,
+                             MboitTrig4Method, MlabMethod>;
 
 /// Calls `f.template operator()<Peer>()` with the peer type of `rule`; false (and no call) for
 /// the k-buffer family's rules.
