@@ -19,7 +19,9 @@ GlTechnique expectedTechnique(const std::string& preset) {
   static const std::map<std::string, GlTechnique> peers = {
       {"abuffer", GlTechnique::ABuffer}, {"wboit", GlTechnique::Wboit},
       {"mboit", GlTechnique::Mboit},     {"mboit6", GlTechnique::Mboit},
-      {"mboit8", GlTechnique::Mboit},    {"mlab", GlTechnique::Mlab}};
+      {"mboit8", GlTechnique::Mboit},    {"mlab", GlTechnique::Mlab},
+      {"aoit4", GlTechnique::Aoit},      {"aoit8", GlTechnique::Aoit},
+      {"aoit16", GlTechnique::Aoit}};
   const auto it = peers.find(preset);
   return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
 }
@@ -39,7 +41,7 @@ TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
     EXPECT_EQ(*tc, GlTechnique::KBuffer) << name << "+occupancy";
     ++occupancyForms;
   }
-  EXPECT_EQ(presets, 19);
+  EXPECT_EQ(presets, 22);
   EXPECT_EQ(occupancyForms, 13);
 }
 
@@ -57,7 +59,7 @@ TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
 
 TEST(GlTechnique, TableRowsFollowTheEnum) {
   const auto rows = glTechniques();
-  ASSERT_EQ(rows.size(), 5u);
+  ASSERT_EQ(rows.size(), 6u);
   for (size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(static_cast<size_t>(rows[i].technique), i);
     EXPECT_EQ(&techniqueInfo(rows[i].technique), &rows[i]);

@@ -62,6 +62,9 @@ enum class Compositing : uint8_t {
   MomentBased6,     // mboit6: the same with 6 power moments (mboit.hpp)
   MomentBased8,     // mboit8: the same with 8 power moments (mboit.hpp)
   MultiLayerAlpha,  // mlab: front-to-back over of the MultiLayer store's nodes (Salvi 2014)
+  Adaptive4,        // aoit4: adaptive transparency, 4 visibility nodes (Salvi 2011), aoit.hpp
+  Adaptive8,        // aoit8: the same with 8 nodes
+  Adaptive16,       // aoit16: the same with 16 nodes
 };
 
 /// True for kbuffer and hybrid, the rules `--composite` chooses between (the k-buffer family).
