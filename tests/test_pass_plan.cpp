@@ -54,6 +54,11 @@ TEST(PassPlan, EachPresetsPassesAsItsPaperRunsThem) {
   // mboit: its moments pass before the capture; occupancy: three passes after the allocation
   EXPECT_EQ(planPasses(methodPreset("mboit").value(), withBudget(1 << 20))->names(),
             (Names{"allocate", "clear", "moments", "capture", "resolve"}));
+  // aoit: its visibility pass (the compressed visibility function) before the capture
+  for (const char* aoit : {"aoit4", "aoit8", "aoit16"})
+    EXPECT_EQ(planPasses(methodPreset(aoit).value(), withBudget(1 << 20))->names(),
+              (Names{"allocate", "clear", "visibility", "capture", "resolve"}))
+        << aoit;
   EXPECT_EQ(planPasses(methodPreset("kplus-sb+occupancy").value(), withBudget(1 << 20))->names(),
             (Names{"count", "allocate", "clear", "depth_range", "occupancy_fill", "occupancy_count",
                    "capture", "resolve"}));

@@ -1,13 +1,15 @@
-// The peer methods (wboit, mboit, mboit6, mboit8, mboit-trig3, mboit-trig4, mlab) against closed
-// forms computed here in double precision from the fragments' own colours and depths (read off the
-// exact A-buffer's nodes): one layer (every preset exact), N layers of one colour and alpha, two
-// layers in both submission orders, MLAB's order-dependent merge, MBOIT's transmittance bounds
-// against the true step function on random depth sets, the moment family (6 and 8 moments: the
-// general reconstruction against the 4-moment closed form, n + 1 layers exact, the bounds, three
-// layers through the engine; 3 and 4 trigonometric moments: the circle series, n layers exact, the
-// bounds, three layers through the engine), MLAB with k >= depth complexity equal to the A-buffer,
-// the documented memory layout within several budgets and sizes, and which command-line options
-// apply to them.
+// The peer methods (wboit, mboit, mboit6, mboit8, mboit-trig3, mboit-trig4, mlab, aoit4, aoit8,
+// aoit16) against closed forms computed here in double precision from the fragments' own colours
+// and depths (read off the exact A-buffer's nodes): one layer (every preset exact), N layers of one
+// colour and alpha, two layers in both submission orders, MLAB's order-dependent merge, MBOIT's
+// transmittance bounds against the true step function on random depth sets, the moment family (6
+// and 8 moments: the general reconstruction against the 4-moment closed form, n + 1 layers exact,
+// the bounds, three layers through the engine; 3 and 4 trigonometric moments: the circle series, n
+// layers exact, the bounds, three layers through the engine), MLAB with k >= depth complexity
+// equal to the A-buffer, the documented memory layout within several budgets and sizes, and which
+// command-line options apply to them; adaptive transparency: its insertion and area-based removal
+// by hand (and the tie-break), at most N layers equal to the A-buffer, N + 1 layers with the
+// hand-chosen node removed, and its dependence on the submission order.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -21,10 +23,12 @@
 #include "mfr/core/color.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/cpu/render.hpp"
+#include "mfr/method/aoit.hpp"
 #include "mfr/method/mboit.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/method_options.hpp"
 #include "mfr/method/mlab.hpp"
+#include "mfr/method/peer_method.hpp"
 #include "mfr/method/wboit.hpp"
 #include "mfr/scene/draw_order.hpp"
 #include "mfr/scene/load.hpp"
@@ -156,9 +160,10 @@ TEST(PeerMethods, TwoLayersInBothOrders) {
   const RasterFrame nearFirst = frameOf({nearL, farL}), farFirst = frameOf({farL, nearL});
   const auto frags = fragmentsOf(nearFirst);
   ASSERT_EQ(frags, fragmentsOf(farFirst)) << "the two frames must hold the same fragments";
-  for (const char* preset : {"wboit", "mboit", "mlab"}) {
+  for (const char* preset : {"wboit", "mboit", "mlab", "aoit4"}) {
     const RenderOutput a = run(nearFirst, preset), b = run(farFirst, preset);
-    // two floats add and multiply commutatively; MLAB with k = 2 >= 2 merges nothing
+    // two floats add and multiply commutatively; MLAB with k = 2 >= 2 merges nothing; AOIT's two
+    // nodes are (1 - a_near) and (1 - a_near)(1 - a_far) in either order
     EXPECT_EQ(a.image.pixels, b.image.pixels) << preset << ": depends on the submission order";
     for (size_t p = 0; p < frags.size(); ++p) {
       const std::vector<Frag>& f = frags[p];
@@ -167,7 +172,7 @@ TEST(PeerMethods, TwoLayersInBothOrders) {
       double tol = 2e-6;
       if (std::string(preset) == "wboit") {
         expected = wboitExpected(f);
-      } else if (std::string(preset) == "mlab") {
+      } else if (std::string(preset) == "mlab" || std::string(preset) == "aoit4") {
         expected = overTruth(f);
       } else {
         // MBOIT: with two fragments the reconstruction is the 2-point distribution itself, so
@@ -548,10 +553,12 @@ TEST(PeerMethods, BudgetsFollowTheDocumentedLayout) {
       for (uint64_t perPixelBudget : {21ull, 36ull, 40ull, 75ull, 200ull}) {
         const uint64_t M = perPixelBudget * P + 13;
         // documented: wboit 20 B/pixel, mboit 36, mboit6 and mboit-trig3 44, mboit8 and
-        // mboit-trig4 52, mlab 4 counter + 4 lock + 20 k
+        // mboit-trig4 52, mlab 4 counter + 4 lock + 20 k; aoit4, aoit8, aoit16: N nodes of 8 B +
+        // the 12 B colour sum
         const std::pair<const char*, uint64_t> fixed[] = {
             {"wboit", 20 + lock},  {"mboit", 36 + lock},       {"mboit6", 44 + lock},
-            {"mboit8", 52 + lock}, {"mboit-trig3", 44 + lock}, {"mboit-trig4", 52 + lock}};
+            {"mboit8", 52 + lock}, {"mboit-trig3", 44 + lock}, {"mboit-trig4", 52 + lock},
+            {"aoit4", 44 + lock},  {"aoit8", 76 + lock},       {"aoit16", 140 + lock}};
         for (const auto& [preset, perPixel] : fixed) {
           MethodDesc m = methodPreset(preset).value();
           RenderOptions o;
@@ -647,6 +654,17 @@ TEST(PeerMethods, ShuffledDrawOrderOverEveryPreset) {
           EXPECT_EQ(encodeSrgb(x.image).rgba, encodeSrgb(y.image).rgba) << what;
         else
           EXPECT_LT(worst, 1e-5f) << what << " (hybrid tail sums)";
+      } else if (const int nodes = aoitNodeCount(m.compositing); nodes > 0) {
+        // AOIT: with n(p) <= N + 1 the nodes do not depend on the order (no removal, or one after
+        // all are in): float rounding only; beyond, the removals follow the order (not compared)
+        const std::vector<std::vector<FragmentNode>> sets = test::capturedSets(run(*a, "abuffer"));
+        float within = 0.0f;
+        for (size_t p = 0; p < x.image.pixels.size(); ++p) {
+          if (sets[p].size() > static_cast<size_t>(nodes) + 1) continue;
+          const glm::vec3 d = glm::abs(x.image.pixels[p] - y.image.pixels[p]);
+          within = std::max({within, d.r, d.g, d.b});
+        }
+        EXPECT_LT(within, 1e-5f) << what << " (n(p) <= N + 1)";
       } else if (preset == "mlab") {
         const uint32_t maxN = run(*a, "abuffer").stats.maxDepthComplexity.value();
         const RenderOutput xk = run(*a, preset, std::nullopt, maxN),
@@ -664,6 +682,189 @@ TEST(PeerMethods, ShuffledDrawOrderOverEveryPreset) {
       }
     }
   }
+}
+
+// ---- adaptive transparency (aoit4, aoit8, aoit16) ----------------------------------------------
+
+// The rule written out here in double, independently of method_math.h: the nodes (depth, T) of
+// the fragments (depth, alpha) inserted in the given order into n nodes, each removal of the node
+// i >= 1 with the least (d_i - d_{i-1}) (T_{i-1} - T_i) (the nearest of equal ones), node i - 1
+// taking T_i; `removed` collects the depths of the removed nodes.
+struct RefNode {
+  double d, t;
+};
+std::vector<RefNode> aoitReference(const std::vector<std::pair<double, double>>& fragments,
+                                   size_t n, std::vector<double>* removed = nullptr) {
+  std::vector<RefNode> nodes;
+  for (const auto& [d, a] : fragments) {
+    size_t at = 0;
+    while (at < nodes.size() && nodes[at].d < d) ++at;
+    const double before = at == 0 ? 1.0 : nodes[at - 1].t;
+    for (size_t i = at; i < nodes.size(); ++i) nodes[i].t *= 1.0 - a;
+    nodes.insert(nodes.begin() + static_cast<std::ptrdiff_t>(at), {d, before * (1.0 - a)});
+    if (nodes.size() <= n) continue;
+    size_t best = 1;
+    double least = (nodes[1].d - nodes[0].d) * (nodes[0].t - nodes[1].t);
+    for (size_t i = 2; i < nodes.size(); ++i) {
+      const double area = (nodes[i].d - nodes[i - 1].d) * (nodes[i - 1].t - nodes[i].t);
+      if (area < least) {
+        least = area;
+        best = i;
+      }
+    }
+    if (removed) removed->push_back(nodes[best].d);
+    nodes[best - 1].t = nodes[best].t;
+    nodes.erase(nodes.begin() + static_cast<std::ptrdiff_t>(best));
+  }
+  return nodes;
+}
+
+// sum vis(d_i) a_i c_i + T_total bg, vis(d) the T of the farthest node strictly in front of d
+glm::dvec3 aoitComposite(const std::vector<RefNode>& nodes, const std::vector<Frag>& f) {
+  glm::dvec3 c(0.0);
+  for (const Frag& x : f) {
+    double vis = 1.0;
+    for (const RefNode& n : nodes)
+      if (n.d < x.d) vis = n.t;
+    c += vis * x.a * glm::dvec3(x.r, x.g, x.b);
+  }
+  return c + (nodes.empty() ? 1.0 : nodes.back().t) * glm::dvec3(kBg);
+}
+
+uint32_t alphaByte(double a) {
+  return static_cast<uint32_t>(std::lround(a * 255.0)) << 24;
+}
+
+TEST(Aoit, FiveFragmentsInFourNodesByHand) {
+  // depths 0.1 .. 0.5, alphas 0.5 0.5 0.5 0.1 0.5 (as 8-bit alphas, 128/255 and 26/255): the
+  // nodes' T before the removal are t1, t1^2, t1^3, t1^3 t2, t1^4 t2; with equal depth steps the
+  // areas are 0.1 (T_{i-1} - T_i) = 0.1 t1^i a1, 0.1 t1^2 a1, 0.1 t1^3 a2, 0.1 t1^3 t2 a1 for
+  // i = 1..4: the third (the alpha-0.1 node at 0.4) is the least, so node 2 (depth 0.3) takes its
+  // T and the nodes are (0.1, t1), (0.2, t1^2), (0.3, t1^3 t2), (0.5, t1^4 t2)
+  const double a1 = 128.0 / 255.0, a2 = 26.0 / 255.0, t1 = 1.0 - a1, t2 = 1.0 - a2;
+  const float depths[5] = {0.1f, 0.2f, 0.3f, 0.4f, 0.5f};
+  const double alphas[5] = {a1, a1, a1, a2, a1};
+  const double expectedT[4] = {t1, t1 * t1, t1 * t1 * t1 * t2, t1 * t1 * t1 * t1 * t2};
+  const float expectedD[4] = {0.1f, 0.2f, 0.3f, 0.5f};
+  // with N + 1 fragments the one removal happens after all are in: any order gives these nodes
+  for (const std::vector<int>& order :
+       {std::vector<int>{0, 1, 2, 3, 4}, {4, 3, 2, 1, 0}, {2, 4, 0, 3, 1}, {3, 0, 4, 1, 2}}) {
+    AoitPixel<4> px;
+    uint32_t count = 0;
+    for (int i : order)  // the visibility pass (pass 0) of the engine's peer type
+      AoitPasses<4>::add(PeerPixel<AoitPixel<4>>{&px, count, 1u}, 0, depths[i],
+                         alphaByte(alphas[i]));
+    EXPECT_EQ(count, 0u);  // (the capture pass counts)
+    for (int i = 0; i < 4; ++i) {
+      EXPECT_EQ(px.nodes[i].depth, expectedD[i]) << i;
+      EXPECT_NEAR(px.nodes[i].trans, expectedT[i], 1e-6) << i;
+    }
+    // vis: 1 in front of everything, T of the node strictly in front; 0.4 now sees node 0.3's
+    // merged T (t1^3 t2, not t1^3: the removed step moved forward), 0.3 sees node 0.2
+    EXPECT_EQ(px.visibility(0.1f), 1.0f);
+    EXPECT_NEAR(px.visibility(0.3f), t1 * t1, 1e-6);
+    EXPECT_NEAR(px.visibility(0.4f), t1 * t1 * t1 * t2, 1e-6);
+    EXPECT_NEAR(px.visibility(0.5f), t1 * t1 * t1 * t2, 1e-6);
+    EXPECT_NEAR(px.visibility(0.9f), t1 * t1 * t1 * t1 * t2, 1e-6);
+  }
+}
+
+TEST(Aoit, EqualAreasRemoveTheNearestCandidate) {
+  // T = 1/2, 1/4, 1/8, 1/16, 1/32 at depths 0, 1/64, 3/64, 7/64, 15/64: the four areas are all
+  // exactly 1/256 (dyadic, exact in float), so node 1 goes and node 0 takes T = 1/4
+  AoitPixel<4> px;
+  const float d[5] = {0.0f, 1.0f / 64, 3.0f / 64, 7.0f / 64, 15.0f / 64};
+  for (float z : d) px.insert(z, 0.5f);
+  const float expectedD[4] = {0.0f, 3.0f / 64, 7.0f / 64, 15.0f / 64};
+  const float expectedT[4] = {0.25f, 0.125f, 0.0625f, 0.03125f};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(px.nodes[i].depth, expectedD[i]) << i;
+    EXPECT_EQ(px.nodes[i].trans, expectedT[i]) << i;
+  }
+  // an equal depth: the zero-width step is the least area, removed first (and the fragment at
+  // that depth is not attenuated by its twin)
+  AoitPixel<4> twins;
+  for (float z : {0.2f, 0.4f, 0.6f, 0.8f}) twins.insert(z, 0.5f);
+  twins.insert(0.4f, 0.5f);
+  EXPECT_EQ(twins.used(), 4);
+  EXPECT_EQ(twins.nodes[1].depth, 0.4f);
+  EXPECT_EQ(twins.nodes[2].depth, 0.6f);
+  EXPECT_EQ(twins.nodes[1].trans, 0.125f);
+  EXPECT_EQ(twins.visibility(0.4f), 0.5f);
+  EXPECT_EQ(twins.nodes[3].trans, 1.0f / 32);  // the total transmittance is kept
+}
+
+TEST(Aoit, AtMostNLayersEqualTheABuffer) {
+  // N distinct layers: nothing is removed, the image is front-to-back "over" up to float rounding
+  for (const char* preset : {"aoit4", "aoit8", "aoit16"}) {
+    const int n = aoitNodeCount(methodPreset(preset).value().compositing);
+    std::vector<Layer> layers;
+    for (int i = 0; i < n; ++i) {
+      const float u = static_cast<float>(i) / static_cast<float>(n);
+      layers.push_back(
+          {-0.3f - 0.25f * static_cast<float>(i), {u, 1.0f - u, 0.5f, 0.2f + 0.6f * u}});
+    }
+    std::reverse(layers.begin() + n / 2, layers.end());  // not in depth order
+    const RasterFrame frame = frameOf(layers);
+    const auto frags = fragmentsOf(frame);
+    const RenderOutput out = run(frame, preset);
+    double worst = 0.0;
+    for (size_t p = 0; p < frags.size(); ++p) {
+      ASSERT_EQ(frags[p].size(), static_cast<size_t>(n));
+      worst = std::max(worst, maxDiff(out.image, p, overTruth(frags[p])));
+    }
+    EXPECT_LT(worst, 1e-5) << preset;
+    EXPECT_EQ(out.stats.lost, 0u);
+    EXPECT_EQ(out.stats.captured, out.stats.fragmentsGenerated);
+  }
+}
+
+TEST(Aoit, NPlusOneLayersRemoveTheLeastAreaNode) {
+  // five layers of alpha 0.5 into four nodes; layer 3 sits just behind layer 2, so the step of
+  // node 3 has the least area and moves forward onto node 2: fragment 3 then sees T_3 instead of
+  // T_2, visibly off the A-buffer, and exactly the reference rule's image
+  const std::vector<Layer> layers = {{-2.5f, {0.1f, 0.2f, 0.9f, 0.5f}},
+                                     {-0.5f, {0.9f, 0.2f, 0.1f, 0.5f}},
+                                     {-1.55f, {0.9f, 0.9f, 0.1f, 0.5f}},
+                                     {-1.0f, {0.2f, 0.9f, 0.2f, 0.5f}},
+                                     {-1.5f, {0.1f, 0.9f, 0.9f, 0.5f}}};
+  const RasterFrame frame = frameOf(layers);
+  const auto frags = fragmentsOf(frame);
+  const RenderOutput out = run(frame, "aoit4");
+  for (size_t p = 0; p < frags.size(); ++p) {
+    const std::vector<Frag>& f = frags[p];  // nearest first
+    ASSERT_EQ(f.size(), 5u);
+    std::vector<std::pair<double, double>> in;
+    for (const Frag& x : f) in.push_back({x.d, x.a});
+    std::vector<double> removed;
+    const std::vector<RefNode> nodes = aoitReference(in, 4, &removed);
+    ASSERT_EQ(removed.size(), 1u);
+    ASSERT_EQ(removed[0], f[3].d) << "pixel " << p << ": the hand-chosen node (layer -1.55)";
+    ASSERT_LT(maxDiff(out.image, p, aoitComposite(nodes, f)), 2e-6) << p;
+    ASSERT_GT(maxDiff(out.image, p, overTruth(f)), 1e-2) << p;
+  }
+}
+
+TEST(Aoit, TheSubmissionOrderMattersOnlyBeyondNPlusOneFragments) {
+  // hairball: tile-owned capture inserts in primitive order; a shuffled draw order changes the
+  // removals at pixels with more than N + 1 fragments (each one's image is the reference rule's
+  // for its own arrival order), never at the others
+  const Scene scene = loadScene("procedural:hairball?strands=120").value();
+  Scene shuffled = scene;
+  shuffleDrawOrder(shuffled, 99);
+  const auto a = test::buildFrame(scene, *scene.defaultCamera, 32, 32, 2);
+  const auto b = test::buildFrame(shuffled, *scene.defaultCamera, 32, 32, 2);
+  ASSERT_TRUE(a && b);
+  const auto sets = test::capturedSets(run(*a, "abuffer"));
+  const RenderOutput x = run(*a, "aoit4"), y = run(*b, "aoit4");
+  float within = 0.0f, beyond = 0.0f;
+  for (size_t p = 0; p < sets.size(); ++p) {
+    const glm::vec3 d = glm::abs(x.image.pixels[p] - y.image.pixels[p]);
+    float& worst = sets[p].size() <= 5 ? within : beyond;
+    worst = std::max({worst, d.r, d.g, d.b});
+  }
+  EXPECT_LT(within, 1e-5f);
+  EXPECT_GT(beyond, 1e-3f) << "aoit4's removals depend on the arrival order";
 }
 
 }  // namespace

@@ -10,6 +10,7 @@
 #include "mfr/gl/gl_engine.hpp"
 #include "mfr/gl/gl_technique.hpp"
 #include "mfr/gl/shared_layout.h"
+#include "mfr/method/aoit.hpp"
 #include "mfr/method/mboit.hpp"
 
 namespace mfr::gl {
@@ -25,6 +26,7 @@ bool countPassFirst(GlTechnique t) {
     case GlTechnique::Wboit:
     case GlTechnique::Mboit:
     case GlTechnique::Mlab:
+    case GlTechnique::Aoit:
       return false;
   }
   return false;
@@ -39,6 +41,7 @@ bool fragmentNodes(GlTechnique t) {
     case GlTechnique::Wboit:
     case GlTechnique::Mboit:
     case GlTechnique::Mlab:  // (mlab's nodes are merged layers, not fragments)
+    case GlTechnique::Aoit:  // (aoit's are visibility steps)
       return false;
   }
   return false;
@@ -47,6 +50,11 @@ bool fragmentNodes(GlTechnique t) {
 // the moment technique's floats per pixel: b0, N moments, four accumulators (shared_layout.h)
 uint32_t mboitWords(const MethodDesc& m) {
   return kMboitWordsBase + static_cast<uint32_t>(mboitMomentCount(m.compositing));
+}
+
+// the AOIT technique's floats per pixel: N nodes of (depth, transmittance), the colour sum
+uint32_t aoitWords(const MethodDesc& m) {
+  return kAoitNodeWords * static_cast<uint32_t>(aoitNodeCount(m.compositing)) + kAoitColorWords;
 }
 
 // bytes per pixel of the frame's largest per-pixel buffer (each must fit one storage block)
@@ -64,6 +72,8 @@ uint64_t largestPerPixelBytes(const RenderPlan& p) {
       return std::max<uint64_t>(12, mboitWords(p.method) * 4);
     case GlTechnique::Mlab:
       return std::max<uint64_t>(12, uint64_t{p.k} * kMlabWords * 4);
+    case GlTechnique::Aoit:
+      return std::max<uint64_t>(12, aoitWords(p.method) * 4);
   }
   return 12;
 }
@@ -144,16 +154,26 @@ struct GlEngine::State::FrameRun {
     }
   }
 
-  // wboit, mboit: the per-pixel accumulators (mboit: its moments first)
+  // wboit, mboit, aoit: the per-pixel accumulators (mboit: its moments first; aoit: its nodes)
   void captureAccumulators() {
     const uint32_t pixels = plan.pixels;
     const bool isWboit = plan.technique == GlTechnique::Wboit;
-    const uint32_t accumWords = isWboit ? kWboitWords : mboitWords(plan.method);
+    const bool isAoit = plan.technique == GlTechnique::Aoit;
+    const uint32_t aoitNodes = static_cast<uint32_t>(aoitNodeCount(plan.method.compositing));
+    const uint32_t accumWords = isWboit  ? kWboitWords
+                                : isAoit ? aoitWords(plan.method)
+                                         : mboitWords(plan.method);
     accum = fb.make("accumulators", uint64_t{pixels} * accumWords * 4);
-    {  // wboit: revealage 1, the rest 0
+    {  // wboit: revealage 1; aoit: unused nodes (kAoitEmptyDepth, transmittance 1); the rest 0
       std::vector<float> init(uint64_t{pixels} * accumWords, 0.0f);
       if (isWboit)
         for (uint32_t p = 0; p < pixels; ++p) init[uint64_t{p} * accumWords + 4] = 1.0f;
+      if (isAoit)
+        for (uint32_t p = 0; p < pixels; ++p)
+          for (uint32_t j = 0; j < aoitNodes; ++j) {
+            init[uint64_t{p} * accumWords + kAoitNodeWords * j] = kAoitEmptyDepth;
+            init[uint64_t{p} * accumWords + kAoitNodeWords * j + 1] = 1.0f;
+          }
       glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
     }
     const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
@@ -164,7 +184,9 @@ struct GlEngine::State::FrameRun {
       } else {
         glUseProgram(program);
       }
-      if (!isWboit) {
+      if (isAoit) {
+        glProgramUniform1ui(program, loc(program, "uNodeCount"), aoitNodes);
+      } else if (!isWboit) {
         glProgramUniform1ui(program, loc(program, "uMomentCount"),
                             static_cast<GLuint>(mboitMomentCount(plan.method.compositing)));
         glProgramUniform1ui(program, loc(program, "uTrigonometric"),
@@ -175,9 +197,15 @@ struct GlEngine::State::FrameRun {
       s.drawScene();
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     };
-    if (!isWboit) pass("moments", [&] { accumulate(s.program(ProgramId::MboitMoments), false); });
+    if (isAoit)
+      pass("visibility", [&] { accumulate(s.program(ProgramId::AoitVisibility), false); });
+    else if (!isWboit)
+      pass("moments", [&] { accumulate(s.program(ProgramId::MboitMoments), false); });
     pass("capture", [&] {
-      accumulate(isWboit ? s.program(ProgramId::Wboit) : s.program(ProgramId::MboitColor), true);
+      accumulate(isWboit  ? s.program(ProgramId::Wboit)
+                 : isAoit ? s.program(ProgramId::AoitColor)
+                          : s.program(ProgramId::MboitColor),
+                 true);
     });
   }
 
@@ -348,7 +376,7 @@ struct GlEngine::State::FrameRun {
     });
   }
 
-  // wboit, mboit: the accumulators' composite
+  // wboit, mboit, aoit: the accumulators' composite
   void resolveAccumulators(ProgramId program) {
     image = fb.make("image", uint64_t{plan.pixels} * 12);
     pass("resolve", [&] {
@@ -357,6 +385,9 @@ struct GlEngine::State::FrameRun {
       if (program == ProgramId::MboitResolve)
         glProgramUniform1ui(p, loc(p, "uMomentCount"),
                             static_cast<GLuint>(mboitMomentCount(plan.method.compositing)));
+      if (program == ProgramId::AoitResolve)
+        glProgramUniform1ui(p, loc(p, "uNodeCount"),
+                            static_cast<GLuint>(aoitNodeCount(plan.method.compositing)));
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
       dispatchPixels();
@@ -481,6 +512,7 @@ Result<RenderPlan> GlEngine::State::planRender(const MethodDesc& method,
     case GlTechnique::ABuffer:
     case GlTechnique::Wboit:
     case GlTechnique::Mboit:
+    case GlTechnique::Aoit:
       break;
     case GlTechnique::KBuffer:
       plan.perPixel = alloc != nullptr || device;
@@ -542,6 +574,10 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       case GlTechnique::Mlab:
         frame.captureMlab();
         frame.resolveMlab();
+        break;
+      case GlTechnique::Aoit:
+        frame.captureAccumulators();
+        frame.resolveAccumulators(ProgramId::AoitResolve);
         break;
     }
     MFR_TRY(frame.checkErrors());

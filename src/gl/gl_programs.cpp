@@ -108,6 +108,9 @@ constexpr ProgramRow kPrograms[] = {
     {ProgramId::ImportanceTotal, "importance_total.comp", Stages::Compute, Prelude::None},
     {ProgramId::AllocK, "alloc_k.comp", Stages::Compute, Prelude::None},
     {ProgramId::AllocPack, "alloc_pack.comp", Stages::Compute, Prelude::None},
+    {ProgramId::AoitVisibility, "aoit_visibility.frag", Stages::Raster, Prelude::None},
+    {ProgramId::AoitColor, "aoit_color.frag", Stages::Raster, Prelude::None},
+    {ProgramId::AoitResolve, "aoit_resolve.comp", Stages::Compute, Prelude::None},
 };
 constexpr bool rowsInIdOrder() {
   if (std::size(kPrograms) != kProgramCount) return false;

@@ -29,6 +29,11 @@ constexpr GlTechniqueInfo kTechniques[] = {
      "mboit, mboit6, mboit8, mboit-trig3, mboit-trig4"},
     {GlTechnique::Mlab, "mlab", "capture (insert, merge the two farthest when full) -> resolve",
      "mlab.frag", "mlab_resolve.comp", "k nodes of 20 B + node count 4 B + lock 4 B", "mlab"},
+    {GlTechnique::Aoit, "aoit",
+     "visibility (insert, remove the least-area node) -> capture (colour, visibility) -> resolve",
+     "aoit_visibility.frag, aoit_color.frag", "aoit_resolve.comp",
+     "nodes and colour sum 44 B (4 nodes), 76 B (8), 140 B (16) + lock 4 B",
+     "aoit4, aoit8, aoit16"},
 };
 
 constexpr bool rowsInEnumOrder() {
@@ -95,6 +100,13 @@ std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
           m.occupancyWords != 0)
         return std::nullopt;
       return GlTechnique::Mlab;
+    case Compositing::Adaptive4:
+    case Compositing::Adaptive8:
+    case Compositing::Adaptive16:
+      if (m.allocation != AllocationPolicy::NoNodes || m.store != StoreChoice::None ||
+          m.occupancyWords != 0)
+        return std::nullopt;
+      return GlTechnique::Aoit;
   }
   return std::nullopt;
 }
@@ -119,7 +131,7 @@ Result<GlTechnique> classifyGl(const MethodDesc& method) {
     return makeError("--engine gl: method " + method.name +
                      " is not in the GL engine (it runs the A-buffer; the k-buffer family with a "
                      "fixed k or a per-pixel k(p), max-array or max-heap stores, occupancy culling "
-                     "and kbuffer or hybrid compositing; wboit; mboit; mlab)");
+                     "and kbuffer or hybrid compositing; wboit; mboit; mlab; aoit)");
   return *t;
 }
 

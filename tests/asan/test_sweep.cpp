@@ -267,6 +267,10 @@ Sameness expectedSameness(const Config& c) {
     case Compositing::KBuffer:
       return Sameness::Exact;
     case Compositing::MultiLayerAlpha:
+    // AOIT's removals (beyond N + 1 fragments a pixel) follow the arrival order
+    case Compositing::Adaptive4:
+    case Compositing::Adaptive8:
+    case Compositing::Adaptive16:
       return Sameness::OrderDependent;
     default:
       return Sameness::RoundingOnly;

@@ -161,7 +161,9 @@ TEST(GlSeamEveryPreset, SharedStatisticsEqualTheCpuEngines) {
       SCOPED_TRACE(name);
       const MethodDesc& method = preset.value();
       RenderOptions options;
-      options.budgetBytes = 200u << 10;
+      // (at least the method's fixed per-pixel words with the lock: aoit16 144 B per pixel)
+      options.budgetBytes =
+          std::max<uint64_t>(200u << 10, MemoryModel::of(method, true).overhead(48 * 40));
       RenderOptions cpuOptions = options;  // the GL k-buffers lock per pixel (see GlSeam above)
       if (method.allocation != AllocationPolicy::Unbounded &&
           method.store != StoreChoice::MultiLayer)

@@ -20,7 +20,9 @@ GlTechnique expectedTechnique(const std::string& preset) {
       {"abuffer", GlTechnique::ABuffer},   {"wboit", GlTechnique::Wboit},
       {"mboit", GlTechnique::Mboit},       {"mboit6", GlTechnique::Mboit},
       {"mboit8", GlTechnique::Mboit},      {"mlab", GlTechnique::Mlab},
-      {"mboit-trig3", GlTechnique::Mboit}, {"mboit-trig4", GlTechnique::Mboit}};
+      {"mboit-trig3", GlTechnique::Mboit}, {"mboit-trig4", GlTechnique::Mboit},
+      {"aoit4", GlTechnique::Aoit},        {"aoit8", GlTechnique::Aoit},
+      {"aoit16", GlTechnique::Aoit}};
   const auto it = peers.find(preset);
   return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
 }
@@ -40,7 +42,7 @@ TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
     EXPECT_EQ(*tc, GlTechnique::KBuffer) << name << "+occupancy";
     ++occupancyForms;
   }
-  EXPECT_EQ(presets, 21);  // 13 of the k-buffer family, the A-buffer, 7 peer methods
+  EXPECT_EQ(presets, 24);  // 13 of the k-buffer family, the A-buffer, 10 peer methods
   EXPECT_EQ(occupancyForms, 13);
 }
 
@@ -58,7 +60,7 @@ TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
 
 TEST(GlTechnique, TableRowsFollowTheEnum) {
   const auto rows = glTechniques();
-  ASSERT_EQ(rows.size(), 5u);
+  ASSERT_EQ(rows.size(), 6u);
   for (size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(static_cast<size_t>(rows[i].technique), i);
     EXPECT_EQ(&techniqueInfo(rows[i].technique), &rows[i]);

@@ -27,6 +27,7 @@ enum class GlTechnique : uint8_t {
   Wboit,    // weighted blended OIT: one accumulation pass, weighted-average resolve
   Mboit,    // moment-based OIT: moments pass, colour pass, reconstruction resolve
   Mlab,     // multi-layer alpha blending: merge capture of k nodes, front-to-back resolve
+  Aoit,     // adaptive transparency: visibility pass (N nodes), colour pass, composite
 };
 
 /// One row of the technique table.

@@ -70,6 +70,10 @@ MFR_GL_CONST(uint, kBindAccum, 2u)
 // mfr::PowerMomentPixel): kMboitWords with N = 4, kMboitWordsBase + N for N = 6, 8
 MFR_GL_CONST(uint, kMboitWords, 9u)
 MFR_GL_CONST(uint, kMboitWordsBase, 5u)
+// adaptive transparency: per pixel N nodes of (depth, transmittance), then sum vis a c (r, g, b)
+// (mfr::AoitPixel<N>): kAoitNodeWords N + kAoitColorWords words, N = 4, 8 or 16
+MFR_GL_CONST(uint, kAoitNodeWords, 2u)
+MFR_GL_CONST(uint, kAoitColorWords, 3u)
 // multi-layer alpha blending: per node depth, premultiplied r, g, b, transmittance (mfr::MlabNode)
 MFR_GL_CONST(uint, kMlabWords, 5u)
 // deep k-buffer: feature accumulators per pixel (n, nearest depth bits and colour, farthest depth
@@ -138,6 +142,8 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //   mboit_color.frag: kBindAccum kBindLocks(image)
 //   mboit_moments.frag: kBindAccum kBindLocks(image)
 //   mlab.frag: kBindNodes kBindFill kBindLocks(image)
+//   aoit_visibility.frag: kBindAccum kBindLocks(image)
+//   aoit_color.frag: kBindAccum kBindLocks(image)
 //   nearest_cosine.frag: kBindNearest kBindLocks(image)
 //   occupancy_fill.frag: kBindOccupancy kBindOccBits
 //   wboit.frag: kBindAccum kBindLocks(image)
@@ -150,6 +156,7 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //   importance_total.comp: kBindImportance kBindImportanceTotal
 //   mboit_resolve.comp: kBindAccum kBindImage
 //   mlab_resolve.comp: kBindNodes kBindFill kBindImage2
+//   aoit_resolve.comp: kBindAccum kBindImage
 //   occupancy_count.comp: kBindOccBits kBindOccupancy kBindAllocation(texture)
 //   prefix_sum.comp: kBindScanIn kBindScanOut kBindScanSums
 //   prefix_sum_add.comp: kBindScanOut kBindScanSums

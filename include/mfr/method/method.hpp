@@ -64,6 +64,9 @@ enum class Compositing : uint8_t {
   MomentBasedTrig3,  // mboit-trig3: 3 trigonometric moments (mboit.hpp)
   MomentBasedTrig4,  // mboit-trig4: 4 trigonometric moments (mboit.hpp)
   MultiLayerAlpha,   // mlab: front-to-back over of the MultiLayer store's nodes (Salvi 2014)
+  Adaptive4,         // aoit4: adaptive transparency, 4 visibility nodes (Salvi 2011), aoit.hpp
+  Adaptive8,         // aoit8: the same with 8 nodes
+  Adaptive16,        // aoit16: the same with 16 nodes
 };
 
 /// True for kbuffer and hybrid, the rules `--composite` chooses between (the k-buffer family).

@@ -16,6 +16,8 @@
 //     see mlab.hpp;
 //   MBOIT: Muenstermann, Krumpen, Klein, Peters, "Moment-Based Order-Independent Transparency",
 //     HPG 2018 (4 power moments, bias 5e-7, overestimation 0.25); see mboit.hpp;
+//   AOIT: Salvi, Montgomery, Lefohn, "Adaptive Transparency", HPG 2011 (the visibility function's
+//     insertion and area-based compression, the colour pass's weight); see aoit.hpp;
 //   importance: Vasilakis, Vardis, Papaioannou, Moustakas, "Variable k-buffer using Importance
 //     Maps", sec. 3.2, Eqs. 3-6 (../shared/papers/variable-k-buffer-importance-maps.md); see
 //     importance.hpp;
@@ -125,6 +127,12 @@ MFR_MATH_CONST(int, kMboitRootIterations, 64)
 // 1e-12 (GLSL has no token pasting for an `lf` suffix: the correctly rounded quotient of exact
 // integers is the same double as the literal)
 MFR_MATH_CONST(double, kMboitTiny, double(1) / (double(1000000) * double(1000000)))
+
+// Adaptive transparency (Salvi, Montgomery, Lefohn 2011): the most nodes a preset keeps (aoit16)
+// and the depth of an unused node, beyond every window depth in [0, 1] (the authors keep unused
+// nodes at a far depth too; their value is the largest float, any depth above 1 works alike)
+MFR_MATH_CONST(int, kAoitMaxNodes, 16)
+MFR_MATH_CONST(float, kAoitEmptyDepth, 3.0e38f)
 
 // Importance (variable k-buffer, sec. 3.2): Eq. 4's diagonal scale 1.1 and factor 2, Eq. 5's
 // Fresnel power 5 and halving, Eq. 6's noise centre; the noise xi is SplitMix64's finaliser of
@@ -789,6 +797,86 @@ MFR_MATH_FN float mboitTransmittanceTrig(int count, float b0,
   MFR_PRECISE double t = doubleExp(-double(b0) * absorbance);
   if (!isFiniteDouble(t)) return 1.0f;
   return float(clamp(t, 0.0, 1.0));
+}
+
+// ---- adaptive transparency (AOIT) ---------------------------------------------------------------
+// Salvi, Montgomery, Lefohn, "Adaptive Transparency", HPG 2011. Per pixel n nodes (depth d_i,
+// transmittance T_i), sorted by depth; T_i is the transmittance just behind d_i; unused nodes sit
+// at kAoitEmptyDepth and carry the pixel's total transmittance (so node n - 1 always holds it). The
+// working arrays have room for n + 1 nodes (kAoitMaxNodes + 1): the insertion may make n + 1, the
+// compression brings them back to n.
+
+/// Inserts a fragment (depth z, transmittance t = 1 - alpha) into nodes 0..n-1:
+/// its node goes at the first node not strictly in front of it (an equal depth: in front of the
+/// nodes already there) with T = T(node before) t, and every node behind it is multiplied by t.
+/// When that makes n + 1 used nodes, the node i in 1..n whose removal changes the area under the
+/// visibility curve least, (d_i - d_{i-1}) (T_{i-1} - T_i), is removed: node i - 1 takes T_i (the
+/// step moves forward to d_{i-1}: visibility is only ever under-, never overestimated, and the
+/// total transmittance is kept); the nearest node is never removed; ties go to the smallest i.
+MFR_MATH_FN void aoitInsert(int n, MFR_INOUT_ARRAY(float, depth, kAoitMaxNodes + 1),
+                            MFR_INOUT_ARRAY(float, trans, kAoitMaxNodes + 1), float z, float t) {
+  int index = 0;
+  float before = 1.0f;
+  for (int i = 0; i < n; ++i) {
+    if (z > depth[i]) {
+      index = i + 1;
+      before = trans[i];
+    }
+  }
+  for (int i = n - 1; i >= index; --i) {
+    MFR_PRECISE float behind = trans[i] * t;
+    depth[i + 1] = depth[i];
+    trans[i + 1] = behind;
+  }
+  MFR_PRECISE float own = before * t;
+  depth[index] = z;
+  trans[index] = own;
+  if (depth[n] == kAoitEmptyDepth) return;
+  int removed = 1;
+  MFR_PRECISE float least = (depth[1] - depth[0]) * (trans[0] - trans[1]);
+  for (int i = 2; i <= n; ++i) {
+    MFR_PRECISE float area = (depth[i] - depth[i - 1]) * (trans[i - 1] - trans[i]);
+    if (area < least) {
+      least = area;
+      removed = i;
+    }
+  }
+  trans[removed - 1] = trans[removed];
+  for (int i = removed; i < n; ++i) {
+    depth[i] = depth[i + 1];
+    trans[i] = trans[i + 1];
+  }
+}
+
+/// Visibility in front of depth z: T of the farthest node strictly in front of z, 1 if none (a
+/// fragment at a node's depth is not attenuated by that node: equal depths do not occlude each
+/// other).
+MFR_MATH_FN float aoitVisibility(int n, MFR_IN_ARRAY(float, depth, kAoitMaxNodes + 1),
+                                 MFR_IN_ARRAY(float, trans, kAoitMaxNodes + 1), float z) {
+  float vis = 1.0f;
+  for (int i = 0; i < n; ++i) {
+    if (z > depth[i]) vis = trans[i];
+  }
+  return vis;
+}
+
+/// Pass 2: the fragment's premultiplied colour weighted by its visibility, (r, g, b) += vis a c.
+MFR_MATH_FN void aoitAddColor(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(float) b, vec3 c,
+                              float a, float vis) {
+  MFR_PRECISE float w = vis * a;
+  MFR_PRECISE float nr = r + c.r * w;
+  MFR_PRECISE float ng = g + c.g * w;
+  MFR_PRECISE float nb = b + c.b * w;
+  r = nr;
+  g = ng;
+  b = nb;
+}
+
+/// The composite: the weighted sum plus the total transmittance (the last node's) times the
+/// background.
+MFR_MATH_FN vec3 aoitComposite(vec3 sum, float total, vec3 background) {
+  MFR_PRECISE vec3 result = sum + total * background;
+  return result;
 }
 
 // ---- importance (variable k-buffer) ------------------------------------------------------------

@@ -1,12 +1,13 @@
 // The peer methods as types: the transparency methods engines ship instead of k-buffers, each
 // described by one type in its own header beside its per-pixel state and rules (wboit.hpp,
-// mboit.hpp, mlab.hpp). A peer type says
+// mboit.hpp, mlab.hpp, aoit.hpp). A peer type says
 //
 //   kRule          the Compositing value that names it, kRuleName its name (toString)
 //   preset()       its row of the preset table (name, paper, summary)
 //   Slot           its per-pixel state (an accumulator), or one node of its per-pixel nodes
 //   kNodes         false: one Slot per pixel; true: k(p) Slots at the fixed-k allocation's offsets
-//   kExtraPasses   its geometry passes before the capture, by name (mboit: "moments")
+//   kExtraPasses   its geometry passes before the capture, by name (mboit: "moments", aoit:
+//                  "visibility")
 //   add(px, pass, depth, rgba)   one fragment in pass `pass` (0..extra-1, then the capture's)
 //   composite(slots, count, bg)  the pixel's colour over the background
 //
@@ -22,6 +23,7 @@
 
 #include <glm/glm.hpp>
 
+#include "mfr/method/aoit.hpp"
 #include "mfr/method/mboit.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/method/mlab.hpp"
@@ -47,7 +49,7 @@ struct PeerList {
   }
 };
 using PeerMethods = PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Method, MboitTrig3Method,
-                             MboitTrig4Method, MlabMethod>;
+                             MboitTrig4Method, MlabMethod, Aoit4Method, Aoit8Method, Aoit16Method>;
 
 /// Calls `f.template operator()<Peer>()` with the peer type of `rule`; false (and no call) for
 /// the k-buffer family's rules.
