@@ -32,7 +32,8 @@ namespace fs = std::filesystem;
 struct CompareArgs {
   SceneOptions scene;
   std::string budgets;
-  std::string methods = "fkb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,optimal,wboit,mboit,mlab";
+  std::string methods =
+      "fkb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,optimal,wboit,mboit,mlab,linked-list";
   std::string model;
   std::string out;
   std::string composite;  // empty: each preset's own rule

@@ -108,6 +108,8 @@ constexpr ProgramRow kPrograms[] = {
     {ProgramId::ImportanceTotal, "importance_total.comp", Stages::Compute, Prelude::None},
     {ProgramId::AllocK, "alloc_k.comp", Stages::Compute, Prelude::None},
     {ProgramId::AllocPack, "alloc_pack.comp", Stages::Compute, Prelude::None},
+    {ProgramId::ListCapture, "capture_list.frag", Stages::Raster, Prelude::None},
+    {ProgramId::ListResolve, "resolve_list.comp", Stages::Compute, Prelude::None},
 };
 constexpr bool rowsInIdOrder() {
   if (std::size(kPrograms) != kProgramCount) return false;

@@ -44,8 +44,10 @@ enum class ProgramId : uint8_t {
   ImportanceTotal,  // importance_total.comp
   AllocK,           // alloc_k.comp
   AllocPack,        // alloc_pack.comp
+  ListCapture,      // capture_list.frag (per-pixel linked lists)
+  ListResolve,      // resolve_list.comp
 };
-inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::AllocPack) + 1;
+inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::ListResolve) + 1;
 
 /// The linked programs of one engine, deleted with it (in the context current then).
 class Programs {

@@ -19,7 +19,8 @@ GlTechnique expectedTechnique(const std::string& preset) {
   static const std::map<std::string, GlTechnique> peers = {
       {"abuffer", GlTechnique::ABuffer}, {"wboit", GlTechnique::Wboit},
       {"mboit", GlTechnique::Mboit},     {"mboit6", GlTechnique::Mboit},
-      {"mboit8", GlTechnique::Mboit},    {"mlab", GlTechnique::Mlab}};
+      {"mboit8", GlTechnique::Mboit},    {"mlab", GlTechnique::Mlab},
+      {"linked-list", GlTechnique::LinkedList}};
   const auto it = peers.find(preset);
   return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
 }
@@ -39,7 +40,7 @@ TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
     EXPECT_EQ(*tc, GlTechnique::KBuffer) << name << "+occupancy";
     ++occupancyForms;
   }
-  EXPECT_EQ(presets, 19);
+  EXPECT_EQ(presets, 20);
   EXPECT_EQ(occupancyForms, 13);
 }
 
@@ -57,7 +58,7 @@ TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
 
 TEST(GlTechnique, TableRowsFollowTheEnum) {
   const auto rows = glTechniques();
-  ASSERT_EQ(rows.size(), 5u);
+  ASSERT_EQ(rows.size(), 6u);
   for (size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(static_cast<size_t>(rows[i].technique), i);
     EXPECT_EQ(&techniqueInfo(rows[i].technique), &rows[i]);
@@ -85,6 +86,9 @@ TEST(GlTechnique, CombinationsOutsideTheGlEngineAreOneLineErrors) {
   m = methodPreset("abuffer").value();
   m.occupancyWords = 2;
   expectRefused(m, "abuffer-occupancy");
+  m = methodPreset("linked-list").value();
+  m.occupancyWords = 1;
+  expectRefused(m, "linked-list-occupancy");
   m = methodPreset("abuffer").value();
   m.compositing = Compositing::Hybrid;
   expectRefused(m, "abuffer-hybrid");

@@ -27,6 +27,7 @@ enum class GlTechnique : uint8_t {
   Wboit,    // weighted blended OIT: one accumulation pass, weighted-average resolve
   Mboit,    // moment-based OIT: moments pass, colour pass, reconstruction resolve
   Mlab,     // multi-layer alpha blending: merge capture of k nodes, front-to-back resolve
+  LinkedList,  // per-pixel linked lists: pool counter + head exchange capture, walk-sort resolve
 };
 
 /// One row of the technique table.
