@@ -32,7 +32,6 @@ namespace mfr::detail {
 CaptureCounters captureLinkedList(const RasterFrame& frame, const MethodDesc& method,
                                   const Allocation& allocation, Stores& stores,
                                   BufferLedger& ledger) {
-  const size_t pixels = frame.pixelCount();
   const int tiles = frame.tileCount();
   const uint64_t poolSize = allocation.slots;
   const bool hybrid = method.compositing == Compositing::Hybrid;
@@ -133,7 +132,6 @@ CaptureCounters captureLinkedList(const RasterFrame& frame, const MethodDesc& me
   MFR_CHECK_EQ(c.generated, generated);
   c.inserted = firstNode.back();
   c.rejected = c.generated - c.inserted;
-  (void)pixels;
   return c;
 }
 

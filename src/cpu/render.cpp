@@ -162,7 +162,7 @@ std::string renderWhat(const RasterFrame& frame, const MethodDesc& method) {
 uint64_t perPixelBytes(const MethodDesc& method, const MemoryModel& memory) {
   uint64_t bytes = 4 + 4 + 8 + 1 + sizeof(glm::vec3);
   if (method.allocation != AllocationPolicy::FixedK) bytes += 4;
-  bytes += memory.lock + memory.occupancy + memory.tail + memory.accum;
+  bytes += memory.lock + memory.occupancy + memory.tail + memory.accum + memory.head;
   if (method.allocation == AllocationPolicy::Importance) bytes += 4 + 8 + 4;
   return bytes;
 }

@@ -17,9 +17,9 @@ using namespace mfr::gl;
 // what each preset is, written from the papers rather than from classifyGl's rules
 GlTechnique expectedTechnique(const std::string& preset) {
   static const std::map<std::string, GlTechnique> peers = {
-      {"abuffer", GlTechnique::ABuffer}, {"wboit", GlTechnique::Wboit},
-      {"mboit", GlTechnique::Mboit},     {"mboit6", GlTechnique::Mboit},
-      {"mboit8", GlTechnique::Mboit},    {"mlab", GlTechnique::Mlab},
+      {"abuffer", GlTechnique::ABuffer},       {"wboit", GlTechnique::Wboit},
+      {"mboit", GlTechnique::Mboit},           {"mboit6", GlTechnique::Mboit},
+      {"mboit8", GlTechnique::Mboit},          {"mlab", GlTechnique::Mlab},
       {"linked-list", GlTechnique::LinkedList}};
   const auto it = peers.find(preset);
   return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
