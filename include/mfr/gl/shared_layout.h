@@ -166,6 +166,9 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //   raster_common.glsl: kBindMaterials kBindColorTables kBindTexels kBindCounts(image)
 //   raster_native.glsl: kBindTriMaterial
 //   raster.geom: kBindTriMaterial kBindMaterials
+//   capture_list.frag: kBindListHeads kBindNodes kBindFill kBindTails
+//   resolve_list.comp: kBindListHeads kBindListLengths kBindNodes kBindImage kBindColorTables
+//       kBindResolveTails
 // (end of the bindings per shader file)
 
 #ifdef __cplusplus
