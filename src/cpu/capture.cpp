@@ -307,7 +307,7 @@ CaptureCounters runCapture(const RasterFrame& frame, const Allocation& alloc,
 }  // namespace
 
 Isa captureIsaFor(const MethodDesc& method, CaptureMode mode) {
-  if (isPeerRule(method.compositing)) return Isa::Scalar;
+  if (isPeerRule(method.compositing) || method.store == StoreChoice::LinkedList) return Isa::Scalar;
   return captureIsa(method, mode);
 }
 

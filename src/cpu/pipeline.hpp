@@ -19,6 +19,7 @@
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/allocation.hpp"
 #include "mfr/method/compositing.hpp"
+#include "mfr/method/linked_list.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/peer_method.hpp"
 
@@ -139,6 +140,8 @@ struct Stores {
   ZeroedBuffer<HybridTail> tails;  // empty unless hybrid
   PeerBuffer peer;                 // the peer method's accumulators or nodes (peer_methods.cpp)
   bool peerHoldsNodes = false;     // the peer buffer holds nodes (mlab), not accumulators
+  std::vector<uint32_t> heads;     // linked lists: each pixel's newest node (kListEnd: none)
+  UninitializedBuffer<LinkedNode> pool;  // linked lists: the node pool
 };
 
 /// The instruction set capture() runs this method on (what the statistics report as "isa").
@@ -162,5 +165,16 @@ CaptureCounters capturePeer(const RasterFrame& frame, const MethodDesc& method,
                             const Allocation& allocation, CaptureMode mode, Stores& stores);
 ImageRGB resolvePeer(const RasterFrame& frame, const MethodDesc& method,
                      const Allocation& allocation, Stores& stores, glm::vec3 background);
+
+/// Per-pixel linked lists (mfr/method/linked_list.hpp, src/cpu/linked_list.cpp): the admission
+/// pass, then the capture into heads and pool (counts[p]: the list's length; the rest to the
+/// hybrid tail or lost), the same for any number of threads; the resolve (walk, sort, composite);
+/// the lists as RenderOutput's nodes / offsets / counts (keepStores).
+CaptureCounters captureLinkedList(const RasterFrame& frame, const MethodDesc& method,
+                                  const Allocation& allocation, Stores& stores,
+                                  BufferLedger& ledger);
+ImageRGB resolveLinkedList(const RasterFrame& frame, const MethodDesc& method, Stores& stores,
+                           glm::vec3 background);
+void exportLinkedLists(const Stores& stores, RenderOutput& out);
 
 }  // namespace mfr::detail

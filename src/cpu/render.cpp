@@ -88,6 +88,8 @@ ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method, const Alloc
                  detail::Stores& stores, glm::vec3 background) {
   if (detail::isPeerRule(method.compositing))
     return detail::resolvePeer(frame, method, alloc, stores, background);
+  if (method.store == StoreChoice::LinkedList)
+    return detail::resolveLinkedList(frame, method, stores, background);
   const bool hybrid = method.compositing == Compositing::Hybrid;
   // a pixel no fragment reached (no node, an empty tail) shows the rule's empty composite: the
   // same bits as compositing it, without the sort and the blend. The image starts as that colour,
@@ -160,7 +162,7 @@ std::string renderWhat(const RasterFrame& frame, const MethodDesc& method) {
 uint64_t perPixelBytes(const MethodDesc& method, const MemoryModel& memory) {
   uint64_t bytes = 4 + 4 + 8 + 1 + sizeof(glm::vec3);
   if (method.allocation != AllocationPolicy::FixedK) bytes += 4;
-  bytes += memory.lock + memory.occupancy + memory.tail + memory.accum;
+  bytes += memory.lock + memory.occupancy + memory.tail + memory.accum + memory.head;
   if (method.allocation == AllocationPolicy::Importance) bytes += 4 + 8 + 4;
   return bytes;
 }
@@ -281,10 +283,12 @@ Result<void> checkNodePool(const RasterFrame& frame, const MethodDesc& method,
                            const RenderOptions& options, const MemoryModel& memory,
                            const Allocation& alloc, const detail::BufferLedger& ledger,
                            uint64_t memoryLimit) {
-  const uint64_t nodeBytes = saturatingMul(
-      alloc.slots, method.store == StoreChoice::MultiLayer ? memory.node : sizeof(FragmentNode));
-  const uint64_t perPixel =
-      4 + sizeof(glm::vec3) + memory.lock + memory.occupancy + memory.tail + memory.accum;
+  const bool ownNodes =
+      method.store == StoreChoice::MultiLayer || method.store == StoreChoice::LinkedList;
+  const uint64_t nodeBytes =
+      saturatingMul(alloc.slots, ownNodes ? memory.node : sizeof(FragmentNode));
+  const uint64_t perPixel = 4 + sizeof(glm::vec3) + memory.lock + memory.occupancy + memory.tail +
+                            memory.accum + memory.head;
   uint64_t held = ledger.total();
   for (const char* freed : {"oracle_prepass", "allocation_scratch"})
     if (auto it = ledger.byCategory().find(freed); it != ledger.byCategory().end())
@@ -301,14 +305,19 @@ Result<void> checkNodePool(const RasterFrame& frame, const MethodDesc& method,
 void clearStores(const MethodDesc& method, const RenderOptions& options, const Allocation& alloc,
                  size_t pixels, detail::Stores& stores, detail::BufferLedger& ledger) {
   const bool peer = detail::isPeerRule(method.compositing);
-  stores.nodes.allocate(peer ? 0 : alloc.slots);
+  const bool lists = method.store == StoreChoice::LinkedList;
+  stores.nodes.allocate(peer || lists ? 0 : alloc.slots);
+  stores.pool.allocate(lists ? alloc.slots : 0);
+  if (lists) stores.heads.assign(pixels, kListEnd);
   detail::allocatePeerStores(method, alloc, pixels, stores);
-  if (options.keepStores && !peer)  // unused slots are handed out: make them defined
+  if (options.keepStores && !peer && !lists)  // unused slots are handed out: make them defined
     std::fill(stores.nodes.data(), stores.nodes.data() + alloc.slots, FragmentNode{0});
   stores.counts.assign(pixels, 0);
-  if (options.capture == CaptureMode::FragmentParallel) stores.locks.assign(pixels, 0);
+  if (options.capture == CaptureMode::FragmentParallel && !lists) stores.locks.assign(pixels, 0);
   if (method.compositing == Compositing::Hybrid) stores.tails.allocate(pixels);
   ledger.addBytes("nodes", stores.nodes.size() * sizeof(FragmentNode));
+  ledger.addBytes("nodes", stores.pool.size() * sizeof(LinkedNode));
+  ledger.add("heads", stores.heads);
   ledger.add("counters", stores.counts);
   ledger.add("locks", stores.locks);
   ledger.addBytes("tail", stores.tails.bytes());
@@ -385,10 +394,13 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
 
   // capture
   out.stats.isa = std::string(isaName(detail::captureIsaFor(method, options.capture)));
+  const bool lists = method.store == StoreChoice::LinkedList;
   const detail::CaptureCounters counters = timer.run("capture", [&] {
+    if (lists) return detail::captureLinkedList(frame, method, alloc, stores, ledger);
     return detail::capture(frame, method, alloc, plan.occupancy ? &occupancy : nullptr,
                            options.capture, stores);
   });
+  if (lists) alloc.capacity = stores.counts;  // k(p): the nodes each list got
 
   // resolve
   out.image = timer.run("resolve",
@@ -407,7 +419,9 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
   cpuStats(counters, ledger, out.stats);
   out.stats.cull = frame.cull();
   out.kMap = alloc.reservedK.empty() ? std::move(alloc.capacity) : std::move(alloc.reservedK);
-  if (options.keepStores) {
+  if (options.keepStores && lists) {
+    detail::exportLinkedLists(stores, out);
+  } else if (options.keepStores) {
     out.nodes.assign(stores.nodes.data(), stores.nodes.data() + stores.nodes.size());
     out.offsets = std::move(alloc.offsets);
     out.counts = std::move(stores.counts);

@@ -84,6 +84,7 @@ Result<GlAllocationTotals> GlEngine::State::allocateK(FrameBuffers& fb, GLuint t
     case StoreChoice::MaxArray:
     case StoreChoice::MultiLayer:
     case StoreChoice::None:
+    case StoreChoice::LinkedList:
       storeMode = 0;
       break;
   }

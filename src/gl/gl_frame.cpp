@@ -27,6 +27,7 @@ bool countPassFirst(GlTechnique t) {
     case GlTechnique::Mboit:
     case GlTechnique::Mlab:
     case GlTechnique::Aoit:
+    case GlTechnique::LinkedList:
       return false;
   }
   return false;
@@ -40,8 +41,9 @@ bool fragmentNodes(GlTechnique t) {
       return true;
     case GlTechnique::Wboit:
     case GlTechnique::Mboit:
-    case GlTechnique::Mlab:  // (mlab's nodes are merged layers, not fragments)
-    case GlTechnique::Aoit:  // (aoit's are visibility steps)
+    case GlTechnique::Mlab:        // (mlab's nodes are merged layers, not fragments)
+    case GlTechnique::Aoit:        // (aoit's are visibility steps)
+    case GlTechnique::LinkedList:  // (read by walking the lists: readLists)
       return false;
   }
   return false;
@@ -74,6 +76,8 @@ uint64_t largestPerPixelBytes(const RenderPlan& p) {
       return std::max<uint64_t>(12, uint64_t{p.k} * kMlabWords * 4);
     case GlTechnique::Aoit:
       return std::max<uint64_t>(12, aoitWords(p.method) * 4);
+    case GlTechnique::LinkedList:
+      return std::max<uint64_t>(12, p.hybrid ? kTailWords * 4 : 0);
   }
   return 12;
 }
@@ -86,7 +90,7 @@ struct GlEngine::State::FrameRun {
   const RenderPlan& plan;
   GlRenderOutput& out;
   FrameBuffers fb;
-  GLuint counts = 0, offsets = 0, nodes = 0, tails = 0, accum = 0, image = 0;
+  GLuint counts = 0, offsets = 0, nodes = 0, tails = 0, accum = 0, image = 0, heads = 0;
   uint64_t nodeCount = 0;
   bool countInCapture = false;  // the capture adds n(p) (no count pass ran)
 
@@ -362,6 +366,74 @@ struct GlEngine::State::FrameRun {
     out.culledKPlus = culled[1];
   }
 
+  // linked lists: the heads, the pool and its counter [, the tails]; a node per fragment while
+  // the pool lasts (capture_list.frag)
+  void captureList() {
+    const uint32_t pixels = plan.pixels;
+    nodeCount = plan.allocSlots;
+    heads = fb.make("heads", uint64_t{pixels} * 4);
+    clearUint(heads, kListEnd);
+    nodes = fb.make("nodes", std::max<uint64_t>(nodeCount, 1) * kListNodeWords * 4);
+    const GLuint counter = fb.make("pool counter", 4);
+    clearUint(counter, 0);
+    if (plan.hybrid) {
+      tails = fb.make("tails", uint64_t{pixels} * kTailWords * 4);
+      clearUint(tails, 0);
+    }
+    pass("capture", [&] {
+      const GLuint p = s.program(ProgramId::ListCapture);
+      useCapture(p);
+      glProgramUniform1ui(p, loc(p, "uPoolSize"), static_cast<GLuint>(nodeCount));
+      glProgramUniform1ui(p, loc(p, "uHybrid"), plan.hybrid ? 1u : 0u);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindListHeads, heads);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, counter);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTails, tails ? tails : counter);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    });
+  }
+
+  // linked lists: each list walked, sorted in place and composited (resolve_list.comp); the
+  // lengths (k(p)) in `offsets`
+  void resolveList() {
+    const uint32_t pixels = plan.pixels;
+    image = fb.make("image", uint64_t{pixels} * 12);
+    offsets = fb.make("lengths", uint64_t{pixels} * 4);
+    pass("resolve", [&] {
+      const GLuint p = s.program(ProgramId::ListResolve);
+      useResolve(p);
+      glProgramUniform1ui(p, loc(p, "uHybrid"), plan.hybrid ? 1u : 0u);
+      glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindListHeads, heads);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindListLengths, offsets);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : offsets);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
+      dispatchPixels();
+    });
+  }
+
+  // linked lists: each pixel's sorted list as nodes, offsets and counts
+  void readLists() {
+    const uint32_t pixels = plan.pixels;
+    std::vector<uint32_t> head(pixels), pool(nodeCount * kListNodeWords);
+    glGetNamedBufferSubData(heads, 0, uint64_t{pixels} * 4ll, head.data());
+    if (nodeCount > 0)
+      glGetNamedBufferSubData(nodes, 0, static_cast<GLsizeiptr>(pool.size() * 4), pool.data());
+    out.nodes.clear();
+    out.nodeOffsets.resize(pixels);
+    out.nodeCounts.resize(pixels);
+    for (uint32_t p = 0; p < pixels; ++p) {
+      out.nodeOffsets[p] = out.nodes.size();
+      for (uint32_t i = head[p]; i != kListEnd && i < nodeCount; i = pool[kListNodeWords * i + 2])
+        out.nodes.push_back((static_cast<uint64_t>(pool[kListNodeWords * i]) << 32) |
+                            pool[kListNodeWords * i + 1]);
+      out.nodeCounts[p] = static_cast<uint32_t>(out.nodes.size() - out.nodeOffsets[p]);
+    }
+  }
+
   // mlab: its nodes front to back over the background
   void resolveMlab() {
     image = fb.make("image", uint64_t{plan.pixels} * 12);
@@ -450,6 +522,11 @@ struct GlEngine::State::FrameRun {
     out.image = ImageRGB(s.width, s.height);
     glGetNamedBufferSubData(image, 0, uint64_t{pixels} * 12ll, out.image.pixels.data());
     if (options.readNodes && fragmentNodes(plan.technique)) readNodes();
+    if (plan.technique == GlTechnique::LinkedList) {
+      out.held.resize(pixels);
+      glGetNamedBufferSubData(offsets, 0, uint64_t{pixels} * 4ll, out.held.data());
+      if (options.readNodes) readLists();
+    }
   }
 
   // the nodes, and each pixel's first node and count
@@ -513,6 +590,12 @@ Result<RenderPlan> GlEngine::State::planRender(const MethodDesc& method,
     case GlTechnique::Wboit:
     case GlTechnique::Mboit:
     case GlTechnique::Aoit:
+      break;
+    case GlTechnique::LinkedList:
+      plan.allocSlots = options.poolNodes;
+      plan.hybrid = method.compositing == Compositing::Hybrid;
+      if (plan.allocSlots * kListNodeWords * 4 > maxBlockBytes)
+        return tooLarge(method, "node pool", plan.allocSlots * kListNodeWords * 4);
       break;
     case GlTechnique::KBuffer:
       plan.perPixel = alloc != nullptr || device;
@@ -578,6 +661,10 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       case GlTechnique::Aoit:
         frame.captureAccumulators();
         frame.resolveAccumulators(ProgramId::AoitResolve);
+        break;
+      case GlTechnique::LinkedList:
+        frame.captureList();
+        frame.resolveList();
         break;
     }
     MFR_TRY(frame.checkErrors());

@@ -111,6 +111,8 @@ constexpr ProgramRow kPrograms[] = {
     {ProgramId::AoitVisibility, "aoit_visibility.frag", Stages::Raster, Prelude::None},
     {ProgramId::AoitColor, "aoit_color.frag", Stages::Raster, Prelude::None},
     {ProgramId::AoitResolve, "aoit_resolve.comp", Stages::Compute, Prelude::None},
+    {ProgramId::ListCapture, "capture_list.frag", Stages::Raster, Prelude::None},
+    {ProgramId::ListResolve, "resolve_list.comp", Stages::Compute, Prelude::None},
 };
 constexpr bool rowsInIdOrder() {
   if (std::size(kPrograms) != kProgramCount) return false;

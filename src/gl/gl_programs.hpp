@@ -47,8 +47,10 @@ enum class ProgramId : uint8_t {
   AoitVisibility,   // aoit_visibility.frag
   AoitColor,        // aoit_color.frag
   AoitResolve,      // aoit_resolve.comp
+  ListCapture,      // capture_list.frag (per-pixel linked lists)
+  ListResolve,      // resolve_list.comp
 };
-inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::AoitResolve) + 1;
+inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::ListResolve) + 1;
 
 /// The linked programs of one engine, deleted with it (in the context current then).
 class Programs {

@@ -122,6 +122,18 @@ class GlFrame {
       if (!a) return a.error();
       method_.k = a->globalK;
     }
+    uint64_t poolNodes = 0;
+    if (method_.allocation == AllocationPolicy::Pool) {  // the pool: F(M), or every fragment
+      if (!options_.budgetBytes) {
+        MFR_TRY(budgetSlots(layout_, method_, memory_, options_.budgetBytes));
+        auto counted = gv_.engine().count();
+        if (!counted) return counted.error();
+        n_ = std::move(counted.value());
+      }
+      auto a = allocate(layout_, method_, memory_, options_.budgetBytes, n_, {}, {});
+      if (!a) return a.error();
+      poolNodes = a->slots;
+    }
     std::optional<uint32_t> deviceGlobalK;
     std::optional<Allocation> perPixel;
     if (onDevice()) {
@@ -139,6 +151,7 @@ class GlFrame {
     go.warmUp = gv_.firstRender();
     go.allocation = perPixel ? &*perPixel : nullptr;
     go.deviceAllocation = onDevice();
+    go.poolNodes = poolNodes;
     // (GL's own n(p) only: the optimal k-buffer's and dkb-curve's come from CPU passes)
     go.counts = n_.empty() || method_.allocation == AllocationPolicy::Optimal ? nullptr : &n_;
     auto gl = gv_.engine().render(method_, go);
@@ -154,6 +167,7 @@ class GlFrame {
       a->globalK = deviceGlobalK;
       MFR_TRY(readDeviceMaps());
     }
+    if (!g.held.empty()) a->capacity = g.held;  // linked lists: k(p), the nodes each list got
     fillStats(g, a.value(), interlock);
     out_.image = std::move(g.image);
     out_.kMap = a->reservedK.empty() ? std::move(a->capacity) : std::move(a->reservedK);
@@ -296,9 +310,10 @@ class GlFrame {
     // stores hold min(n(p), k(p)) of the n(p) the capture counted
     const bool counted = plan_.count || plan_.oracle || plan_.predictedCurves;
     static const std::vector<uint32_t> none;
-    fillSharedStats(SharedMeasures{method_, memory_, a, counted ? g.counts : none, none, g.counts,
-                                   g.fragments, options_.budgetBytes},
-                    s);
+    fillSharedStats(
+        SharedMeasures{method_, memory_, a, counted ? g.counts : none, g.held,
+                       g.held.empty() ? g.counts : none, g.fragments, options_.budgetBytes},
+        s);
     s.bytesAllocatedByCategory = g.bufferBytes;
     s.bytesAllocated = g.totalBufferBytes();
     s.culledOccupancy = g.culledOccupancy;

@@ -34,6 +34,11 @@ constexpr GlTechniqueInfo kTechniques[] = {
      "aoit_visibility.frag, aoit_color.frag", "aoit_resolve.comp",
      "nodes and colour sum 44 B (4 nodes), 76 B (8), 140 B (16) + lock 4 B",
      "aoit4, aoit8, aoit16"},
+    {GlTechnique::LinkedList, "linked-list",
+     "[count (no budget)] -> capture (pool counter atomicAdd, head atomicExchange; full pool: "
+     "lost or hybrid tail) -> resolve (walk, selection sort in place, kbuffer or hybrid)",
+     "capture_list.frag", "resolve_list.comp",
+     "head 4 B [+ tail 20 B]; per image: pool counter 4 B + F(M) nodes of 12 B", "linked-list"},
 };
 
 constexpr bool rowsInEnumOrder() {
@@ -54,6 +59,7 @@ bool kBufferStore(const MethodDesc& m) {
     case StoreChoice::Append:
     case StoreChoice::MultiLayer:
     case StoreChoice::None:
+    case StoreChoice::LinkedList:
       return false;
   }
   return false;
@@ -69,6 +75,7 @@ bool kBufferAllocation(AllocationPolicy a) {
       return true;
     case AllocationPolicy::Unbounded:
     case AllocationPolicy::NoNodes:
+    case AllocationPolicy::Pool:
       return false;
   }
   return false;
@@ -82,6 +89,9 @@ std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
       if (m.allocation == AllocationPolicy::Unbounded && m.store == StoreChoice::Append &&
           m.compositing == Compositing::KBuffer && m.occupancyWords == 0)
         return GlTechnique::ABuffer;
+      if (m.allocation == AllocationPolicy::Pool && m.store == StoreChoice::LinkedList &&
+          m.occupancyWords == 0)
+        return GlTechnique::LinkedList;
       if (kBufferAllocation(m.allocation) && kBufferStore(m)) return GlTechnique::KBuffer;
       return std::nullopt;
     case Compositing::WeightedBlended:
@@ -131,7 +141,7 @@ Result<GlTechnique> classifyGl(const MethodDesc& method) {
     return makeError("--engine gl: method " + method.name +
                      " is not in the GL engine (it runs the A-buffer; the k-buffer family with a "
                      "fixed k or a per-pixel k(p), max-array or max-heap stores, occupancy culling "
-                     "and kbuffer or hybrid compositing; wboit; mboit; mlab; aoit)");
+                     "and kbuffer or hybrid compositing; wboit; mboit; mlab; aoit; linked-list)");
   return *t;
 }
 

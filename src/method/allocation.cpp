@@ -16,7 +16,9 @@
 //   covered pixel k(p) = 0: it is composited from its order-independent tail alone, so their
 //   budget floor is the per-pixel words; allowsTailOnlyPixels, issue 28)
 //   unbounded     k(p) = n(p) (A-buffer / S-buffer);
-//   no nodes      k(p) = 0 (wboit, mboit: per-pixel accumulators only; the budget must cover them).
+//   no nodes      k(p) = 0 (wboit, mboit: per-pixel accumulators only; the budget must cover them);
+//   pool          one pool of F(M) nodes for every pixel, first come first served (linked lists,
+//                 Yang et al. 2010; without a budget every fragment, sum n(p)).
 // Node bytes are the memory model's S_f (8, or 20 for mlab's nodes).
 // Offsets are an exclusive prefix sum of k(p) in tile-major order (the S-buffer's clustering of
 // pixels by tiles, for locality).
@@ -50,6 +52,7 @@ StoreKind pickStore(StoreChoice choice, uint32_t n, uint32_t k) {
       return (n > k && k > 16) ? StoreKind::MaxHeap : StoreKind::MaxArray;
     case StoreChoice::MultiLayer:  // MLAB's own store (peer_methods.cpp); the kind is unused
     case StoreChoice::None:
+    case StoreChoice::LinkedList:
       return StoreKind::MaxArray;
   }
   return StoreKind::MaxArray;
@@ -110,6 +113,7 @@ bool allowsTailOnlyPixels(const MethodDesc& method) {
     case AllocationPolicy::Unbounded:
     case AllocationPolicy::FixedK:
     case AllocationPolicy::NoNodes:
+    case AllocationPolicy::Pool:
       return false;
   }
   return false;
@@ -400,6 +404,23 @@ Result<void> allocateOptimal(const AllocationInputs& in, const std::vector<uint3
   return {};
 }
 
+// pool (linked lists): F(M) nodes shared by all pixels, or every fragment without a budget; no
+// per-pixel region (k(p) is what the capture links, offsets unused); the next index is 32-bit
+// with 0xFFFFFFFF ending a list
+Result<void> allocatePool(const AllocationInputs& in, Allocation& a) {
+  constexpr uint64_t kMaxPool = 0xFFFFFFFEull;
+  if (in.budget) {
+    a.slots = std::min(in.slotsInBudget, kMaxPool);
+    return {};
+  }
+  a.slots = cappedSum(in.n, UINT32_MAX);
+  if (a.slots > kMaxPool)
+    return makeError(in.method.name + ": " + std::to_string(a.slots) +
+                     " fragments exceed the linked list's 32-bit node index at " +
+                     sizeText(in.frame) + " (give a budget)");
+  return {};
+}
+
 // exclusive prefix sum of the capacities in tile-major order (row-major: one tile as wide and
 // high as the frame)
 void tileMajorOffsets(const PixelLayout& frame, Allocation& a) {
@@ -461,6 +482,11 @@ Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
     case AllocationPolicy::Optimal:
       MFR_TRY(allocateOptimal(in, oracleK, a));
       break;
+    case AllocationPolicy::Pool:
+      MFR_TRY(allocatePool(in, a));
+      a.reservedSlots = a.slots;
+      a.offsets.assign(pixels, 0);
+      return a;
   }
   if (a.reservedK.empty()) a.reservedSlots = a.slots;
 

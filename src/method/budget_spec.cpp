@@ -27,6 +27,8 @@ uint64_t nodesNeeded(const MethodDesc& method, const FrameCounts& counts) {
   switch (method.allocation) {
     case AllocationPolicy::NoNodes:
       return 0;
+    case AllocationPolicy::Pool:  // a pool of one node: the rest is dropped or tailed
+      return 1;
     case AllocationPolicy::Unbounded:
       return counts.fragments;
     case AllocationPolicy::FixedK:

@@ -25,12 +25,20 @@ MemoryModel MemoryModel::of(const MethodDesc& method, bool fragmentParallel) {
   });
   if (noNodes) m.node = 0;
   m.image = method.allocation == AllocationPolicy::DynamicK ? kHistogramBins * 4 : 0;
+  if (method.allocation == AllocationPolicy::Pool) {  // linked lists: lock-free (atomics)
+    m.counter = 0;
+    m.offset = 0;
+    m.head = 4;
+    m.poolCounter = 4;
+    m.lock = method.perPixelLock ? 4 : 0;
+    m.node = kLinkedNodeBytes;
+  }
   return m;
 }
 
 std::map<std::string, uint64_t> MemoryModel::breakdown(uint64_t pixels, uint64_t slots) const {
   std::map<std::string, uint64_t> bytes;
-  if (slots || counter) bytes["nodes"] = slots * node;
+  if (slots || counter || head) bytes["nodes"] = slots * node;
   if (counter) bytes["counters"] = pixels * counter;
   if (offset) bytes["offsets"] = pixels * offset;
   if (lock) bytes["locks"] = pixels * lock;
@@ -39,6 +47,8 @@ std::map<std::string, uint64_t> MemoryModel::breakdown(uint64_t pixels, uint64_t
   if (previous) bytes["previous_frame"] = pixels * previous;
   if (accum) bytes["accumulators"] = pixels * accum;
   if (image) bytes["histogram"] = image;
+  if (head) bytes["heads"] = pixels * head;
+  if (poolCounter) bytes["pool_counter"] = poolCounter;
   return bytes;
 }
 

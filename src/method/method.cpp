@@ -139,6 +139,16 @@ const std::vector<PresetRow>& presetRows() {
     PeerMethods::forEach([&]<class Peer>() {
       rows.push_back({Peer::preset(), configurePeerPreset<Peer>});
     });
+    // per-pixel linked lists (mfr/method/linked_list.hpp): a pool allocation + the linked-list
+    // store
+    rows.push_back(
+        {{"linked-list", "per-pixel linked lists (Yang, Hensley, Gruen, Thibieroz, EGSR 2010)",
+          "head pointer per pixel + one pool of F(M) 12 B nodes; a full pool drops (or tails) "
+          "the later fragments in primitive order"},
+         [](MethodDesc& m) {
+           m.allocation = AllocationPolicy::Pool;
+           m.store = StoreChoice::LinkedList;
+         }});
     return rows;
   }();
   return table;
@@ -184,7 +194,7 @@ Result<MethodDesc> methodPreset(const std::string& fullName) {
   if (occupancy) {
     if (!kBufferFamilyRule(m.compositing))
       return makeError("method '" + fullName + "': occupancy culling applies to k-buffers only");
-    if (m.allocation == AllocationPolicy::Unbounded)
+    if (m.allocation == AllocationPolicy::Unbounded || m.allocation == AllocationPolicy::Pool)
       return makeError("method '" + fullName + "': occupancy culling needs a bounded k");
     m.occupancyWords = 1;
   }
@@ -218,6 +228,8 @@ const char* toString(AllocationPolicy a) {
       return "optimal";
     case AllocationPolicy::NoNodes:
       return "no-nodes";
+    case AllocationPolicy::Pool:
+      return "pool";
   }
   return "?";
 }
@@ -235,6 +247,8 @@ const char* toString(StoreChoice s) {
       return "multi-layer";
     case StoreChoice::None:
       return "none";
+    case StoreChoice::LinkedList:
+      return "linked-list";
   }
   return "?";
 }

@@ -14,6 +14,7 @@ bool takesK(const MethodDesc& m) {
     case AllocationPolicy::Importance:
     case AllocationPolicy::Optimal:
     case AllocationPolicy::NoNodes:
+    case AllocationPolicy::Pool:
       return false;
   }
   return false;

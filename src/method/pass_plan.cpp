@@ -31,6 +31,12 @@ Result<void> checkComposition(const MethodDesc& m) {
       (m.store == StoreChoice::MultiLayer && m.allocation != AllocationPolicy::FixedK))
     return makeError(m.name + ": the multi-layer store goes with fixed k and " +
                      "multi-layer-alpha compositing, and only them");
+  if ((m.store == StoreChoice::LinkedList) != (m.allocation == AllocationPolicy::Pool) ||
+      (m.store == StoreChoice::LinkedList && !kBufferFamilyRule(m.compositing)))
+    return makeError(m.name + ": the linked-list store goes with the pool allocation and " +
+                     "kbuffer or hybrid compositing, and only them");
+  if (m.allocation == AllocationPolicy::Pool && m.occupancyWords > 0)
+    return makeError(m.name + ": occupancy culling needs a bounded k");
   if (!kBufferFamilyRule(m.compositing) && m.occupancyWords > 0)
     return makeError(m.name + ": occupancy culling applies to k-buffers only");
   return {};

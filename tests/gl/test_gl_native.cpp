@@ -106,6 +106,16 @@ TEST_P(GlNative, AgreesWithTheCpuEngineOnEveryPreset) {
                                       static_cast<double>(r->stats.bytesUsed));
         EXPECT_LE(apart, 1e-3 * static_cast<double>(r->stats.bytesUsed));
       }
+      // linked lists: once the pool overflows, GL's atomic counter admits fragments in its own
+      // arrival order and the CPU engine in primitive order (by design, docs/METHODS.md): a full
+      // pool on both, images not compared
+      if (method.allocation == AllocationPolicy::Pool && r->stats.lost > 0) {
+        EXPECT_EQ(g->stats.captured, g->stats.fragmentSlots);
+        EXPECT_EQ(r->stats.captured, r->stats.fragmentSlots);
+        EXPECT_EQ(g->stats.lost, g->stats.fragmentsGenerated - g->stats.captured);
+        ++checked;
+        continue;
+      }
       auto flip = computeFlip(encodeSrgb(r->image), encodeSrgb(g->image));
       ASSERT_TRUE(flip.ok()) << flip.error().message;
       EXPECT_LE(flip->mean, 2e-3);

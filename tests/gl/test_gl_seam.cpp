@@ -134,7 +134,11 @@ INSTANTIATE_TEST_SUITE_P(
         SeamCase{"procedural:hairball?strands=150", "mboit-trig4", Compositing::MomentBasedTrig4,
                  600u << 10},
         SeamCase{"procedural:layers", "mlab", Compositing::MultiLayerAlpha, 600u << 10},
-        SeamCase{"procedural:bottles?count=4", "mlab", Compositing::MultiLayerAlpha, 300u << 10}),
+        SeamCase{"procedural:bottles?count=4", "mlab", Compositing::MultiLayerAlpha, 300u << 10},
+        // linked lists with a pool that holds every fragment: the same sorted lists (the atomic
+        // counter's node order is GL's own, the resolve sorts); overflow: test_gl_linked_list.cpp
+        SeamCase{"procedural:hairball?strands=150", "linked-list", Compositing::KBuffer, 4u << 20},
+        SeamCase{"procedural:bottles?count=4", "linked-list", Compositing::Hybrid, 4u << 20}),
     [](const auto& info) {
       std::string name = std::string(info.param.method) + "_" +
                          std::string(toString(info.param.compositing)) + "_" +

@@ -22,7 +22,7 @@ GlTechnique expectedTechnique(const std::string& preset) {
       {"mboit8", GlTechnique::Mboit},      {"mlab", GlTechnique::Mlab},
       {"mboit-trig3", GlTechnique::Mboit}, {"mboit-trig4", GlTechnique::Mboit},
       {"aoit4", GlTechnique::Aoit},        {"aoit8", GlTechnique::Aoit},
-      {"aoit16", GlTechnique::Aoit}};
+      {"aoit16", GlTechnique::Aoit},       {"linked-list", GlTechnique::LinkedList}};
   const auto it = peers.find(preset);
   return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
 }
@@ -42,7 +42,7 @@ TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
     EXPECT_EQ(*tc, GlTechnique::KBuffer) << name << "+occupancy";
     ++occupancyForms;
   }
-  EXPECT_EQ(presets, 24);  // 13 of the k-buffer family, the A-buffer, 10 peer methods
+  EXPECT_EQ(presets, 25);  // 13 of the k-buffer family, the A-buffer, linked-list, 10 peers
   EXPECT_EQ(occupancyForms, 13);
 }
 
@@ -60,7 +60,7 @@ TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
 
 TEST(GlTechnique, TableRowsFollowTheEnum) {
   const auto rows = glTechniques();
-  ASSERT_EQ(rows.size(), 6u);
+  ASSERT_EQ(rows.size(), 7u);
   for (size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(static_cast<size_t>(rows[i].technique), i);
     EXPECT_EQ(&techniqueInfo(rows[i].technique), &rows[i]);
@@ -88,6 +88,9 @@ TEST(GlTechnique, CombinationsOutsideTheGlEngineAreOneLineErrors) {
   m = methodPreset("abuffer").value();
   m.occupancyWords = 2;
   expectRefused(m, "abuffer-occupancy");
+  m = methodPreset("linked-list").value();
+  m.occupancyWords = 1;
+  expectRefused(m, "linked-list-occupancy");
   m = methodPreset("abuffer").value();
   m.compositing = Compositing::Hybrid;
   expectRefused(m, "abuffer-hybrid");

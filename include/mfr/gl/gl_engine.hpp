@@ -48,6 +48,8 @@ struct GlRenderOptions {
   // the allocation the compute shaders left in the engine's buffers (countOnDevice, then
   // allocateCapped or allocateByImportance) and its n(p), instead of `allocation` and `counts`
   bool deviceAllocation = false;
+  // linked lists: the pool's nodes (F(M), or every fragment without a budget)
+  uint64_t poolNodes = 0;
 };
 
 /// What the host reads back of a variable-k allocation computed on the GPU: two totals.
@@ -71,6 +73,7 @@ struct GlRenderOutput {
   uint64_t culledKPlus = 0;        // k-buffers: rejected by the k+ test (depends on arrival order)
   bool atomic64 = false;           // the fixed-k capture took 64-bit atomicMin (no lock)
   std::vector<GlPassTime> passes;  // count, prefix sum, capture, resolve (timed run)
+  std::vector<uint32_t> held;      // linked lists: the nodes each pixel's list holds
 };
 
 /// How the geometry passes make fragments (--gl-raster).

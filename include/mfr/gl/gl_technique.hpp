@@ -28,6 +28,7 @@ enum class GlTechnique : uint8_t {
   Mboit,    // moment-based OIT: moments pass, colour pass, reconstruction resolve
   Mlab,     // multi-layer alpha blending: merge capture of k nodes, front-to-back resolve
   Aoit,     // adaptive transparency: visibility pass (N nodes), colour pass, composite
+  LinkedList,  // per-pixel linked lists: pool counter + head exchange capture, walk-sort resolve
 };
 
 /// One row of the technique table.

@@ -83,6 +83,12 @@ MFR_GL_CONST(uint, kBindDkbAcc, 0u)
 MFR_GL_CONST(uint, kBindDkbWeights, 1u)
 MFR_GL_CONST(uint, kBindDkbImportance, 2u)
 MFR_GL_CONST(uint, kBindImage2, 4u)  // mlab resolve output (kBindImage is mlab's fill counts)
+// per-pixel linked lists (mfr::LinkedNode): a node is depth bits, RGBA8, next index; a head word
+// per pixel (kListEnd: empty); the pool counter; in the resolve, each list's length per pixel
+MFR_GL_CONST(uint, kListNodeWords, 3u)
+MFR_GL_CONST(uint, kListEnd, 0xffffffffu)  // mfr::kListEnd
+MFR_GL_CONST(uint, kBindListHeads, 0u)     // heads (capture and resolve)
+MFR_GL_CONST(uint, kBindListLengths, 1u)   // resolve: the nodes each list holds
 
 // variable-k allocation in compute shaders (alloc_histogram.comp, importance.comp,
 // importance_total.comp, alloc_k.comp, alloc_pack.comp)
@@ -167,6 +173,9 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //   raster_common.glsl: kBindMaterials kBindColorTables kBindTexels kBindCounts(image)
 //   raster_native.glsl: kBindTriMaterial
 //   raster.geom: kBindTriMaterial kBindMaterials
+//   capture_list.frag: kBindListHeads kBindNodes kBindFill kBindTails
+//   resolve_list.comp: kBindListHeads kBindListLengths kBindNodes kBindImage kBindColorTables
+//       kBindResolveTails
 // (end of the bindings per shader file)
 
 #ifdef __cplusplus

@@ -55,6 +55,7 @@
 namespace mfr {
 
 inline constexpr uint64_t kNodeBytes = 8;
+inline constexpr uint64_t kLinkedNodeBytes = 12;  // depth bits, RGBA8, next index
 inline constexpr uint64_t kHistogramBins = 1024;
 
 /// Bytes per pixel of an occupancy map of `words` 32-bit bucket words: near and far depth and the
@@ -63,8 +64,16 @@ inline constexpr uint64_t occupancyBytesPerPixel(int words) {
   return 12 + 4 * static_cast<uint64_t>(words);
 }
 
+// The linked list (linked-list, linked_list.hpp; Yang et al. 2010): no counter, a head word per
+// pixel (the index of the pixel's newest node), one 4-byte pool counter per image and a pool of
+// 12-byte nodes (depth bits, RGBA8, next index):
+//   M = |P| * (4 [+ 20 hybrid tail]) + 4 + 12 * F(M),  F(M) = floor((M - |P| S_p - 4) / 12)
+//     heads: | h(0) | h(1) | ... | h(P-1) |    h(p) = newest node of p, or 0xFFFFFFFF (empty)
+//     pool:  | depth rgba next | depth rgba next | ... |   F(M) nodes, handed out by the counter
 struct MemoryModel {
   uint64_t counter = 4, offset = 0, lock = 0, occupancy = 0, tail = 0, previous = 0;  // per pixel
+  uint64_t head = 0;           // per pixel: the linked list's head word
+  uint64_t poolCounter = 0;    // per image: the linked list's node counter
   uint64_t accum = 0;          // per pixel: wboit / mboit accumulators
   uint64_t image = 0;          // bytes per image
   uint64_t node = kNodeBytes;  // S_f: bytes of one node (mlab: 20; wboit, mboit: 0, no nodes)
@@ -74,9 +83,9 @@ struct MemoryModel {
   /// atomic insertion), and it is charged.
   static MemoryModel of(const MethodDesc& method, bool fragmentParallel = false);
   uint64_t perPixel() const {
-    return counter + offset + lock + occupancy + tail + previous + accum;
+    return counter + offset + lock + occupancy + tail + previous + accum + head;
   }
-  uint64_t overhead(uint64_t pixels) const { return pixels * perPixel() + image; }
+  uint64_t overhead(uint64_t pixels) const { return pixels * perPixel() + image + poolCounter; }
   /// F(M): fragment slots a budget buys (0 when the overhead alone exceeds it, or without nodes).
   uint64_t fragmentSlots(uint64_t budget, uint64_t pixels) const {
     const uint64_t fixed = overhead(pixels);

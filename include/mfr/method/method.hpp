@@ -27,6 +27,8 @@ enum class AllocationPolicy : uint8_t {
   Importance,  // k(p) = floor(P(p) F(M)) from an importance map (variable / deep k-buffer)
   Optimal,     // offline oracle: k(p) minimising the hybrid error from an exact A-buffer pre-pass
   NoNodes,     // no fragment nodes: per-pixel accumulators only (wboit, mboit)
+  Pool,        // one node pool of F(M) 12-byte nodes shared by all pixels, first come first
+               // served in primitive order (per-pixel linked lists, linked_list.hpp)
 };
 
 /// The store of one pixel, as the allocation picked it from the StoreChoice.
@@ -40,6 +42,7 @@ enum class StoreChoice : uint8_t {
   PerPixel,    // K+B-SB rule: max-heap when n(p) > k(p) and k(p) > 16, else max-array
   MultiLayer,  // MLAB's blended nodes: depth-ordered insertion, two farthest merged when full
   None,        // no nodes (NoNodes allocation)
+  LinkedList,  // per-pixel linked lists: a head word per pixel, nodes from the Pool allocation
 };
 
 enum class CullingTest : uint8_t {
