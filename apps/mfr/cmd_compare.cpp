@@ -34,7 +34,7 @@ struct CompareArgs {
   std::string budgets;
   std::string methods =
       "fkb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,optimal,wboit,mboit,mboit6,mboit8,mboit-trig3,"
-      "mboit-trig4,mlab";
+      "mboit-trig4,mboit-q16,mboit6-q16,mboit8-q16,mboit-trig3-q16,mboit-trig4-q16,mlab";
   std::string model;
   std::string out;
   std::string composite;  // empty: each preset's own rule

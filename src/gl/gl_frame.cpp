@@ -45,8 +45,12 @@ bool fragmentNodes(GlTechnique t) {
 }
 
 // the moment technique's floats per pixel: b0, N moments, four accumulators (shared_layout.h)
+uint32_t mboitMomentWords(const MethodDesc& m) {
+  const auto n = static_cast<uint32_t>(mboitMomentCount(m.compositing));
+  return mboitQuantized(m.compositing) ? n / 2 : n;  // 16-bit codes: two per word
+}
 uint32_t mboitWords(const MethodDesc& m) {
-  return kMboitWordsBase + static_cast<uint32_t>(mboitMomentCount(m.compositing));
+  return kMboitWordsBase + mboitMomentWords(m);
 }
 
 // bytes per pixel of the frame's largest per-pixel buffer (each must fit one storage block)
@@ -169,6 +173,9 @@ struct GlEngine::State::FrameRun {
                             static_cast<GLuint>(mboitMomentCount(plan.method.compositing)));
         glProgramUniform1ui(program, loc(program, "uTrigonometric"),
                             mboitTrigonometric(plan.method.compositing) ? 1u : 0u);
+        glProgramUniform1ui(program, loc(program, "uQuantized"),
+                            mboitQuantized(plan.method.compositing) ? 1u : 0u);
+        glProgramUniform1ui(program, loc(program, "uMomentWords"), mboitMomentWords(plan.method));
       }
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       fb.bindImage(locks, kBindLocks);
@@ -355,8 +362,7 @@ struct GlEngine::State::FrameRun {
       const GLuint p = s.program(program);
       useResolve(p);
       if (program == ProgramId::MboitResolve)
-        glProgramUniform1ui(p, loc(p, "uMomentCount"),
-                            static_cast<GLuint>(mboitMomentCount(plan.method.compositing)));
+        glProgramUniform1ui(p, loc(p, "uMomentWords"), mboitMomentWords(plan.method));
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
       dispatchPixels();

@@ -47,7 +47,8 @@ struct PeerList {
   }
 };
 using PeerMethods = PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Method, MboitTrig3Method,
-                             MboitTrig4Method, MlabMethod>;
+                             MboitTrig4Method, Mboit16Method, Mboit6_16Method, Mboit8_16Method,
+                             MboitTrig3_16Method, MboitTrig4_16Method, MlabMethod>;
 
 /// Calls `f.template operator()<Peer>()` with the peer type of `rule`; false (and no call) for
 /// the k-buffer family's rules.
