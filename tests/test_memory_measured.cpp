@@ -38,16 +38,21 @@ std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const 
   std::map<std::string, uint64_t> b;
   if (m.allocation == AllocationPolicy::NoNodes) {  // wboit, mboit*: accumulators, no nodes
     // documented: wboit 20 B, mboit 36 B, mboit6 and mboit-trig3 44 B, mboit8 and mboit-trig4
-    // 52 B, aoit4 44 B, aoit8 76 B, aoit16 140 B per pixel
-    const uint64_t perPixel = m.compositing == Compositing::WeightedBlended    ? 20
-                              : m.compositing == Compositing::MomentBased6     ? 44
-                              : m.compositing == Compositing::MomentBased8     ? 52
-                              : m.compositing == Compositing::MomentBasedTrig3 ? 44
-                              : m.compositing == Compositing::MomentBasedTrig4 ? 52
-                              : m.compositing == Compositing::Adaptive4        ? 44
-                              : m.compositing == Compositing::Adaptive8        ? 76
-                              : m.compositing == Compositing::Adaptive16       ? 140
-                                                                               : 36;
+    // 52 B, aoit4 44 B, aoit8 76 B, aoit16 140 B per pixel; the 16-bit moment forms 28, 32, 36 B
+    const uint64_t perPixel = m.compositing == Compositing::WeightedBlended       ? 20
+                              : m.compositing == Compositing::MomentBased6        ? 44
+                              : m.compositing == Compositing::MomentBased8        ? 52
+                              : m.compositing == Compositing::MomentBasedTrig3    ? 44
+                              : m.compositing == Compositing::MomentBasedTrig4    ? 52
+                              : m.compositing == Compositing::MomentBased16       ? 28
+                              : m.compositing == Compositing::MomentBased6_16     ? 32
+                              : m.compositing == Compositing::MomentBased8_16     ? 36
+                              : m.compositing == Compositing::MomentBasedTrig3_16 ? 32
+                              : m.compositing == Compositing::MomentBasedTrig4_16 ? 36
+                              : m.compositing == Compositing::Adaptive4           ? 44
+                              : m.compositing == Compositing::Adaptive8           ? 76
+                              : m.compositing == Compositing::Adaptive16          ? 140
+                                                                                  : 36;
     b["accumulators"] = perPixel * pixels;
     b["counters"] = 4 * pixels;  // the CPU engine's count of accumulated fragments
     b["k"] = 4 * pixels;

@@ -110,7 +110,8 @@ _compare = _named_type_errors(_mfr._compare)
 #: The methods `mfr compare` runs when --methods is not given.
 DEFAULT_COMPARE_METHODS = ("fkb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "dkb-fill", "optimal",
                            "wboit", "mboit", "mboit6", "mboit8", "mboit-trig3", "mboit-trig4",
-                           "mlab", "aoit4", "aoit8", "aoit16", "linked-list")
+                           "mboit-q16", "mboit6-q16", "mboit8-q16", "mboit-trig3-q16",
+                           "mboit-trig4-q16", "mlab", "aoit4", "aoit8", "aoit16", "linked-list")
 
 
 def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1024, camera=None,

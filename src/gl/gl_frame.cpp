@@ -50,8 +50,12 @@ bool fragmentNodes(GlTechnique t) {
 }
 
 // the moment technique's floats per pixel: b0, N moments, four accumulators (shared_layout.h)
+uint32_t mboitMomentWords(const MethodDesc& m) {
+  const auto n = static_cast<uint32_t>(mboitMomentCount(m.compositing));
+  return mboitQuantized(m.compositing) ? n / 2 : n;  // 16-bit codes: two per word
+}
 uint32_t mboitWords(const MethodDesc& m) {
-  return kMboitWordsBase + static_cast<uint32_t>(mboitMomentCount(m.compositing));
+  return kMboitWordsBase + mboitMomentWords(m);
 }
 
 // the AOIT technique's floats per pixel: N nodes of (depth, transmittance), the colour sum
@@ -195,6 +199,9 @@ struct GlEngine::State::FrameRun {
                             static_cast<GLuint>(mboitMomentCount(plan.method.compositing)));
         glProgramUniform1ui(program, loc(program, "uTrigonometric"),
                             mboitTrigonometric(plan.method.compositing) ? 1u : 0u);
+        glProgramUniform1ui(program, loc(program, "uQuantized"),
+                            mboitQuantized(plan.method.compositing) ? 1u : 0u);
+        glProgramUniform1ui(program, loc(program, "uMomentWords"), mboitMomentWords(plan.method));
       }
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       fb.bindImage(locks, kBindLocks);
@@ -455,8 +462,7 @@ struct GlEngine::State::FrameRun {
       const GLuint p = s.program(program);
       useResolve(p);
       if (program == ProgramId::MboitResolve)
-        glProgramUniform1ui(p, loc(p, "uMomentCount"),
-                            static_cast<GLuint>(mboitMomentCount(plan.method.compositing)));
+        glProgramUniform1ui(p, loc(p, "uMomentWords"), mboitMomentWords(plan.method));
       if (program == ProgramId::AoitResolve)
         glProgramUniform1ui(p, loc(p, "uNodeCount"),
                             static_cast<GLuint>(aoitNodeCount(plan.method.compositing)));

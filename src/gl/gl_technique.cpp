@@ -25,8 +25,9 @@ constexpr GlTechniqueInfo kTechniques[] = {
     {GlTechnique::Mboit, "mboit",
      "moments (accumulate) -> capture (colour, reconstructed transmittance) -> resolve",
      "mboit_moments.frag, mboit_color.frag", "mboit_resolve.comp",
-     "accumulators 36 B (4 moments), 44 B (6 power or 3 trigonometric), 52 B (8 or 4) + lock 4 B",
-     "mboit, mboit6, mboit8, mboit-trig3, mboit-trig4"},
+     "accumulators 36 B (4 moments), 44 B (6 power or 3 trigonometric), 52 B (8 or 4); 16-bit "
+     "moments: 28, 32, 36 B + lock 4 B",
+     "mboit, mboit6, mboit8, mboit-trig3, mboit-trig4 and their -q16 forms"},
     {GlTechnique::Mlab, "mlab", "capture (insert, merge the two farthest when full) -> resolve",
      "mlab.frag", "mlab_resolve.comp", "k nodes of 20 B + node count 4 B + lock 4 B", "mlab"},
     {GlTechnique::Aoit, "aoit",
@@ -100,6 +101,11 @@ std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
     case Compositing::MomentBased8:
     case Compositing::MomentBasedTrig3:
     case Compositing::MomentBasedTrig4:
+    case Compositing::MomentBased16:
+    case Compositing::MomentBased6_16:
+    case Compositing::MomentBased8_16:
+    case Compositing::MomentBasedTrig3_16:
+    case Compositing::MomentBasedTrig4_16:
       if (m.allocation != AllocationPolicy::NoNodes || m.store != StoreChoice::None ||
           m.occupancyWords != 0)
         return std::nullopt;

@@ -271,6 +271,12 @@ Sameness expectedSameness(const Config& c) {
     case Compositing::Adaptive4:
     case Compositing::Adaptive8:
     case Compositing::Adaptive16:
+    // the 16-bit moments are re-rounded per fragment: the order decides the codes
+    case Compositing::MomentBased16:
+    case Compositing::MomentBased6_16:
+    case Compositing::MomentBased8_16:
+    case Compositing::MomentBasedTrig3_16:
+    case Compositing::MomentBasedTrig4_16:
       return Sameness::OrderDependent;
     default:
       return Sameness::RoundingOnly;
@@ -312,8 +318,10 @@ void expectSameOutput(const Config& c, const RenderOutput& a, const RenderOutput
     const float worst = largestDifference(a.image, b.image);
     std::fprintf(stderr, "  summation-order difference %g\n", worst);
     // every moment-based rule (mboit, mboit6, mboit8) reconstructs from its moments
-    const float tolerance =
-        mboitMomentCount(c.method.compositing) != 0 ? kMomentRoundingTolerance : kRoundingTolerance;
+    // (the trigonometric ones more: measured 2.5e-2 under a shuffled draw order, test_peer_methods)
+    const float tolerance = mboitTrigonometric(c.method.compositing)      ? 5e-2f
+                            : mboitMomentCount(c.method.compositing) != 0 ? kMomentRoundingTolerance
+                                                                          : kRoundingTolerance;
     EXPECT_LE(worst, tolerance) << c.describe << ": differs beyond float rounding";
   }
 }

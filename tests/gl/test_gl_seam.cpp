@@ -133,6 +133,8 @@ INSTANTIATE_TEST_SUITE_P(
         SeamCase{"procedural:hairball?strands=150", "mboit", Compositing::MomentBased, 600u << 10},
         SeamCase{"procedural:hairball?strands=150", "mboit-trig4", Compositing::MomentBasedTrig4,
                  600u << 10},
+        SeamCase{"procedural:bottles?count=4", "mboit6-q16", Compositing::MomentBased6_16,
+                 600u << 10},
         SeamCase{"procedural:layers", "mlab", Compositing::MultiLayerAlpha, 600u << 10},
         SeamCase{"procedural:bottles?count=4", "mlab", Compositing::MultiLayerAlpha, 300u << 10},
         // linked lists with a pool that holds every fragment: the same sorted lists (the atomic

@@ -17,12 +17,23 @@ using namespace mfr::gl;
 // what each preset is, written from the papers rather than from classifyGl's rules
 GlTechnique expectedTechnique(const std::string& preset) {
   static const std::map<std::string, GlTechnique> peers = {
-      {"abuffer", GlTechnique::ABuffer},   {"wboit", GlTechnique::Wboit},
-      {"mboit", GlTechnique::Mboit},       {"mboit6", GlTechnique::Mboit},
-      {"mboit8", GlTechnique::Mboit},      {"mlab", GlTechnique::Mlab},
-      {"mboit-trig3", GlTechnique::Mboit}, {"mboit-trig4", GlTechnique::Mboit},
-      {"aoit4", GlTechnique::Aoit},        {"aoit8", GlTechnique::Aoit},
-      {"aoit16", GlTechnique::Aoit},       {"linked-list", GlTechnique::LinkedList}};
+      {"abuffer", GlTechnique::ABuffer},
+      {"wboit", GlTechnique::Wboit},
+      {"mboit", GlTechnique::Mboit},
+      {"mboit6", GlTechnique::Mboit},
+      {"mboit8", GlTechnique::Mboit},
+      {"mlab", GlTechnique::Mlab},
+      {"mboit-trig3", GlTechnique::Mboit},
+      {"mboit-trig4", GlTechnique::Mboit},
+      {"mboit-q16", GlTechnique::Mboit},
+      {"mboit6-q16", GlTechnique::Mboit},
+      {"mboit8-q16", GlTechnique::Mboit},
+      {"mboit-trig3-q16", GlTechnique::Mboit},
+      {"mboit-trig4-q16", GlTechnique::Mboit},
+      {"aoit4", GlTechnique::Aoit},
+      {"aoit8", GlTechnique::Aoit},
+      {"aoit16", GlTechnique::Aoit},
+      {"linked-list", GlTechnique::LinkedList}};
   const auto it = peers.find(preset);
   return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
 }
@@ -42,7 +53,7 @@ TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
     EXPECT_EQ(*tc, GlTechnique::KBuffer) << name << "+occupancy";
     ++occupancyForms;
   }
-  EXPECT_EQ(presets, 25);  // 13 of the k-buffer family, the A-buffer, linked-list, 10 peers
+  EXPECT_EQ(presets, 30);  // 13 of the k-buffer family, the A-buffer, linked-list, 15 peers
   EXPECT_EQ(occupancyForms, 13);
 }
 

@@ -67,7 +67,8 @@ MFR_GL_CONST(uint, kBindNearest, 0u)
 MFR_GL_CONST(uint, kWboitWords, 5u)
 MFR_GL_CONST(uint, kBindAccum, 2u)
 // moment-based OIT: per pixel b0, b1..bN, then sum T a c (r, g, b), sum T a (mfr::MboitPixel,
-// mfr::PowerMomentPixel): kMboitWords with N = 4, kMboitWordsBase + N for N = 6, 8
+// mfr::PowerMomentPixel, mfr::TrigMomentPixel): kMboitWords with N = 4, kMboitWordsBase + N for
+// N = 6, 8; with 16-bit moments (mfr::QuantizedMomentPixel) kMboitWordsBase + N / 2
 MFR_GL_CONST(uint, kMboitWords, 9u)
 MFR_GL_CONST(uint, kMboitWordsBase, 5u)
 // adaptive transparency: per pixel N nodes of (depth, transmittance), then sum vis a c (r, g, b)

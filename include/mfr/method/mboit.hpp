@@ -32,6 +32,11 @@
 // TrigonometricMomentMath (method_math.h's mboitAddTrigMoments and mboitTransmittanceTrig; roots
 // by Weierstrass' iteration in double); bias 8e-7 and 1.5e-6 (the supplementary's float32 rows).
 // Storage 44 and 52 B per pixel, as mboit6 and mboit8.
+// The -q16 forms (mboit-q16, mboit6-q16, mboit8-q16, mboit-trig3-q16, mboit-trig4-q16): the
+// paper's 16-bit storage of those moment sets, b0 in float32 and the normalised moments as 16-bit
+// unorm codes in the authors' storage basis, updated read-modify-write per fragment
+// (method_math.h's mboitAddQuantizedMoments, mboitDequantizeMoments); the 16-bit biases of the
+// supplementary (6e-5, 6e-4, 2.5e-3; 6.5e-4, 8.5e-4). Storage 28, 32 and 36 B per pixel.
 // The 4-moment constants were checked against the same sources: bias 5e-7 and the target
 // (0, 0.375, 0, 0.375) are the supplementary's and the authors' code's; overestimation 0.25 is
 // the setting of the authors' demo and of the public ports (PixelSyncOIT, LineVis's first
@@ -158,6 +163,54 @@ struct TrigMomentPixel {
 };
 static_assert(sizeof(TrigMomentPixel<3>) == 44 && sizeof(TrigMomentPixel<4>) == 52);
 
+/// One pixel's buffers with 16-bit storage of `Count` floats of moments (4, 6, 8 power moments, or
+/// 6, 8 for 3, 4 trigonometric ones): b0 in float32, the moments as 16-bit unorm codes of the
+/// storage basis, the four float32 accumulators: 4 + 2 Count + 16 bytes.
+template <int Count, bool Trigonometric>
+struct QuantizedMomentPixel {
+  static_assert(Count == 4 || Count == 6 || Count == 8);
+  static_assert(!Trigonometric || Count != 4);
+  float b0 = 0.0f;
+  uint16_t codes[Count] = {};                    // unorm16 codes (method_math.h's storage basis)
+  float r = 0.0f, g = 0.0f, b = 0.0f, a = 0.0f;  // pass 2: sum T a c, sum T a
+
+  void unorm(float (&u)[method_math::kMboitMaxMoments]) const {
+    for (int j = 0; j < Count; ++j) u[j] = static_cast<float>(codes[j]) / method_math::kUnorm16Max;
+  }
+  void addMoments(float depth, float alpha) {
+    if (alpha <= 0.0f) return;
+    float u[method_math::kMboitMaxMoments] = {};
+    unorm(u);  // with b0 = 0 the stored values weigh nothing
+    method_math::mboitAddQuantizedMoments(Count, Trigonometric, b0, u, mboitAbsorbance(alpha),
+                                          mboitWarpDepth(depth));
+    for (int j = 0; j < Count; ++j)
+      codes[j] = static_cast<uint16_t>(method_math::unorm16Code(u[j]));
+  }
+  float transmittanceAt(float depth) const {
+    float u[method_math::kMboitMaxMoments] = {};
+    unorm(u);
+    float moments[method_math::kMboitMaxMoments] = {};
+    method_math::mboitDequantizeMoments(Count, Trigonometric, b0, u, moments);
+    const float bias = method_math::mboitQuantizedBias(Count, Trigonometric);
+    if constexpr (Trigonometric)
+      return method_math::mboitTransmittanceTrig(Count / 2, b0, moments, mboitWarpDepth(depth),
+                                                 bias, kMboitOverestimation);
+    return method_math::mboitTransmittancePower(Count, b0, moments, mboitWarpDepth(depth), bias,
+                                                kMboitOverestimation);
+  }
+  void addColor(float depth, uint32_t rgba) {
+    const glm::vec4 c = unpackFragmentColor(rgba);
+    if (c.a <= 0.0f) return;
+    method_math::mboitAddColor(r, g, b, a, glm::vec3(c), transmittanceAt(depth) * c.a);
+  }
+  glm::vec3 composite(glm::vec3 background) const {
+    return method_math::mboitComposite(b0, glm::vec3(r, g, b), a, background);
+  }
+};
+static_assert(sizeof(QuantizedMomentPixel<4, false>) == 28 &&
+              sizeof(QuantizedMomentPixel<6, false>) == 32 &&
+              sizeof(QuantizedMomentPixel<8, true>) == 36);
+
 /// The moments pass, then the capture weighting each fragment by its reconstructed transmittance:
 /// what every power-moment peer method does with its Pixel.
 template <class Pixel>
@@ -219,18 +272,69 @@ struct MboitTrig4Method : MomentPasses<TrigMomentPixel<4>> {
   }
 };
 
+/// A 16-bit moment preset: the storage's Count floats of moments, its preset row.
+template <Compositing Rule, int Count, bool Trigonometric>
+struct Quantized16Method : MomentPasses<QuantizedMomentPixel<Count, Trigonometric>> {
+  static constexpr Compositing kRule = Rule;
+};
+
+/// mboit-q16, mboit6-q16, mboit8-q16, mboit-trig3-q16, mboit-trig4-q16: the 16-bit storage of
+/// the paper's sec. 4 (b0 float32, 28 to 36 bytes per pixel).
+struct Mboit16Method : Quantized16Method<Compositing::MomentBased16, 4, false> {
+  static constexpr const char* kRuleName = "moment-based-16";
+  static PresetInfo preset() {
+    return {"mboit-q16", "moment-based OIT, 4 power moments in 16 bits (Muenstermann et al. 2018)",
+            "4 power moments in 16-bit unorm + float b0 per pixel, no fragment nodes"};
+  }
+};
+struct Mboit6_16Method : Quantized16Method<Compositing::MomentBased6_16, 6, false> {
+  static constexpr const char* kRuleName = "moment-based-6-16";
+  static PresetInfo preset() {
+    return {"mboit6-q16", "moment-based OIT, 6 power moments in 16 bits (Muenstermann et al. 2018)",
+            "6 power moments in 16-bit unorm + float b0 per pixel, no fragment nodes"};
+  }
+};
+struct Mboit8_16Method : Quantized16Method<Compositing::MomentBased8_16, 8, false> {
+  static constexpr const char* kRuleName = "moment-based-8-16";
+  static PresetInfo preset() {
+    return {"mboit8-q16", "moment-based OIT, 8 power moments in 16 bits (Muenstermann et al. 2018)",
+            "8 power moments in 16-bit unorm + float b0 per pixel, no fragment nodes"};
+  }
+};
+struct MboitTrig3_16Method : Quantized16Method<Compositing::MomentBasedTrig3_16, 6, true> {
+  static constexpr const char* kRuleName = "moment-based-trig-3-16";
+  static PresetInfo preset() {
+    return {"mboit-trig3-q16",
+            "moment-based OIT, 3 trigonometric moments in 16 bits (Muenstermann et al. 2018)",
+            "3 trigonometric moments in 16-bit unorm + float b0 per pixel, no fragment nodes"};
+  }
+};
+struct MboitTrig4_16Method : Quantized16Method<Compositing::MomentBasedTrig4_16, 8, true> {
+  static constexpr const char* kRuleName = "moment-based-trig-4-16";
+  static PresetInfo preset() {
+    return {"mboit-trig4-q16",
+            "moment-based OIT, 4 trigonometric moments in 16 bits (Muenstermann et al. 2018)",
+            "4 trigonometric moments in 16-bit unorm + float b0 per pixel, no fragment nodes"};
+  }
+};
+
 /// The floats of moments a moment-based rule keeps besides b0: 4 (mboit), 6 (mboit6, and
 /// mboit-trig3's three complex moments), 8 (mboit8, mboit-trig4); 0 for any other rule. The GL
 /// engine's one moment technique runs all five by this count and mboitTrigonometric.
 inline int mboitMomentCount(Compositing c) {
   switch (c) {
     case Compositing::MomentBased:
+    case Compositing::MomentBased16:
       return 4;
     case Compositing::MomentBased6:
     case Compositing::MomentBasedTrig3:
+    case Compositing::MomentBased6_16:
+    case Compositing::MomentBasedTrig3_16:
       return 6;
     case Compositing::MomentBased8:
     case Compositing::MomentBasedTrig4:
+    case Compositing::MomentBased8_16:
+    case Compositing::MomentBasedTrig4_16:
       return 8;
     default:
       return 0;
@@ -239,7 +343,15 @@ inline int mboitMomentCount(Compositing c) {
 
 /// True for the trigonometric moment rules.
 inline bool mboitTrigonometric(Compositing c) {
-  return c == Compositing::MomentBasedTrig3 || c == Compositing::MomentBasedTrig4;
+  return c == Compositing::MomentBasedTrig3 || c == Compositing::MomentBasedTrig4 ||
+         c == Compositing::MomentBasedTrig3_16 || c == Compositing::MomentBasedTrig4_16;
+}
+
+/// True for the 16-bit moment rules.
+inline bool mboitQuantized(Compositing c) {
+  return c == Compositing::MomentBased16 || c == Compositing::MomentBased6_16 ||
+         c == Compositing::MomentBased8_16 || c == Compositing::MomentBasedTrig3_16 ||
+         c == Compositing::MomentBasedTrig4_16;
 }
 
 /// mboit as a peer method (peer_method.hpp): the moments pass, then the capture weighting each

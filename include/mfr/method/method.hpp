@@ -60,16 +60,21 @@ enum class Compositing : uint8_t {
   KBuffer,  // sort the captured fragments, composite front to back, drop the rest
   Hybrid,   // sorted core + order-independent tail (hybrid transparency)
   // The peer methods' own rules (docs/METHODS.md); --composite does not apply to them.
-  WeightedBlended,   // wboit: weighted sums and revealage (McGuire & Bavoil 2013), wboit.hpp
-  MomentBased,       // mboit: power moments, reconstructed transmittance (Muenstermann 2018)
-  MomentBased6,      // mboit6: the same with 6 power moments (mboit.hpp)
-  MomentBased8,      // mboit8: the same with 8 power moments (mboit.hpp)
-  MomentBasedTrig3,  // mboit-trig3: 3 trigonometric moments (mboit.hpp)
-  MomentBasedTrig4,  // mboit-trig4: 4 trigonometric moments (mboit.hpp)
-  MultiLayerAlpha,   // mlab: front-to-back over of the MultiLayer store's nodes (Salvi 2014)
-  Adaptive4,         // aoit4: adaptive transparency, 4 visibility nodes (Salvi 2011), aoit.hpp
-  Adaptive8,         // aoit8: the same with 8 nodes
-  Adaptive16,        // aoit16: the same with 16 nodes
+  WeightedBlended,      // wboit: weighted sums and revealage (McGuire & Bavoil 2013), wboit.hpp
+  MomentBased,          // mboit: power moments, reconstructed transmittance (Muenstermann 2018)
+  MomentBased6,         // mboit6: the same with 6 power moments (mboit.hpp)
+  MomentBased8,         // mboit8: the same with 8 power moments (mboit.hpp)
+  MomentBasedTrig3,     // mboit-trig3: 3 trigonometric moments (mboit.hpp)
+  MomentBasedTrig4,     // mboit-trig4: 4 trigonometric moments (mboit.hpp)
+  MomentBased16,        // mboit-q16: 4 power moments stored in 16 bits (mboit.hpp)
+  MomentBased6_16,      // mboit6-q16
+  MomentBased8_16,      // mboit8-q16
+  MomentBasedTrig3_16,  // mboit-trig3-q16
+  MomentBasedTrig4_16,  // mboit-trig4-q16
+  MultiLayerAlpha,      // mlab: front-to-back over of the MultiLayer store's nodes (Salvi 2014)
+  Adaptive4,            // aoit4: adaptive transparency, 4 visibility nodes (Salvi 2011), aoit.hpp
+  Adaptive8,            // aoit8: the same with 8 nodes
+  Adaptive16,           // aoit16: the same with 16 nodes
 };
 
 /// True for kbuffer and hybrid, the rules `--composite` chooses between (the k-buffer family).

@@ -49,6 +49,7 @@ using dvec2 = glm::dvec2;
 using std::abs;
 using std::clamp;
 using std::exp;
+using std::floor;
 using std::log;
 using std::max;
 using std::min;
@@ -122,6 +123,56 @@ MFR_MATH_CONST(float, kMboitTrigZoneOffset, -18.555231453343893f)
 MFR_MATH_CONST(double, kMboitPi, double(3.14159274f) - double(8.74227766e-8f))
 // terms of the sine and cosine series (|t| <= pi: the next term is below 1e-18)
 MFR_MATH_CONST(int, kMboitSeriesTerms, 16)
+// MBOIT's 16-bit storage (the paper's sec. 4 and supplementary; the authors' MomentMath.hlsli
+// quantizeMoments / offsetMoments, as published with the paper under CC0): the normalised power
+// moments, split into the odd (z, z^3, ..) and even (z^2, z^4, ..) vectors, are stored in the
+// basis Q v (column convention; the authors write 4 and 6 moments as v Q^T) plus an offset, which
+// puts every moment vector of a single depth into [0, 1] for UNORM16 storage; b0 stays float32.
+// Trigonometric moments are stored as b / b0 / 2 + 1/2. The bias for 16-bit storage, from the
+// supplementary's table (as recorded in PixelSyncOIT's OIT_MBOIT.cpp): 4, 6, 8 power moments
+// 6e-5, 6e-4, 2.5e-3; 3 and 4 trigonometric moments 6.5e-4 and 8.5e-4.
+#define MFR_MBOIT_Q4_ODD 1.5f, -2.0f, 0.866025403784f, -0.384900179460f
+#define MFR_MBOIT_Q4_EVEN 4.0f, -4.0f, 0.5f, 0.5f
+#define MFR_MBOIT_Q6_ODD                                                                \
+  2.5f, -10.0f, 8.0f, -1.87499864450f, 4.20757543111f, -1.83257678661f, 1.26583039016f, \
+      -1.47644882902f, 0.71061660238f
+#define MFR_MBOIT_Q6_EVEN \
+  4.0f, -4.0f, 0.0f, 9.0f, -24.0f, 16.0f, -0.57759806484f, 4.61936647543f, -3.07953906655f
+#define MFR_MBOIT_Q8_ODD                                                                           \
+  3.48044635732474f, -27.5760737514826f, 55.1267384344761f, -31.5311110403183f, 1.26797185782836f, \
+      -0.928755808743913f, -2.07520453231032f, 1.23598848322588f, -2.1671560004294f,               \
+      6.17950199592966f, -0.276515571579297f, -4.23583042392097f, 0.974332879165755f,              \
+      -0.443426830933027f, -0.360491648368785f, 0.310149466050223f
+#define MFR_MBOIT_Q8_EVEN                                                            \
+  0.280504133158527f, -0.757633844606942f, 0.392179589334688f, -0.887531871812237f,  \
+      -2.01362265883247f, 0.221551373038988f, -1.06107954265125f, 2.83887201588367f, \
+      -7.31010494985321f, 13.9855979699139f, -0.114305766176437f, -7.4361899359832f, \
+      -15.8954215629556f, 79.6186327084103f, -127.457278992502f, 63.7349456687829f
+#define MFR_MBOIT_Q8_EVEN_OFFSET 0.972481993925964f, 1.0f, 0.999179192513328f, 0.991778293073131f
+#ifdef __cplusplus
+inline constexpr float kMboitQ4Odd[4] = {MFR_MBOIT_Q4_ODD};
+inline constexpr float kMboitQ4Even[4] = {MFR_MBOIT_Q4_EVEN};
+inline constexpr float kMboitQ6Odd[9] = {MFR_MBOIT_Q6_ODD};
+inline constexpr float kMboitQ6Even[9] = {MFR_MBOIT_Q6_EVEN};
+inline constexpr float kMboitQ8Odd[16] = {MFR_MBOIT_Q8_ODD};
+inline constexpr float kMboitQ8Even[16] = {MFR_MBOIT_Q8_EVEN};
+inline constexpr float kMboitQ8EvenOffset[4] = {MFR_MBOIT_Q8_EVEN_OFFSET};
+#else
+const float kMboitQ4Odd[4] = float[4](MFR_MBOIT_Q4_ODD);
+const float kMboitQ4Even[4] = float[4](MFR_MBOIT_Q4_EVEN);
+const float kMboitQ6Odd[9] = float[9](MFR_MBOIT_Q6_ODD);
+const float kMboitQ6Even[9] = float[9](MFR_MBOIT_Q6_EVEN);
+const float kMboitQ8Odd[16] = float[16](MFR_MBOIT_Q8_ODD);
+const float kMboitQ8Even[16] = float[16](MFR_MBOIT_Q8_EVEN);
+const float kMboitQ8EvenOffset[4] = float[4](MFR_MBOIT_Q8_EVEN_OFFSET);
+#endif
+MFR_MATH_CONST(float, kMboitQ6EvenOffset3, 0.018888946f)
+MFR_MATH_CONST(float, kMboit16Bias, 6e-5f)
+MFR_MATH_CONST(float, kMboit6_16Bias, 6e-4f)
+MFR_MATH_CONST(float, kMboit8_16Bias, 2.5e-3f)
+MFR_MATH_CONST(float, kMboitTrig3_16Bias, 6.5e-4f)
+MFR_MATH_CONST(float, kMboitTrig4_16Bias, 8.5e-4f)
+MFR_MATH_CONST(float, kUnorm16Max, 65535.0f)
 // Laguerre's iteration for the support points: at most this many steps per root
 MFR_MATH_CONST(int, kMboitRootIterations, 64)
 // 1e-12 (GLSL has no token pasting for an `lf` suffix: the correctly rounded quotient of exact
@@ -877,6 +928,141 @@ MFR_MATH_FN void aoitAddColor(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(
 MFR_MATH_FN vec3 aoitComposite(vec3 sum, float total, vec3 background) {
   MFR_PRECISE vec3 result = sum + total * background;
   return result;
+}
+
+// ---- moment-based OIT: 16-bit storage ---------------------------------------------------------
+// The authors' read-modify-write of the normalised moments (their generatePowerMoments and
+// generateTrigonometricMoments without SINGLE_PRECISION, under a rasterizer-ordered view; here
+// under the per-pixel lock or in the tile's order): the stored unorm values u_j (q_j / 65535) less
+// the offset, times the old b0, plus A times the new fragment's vector in the storage basis,
+// divided by the new b0, plus the offset, rounded to the nearest 16-bit step. The resolve inverts
+// the basis (the inverse of Q by Gauss-Jordan in double) and hands b0 times the normalised moments
+// to the float32 reconstructions above. `count`: the floats of moments (4, 6, 8; trigonometric: 6,
+// 8).
+
+/// The 16-bit unorm code of u (clamped to [0, 1], nearest).
+MFR_MATH_FN uint unorm16Code(float u) {
+  MFR_PRECISE float scaled = clamp(u, 0.0f, 1.0f) * kUnorm16Max + 0.5f;
+  return uint(floor(scaled));
+}
+
+/// The storage basis' entry (row, col) of the odd (z^1, z^3, ..) or even (z^2, z^4, ..) vector
+/// for `count` power moments (halves = count / 2 rows and columns).
+MFR_MATH_FN float mboitQuantizeEntry(int count, bool odd, int row, int col) {
+  const int halves = count / 2;
+  const int at = row * halves + col;
+  if (count == 4) return odd ? kMboitQ4Odd[at] : kMboitQ4Even[at];
+  if (count == 6) return odd ? kMboitQ6Odd[at] : kMboitQ6Even[at];
+  return odd ? kMboitQ8Odd[at] : kMboitQ8Even[at];
+}
+
+/// The storage offset of stored moment `index` (0-based in z, z^2, .., z^count order).
+MFR_MATH_FN float mboitQuantizeOffset(int count, bool trigonometric, int index) {
+  if (trigonometric || index % 2 == 0) return 0.5f;  // the odd moments and b / b0 / 2 + 1/2
+  const int row = index / 2;
+  if (count == 6) return row == 2 ? kMboitQ6EvenOffset3 : 0.0f;
+  if (count == 8) return kMboitQ8EvenOffset[row];
+  return 0.0f;
+}
+
+/// The bias of a 16-bit moment set.
+MFR_MATH_FN float mboitQuantizedBias(int count, bool trigonometric) {
+  if (trigonometric) return count == 6 ? kMboitTrig3_16Bias : kMboitTrig4_16Bias;
+  return count == 4 ? kMboit16Bias : (count == 6 ? kMboit6_16Bias : kMboit8_16Bias);
+}
+
+/// Pass 1 on 16-bit storage: b0 (float32) and the unorm values u (count of them, each on the
+/// 1/65535 grid) take the fragment of absorbance A at warped depth z.
+MFR_MATH_FN void mboitAddQuantizedMoments(int count, bool trigonometric, MFR_INOUT(float) b0,
+                                          MFR_INOUT_ARRAY(float, u, kMboitMaxMoments), float A,
+                                          float z) {
+  // the fragment's own vector in the storage basis
+  float v[kMboitMaxMoments];
+  if (trigonometric) {
+    const dvec2 w = mboitCircle(mboitTrigPhase(z));
+    dvec2 wk = w;
+    for (int k = 0; k < count / 2; ++k) {
+      v[2 * k] = float(wk.x);
+      v[2 * k + 1] = float(wk.y);
+      wk = complexMul(wk, w);
+    }
+  } else {
+    float powers[kMboitMaxMoments];
+    MFR_PRECISE float zj = 1.0f;
+    for (int j = 0; j < count; ++j) {
+      MFR_PRECISE float next = zj * z;
+      zj = next;
+      powers[j] = zj;
+    }
+    const int halves = count / 2;
+    for (int row = 0; row < halves; ++row) {
+      MFR_PRECISE float odd = 0.0f;
+      MFR_PRECISE float even = 0.0f;
+      for (int col = 0; col < halves; ++col) {
+        odd += mboitQuantizeEntry(count, true, row, col) * powers[2 * col];
+        even += mboitQuantizeEntry(count, false, row, col) * powers[2 * col + 1];
+      }
+      v[2 * row] = odd;
+      v[2 * row + 1] = even;
+    }
+  }
+  const float oldB0 = b0;
+  MFR_PRECISE float newB0 = oldB0 + A;
+  for (int j = 0; j < count; ++j) {
+    const float offset = mboitQuantizeOffset(count, trigonometric, j);
+    // trigonometric: b / b0 = 2 (u - 1/2)
+    const float scale = trigonometric ? 2.0f : 1.0f;
+    MFR_PRECISE float s = (u[j] - offset) * scale * oldB0 + A * v[j];
+    MFR_PRECISE float back = s / newB0 / scale + offset;
+    u[j] = float(unorm16Code(back)) / kUnorm16Max;
+  }
+  b0 = newB0;
+}
+
+/// The resolve's view of 16-bit storage: b0 times the normalised moments (z, z^2, .. order, or
+/// the trigonometric moments' real and imaginary parts), for mboitTransmittancePower / Trig.
+MFR_MATH_FN void mboitDequantizeMoments(int count, bool trigonometric, float b0,
+                                        MFR_IN_ARRAY(float, u, kMboitMaxMoments),
+                                        MFR_INOUT_ARRAY(float, moments, kMboitMaxMoments)) {
+  if (trigonometric) {
+    for (int j = 0; j < count; ++j) {
+      MFR_PRECISE float m = (u[j] - 0.5f) * 2.0f * b0;
+      moments[j] = m;
+    }
+    return;
+  }
+  const int halves = count / 2;
+  for (int parity = 0; parity < 2; ++parity) {
+    // Gauss-Jordan on [Q | q]: solves Q v = q for the normalised odd or even vector v
+    double a[20];
+    for (int row = 0; row < halves; ++row) {
+      for (int col = 0; col < halves; ++col)
+        a[row * 5 + col] = double(mboitQuantizeEntry(count, parity == 0, row, col));
+      const int index = 2 * row + parity;
+      a[row * 5 + 4] = double(u[index]) - double(mboitQuantizeOffset(count, false, index));
+    }
+    for (int col = 0; col < halves; ++col) {
+      int pivot = col;
+      for (int row = col + 1; row < halves; ++row)
+        if (abs(a[row * 5 + col]) > abs(a[pivot * 5 + col])) pivot = row;
+      for (int k = 0; k < 5; ++k) {
+        const double t = a[col * 5 + k];
+        a[col * 5 + k] = a[pivot * 5 + k];
+        a[pivot * 5 + k] = t;
+      }
+      const double diagonal = a[col * 5 + col];
+      for (int k = 0; k < 5; ++k) a[col * 5 + k] /= diagonal;
+      for (int row = 0; row < halves; ++row) {
+        if (row == col) continue;
+        const double factor = a[row * 5 + col];
+        for (int k = 0; k < 5; ++k) a[row * 5 + k] -= factor * a[col * 5 + k];
+      }
+    }
+    for (int row = 0; row < halves; ++row) {
+      MFR_PRECISE float m = float(a[row * 5 + 4]) * b0;
+      moments[2 * row + parity] = m;
+    }
+  }
 }
 
 // ---- importance (variable k-buffer) ------------------------------------------------------------

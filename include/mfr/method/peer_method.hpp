@@ -48,8 +48,10 @@ struct PeerList {
     (f.template operator()<Peers>(), ...);
   }
 };
-using PeerMethods = PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Method, MboitTrig3Method,
-                             MboitTrig4Method, MlabMethod, Aoit4Method, Aoit8Method, Aoit16Method>;
+using PeerMethods =
+    PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Method, MboitTrig3Method,
+             MboitTrig4Method, Mboit16Method, Mboit6_16Method, Mboit8_16Method, MboitTrig3_16Method,
+             MboitTrig4_16Method, MlabMethod, Aoit4Method, Aoit8Method, Aoit16Method>;
 
 /// Calls `f.template operator()<Peer>()` with the peer type of `rule`; false (and no call) for
 /// the k-buffer family's rules.
