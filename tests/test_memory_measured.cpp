@@ -36,10 +36,12 @@ std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const 
                                                      uint64_t abufferFragments) {
   std::map<std::string, uint64_t> b;
   if (m.allocation == AllocationPolicy::NoNodes) {  // wboit, mboit*: accumulators, no nodes
-    // documented: wboit 20 B, mboit 36 B, mboit6 44 B, mboit8 52 B per pixel
+    // documented: wboit 20 B, mboit 36 B, mboit6 44 B, mboit8 52 B, peel 36 B, dual-peel 72 B
+    // per pixel
     const uint64_t perPixel = m.compositing == Compositing::WeightedBlended ? 20
                               : m.compositing == Compositing::MomentBased6  ? 44
                               : m.compositing == Compositing::MomentBased8  ? 52
+                              : m.compositing == Compositing::DualPeel      ? 72
                                                                             : 36;
     b["accumulators"] = perPixel * pixels;
     b["counters"] = 4 * pixels;  // the CPU engine's count of accumulated fragments
@@ -128,8 +130,9 @@ TEST(MemoryMeasured, BytesAllocatedFollowTheDocumentedCpuLayoutForEveryPreset) {
           }
           ++checked;
         }
-  // wboit, mboit, mboit6, mboit8, mlab: one rule, no +occupancy, both capture modes
-  constexpr int kPeers = 5;
+  // wboit, mboit, mboit6, mboit8, mlab, peel, dual-peel: one rule, no +occupancy, both capture
+  // modes
+  constexpr int kPeers = 7;
   EXPECT_EQ(checked,
             4 * (1 + 2 * (static_cast<int>(presetNames().size()) - 1 - kPeers)) + 2 * kPeers);
 }

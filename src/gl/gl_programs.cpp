@@ -108,6 +108,9 @@ constexpr ProgramRow kPrograms[] = {
     {ProgramId::ImportanceTotal, "importance_total.comp", Stages::Compute, Prelude::None},
     {ProgramId::AllocK, "alloc_k.comp", Stages::Compute, Prelude::None},
     {ProgramId::AllocPack, "alloc_pack.comp", Stages::Compute, Prelude::None},
+    {ProgramId::Peel, "peel.frag", Stages::Raster, Prelude::None},
+    {ProgramId::PeelStep, "peel_step.comp", Stages::Compute, Prelude::None},
+    {ProgramId::PeelResolve, "peel_resolve.comp", Stages::Compute, Prelude::None},
 };
 constexpr bool rowsInIdOrder() {
   if (std::size(kPrograms) != kProgramCount) return false;

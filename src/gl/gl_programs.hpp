@@ -44,8 +44,11 @@ enum class ProgramId : uint8_t {
   ImportanceTotal,  // importance_total.comp
   AllocK,           // alloc_k.comp
   AllocPack,        // alloc_pack.comp
+  Peel,             // peel.frag (depth peeling's passes and tail pass)
+  PeelStep,         // peel_step.comp (between peel passes)
+  PeelResolve,      // peel_resolve.comp
 };
-inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::AllocPack) + 1;
+inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::PeelResolve) + 1;
 
 /// The linked programs of one engine, deleted with it (in the context current then).
 class Programs {

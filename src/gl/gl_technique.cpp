@@ -28,6 +28,12 @@ constexpr GlTechniqueInfo kTechniques[] = {
      "accumulators 36 B (4 moments), 44 B (6), 52 B (8) + lock 4 B", "mboit, mboit6, mboit8"},
     {GlTechnique::Mlab, "mlab", "capture (insert, merge the two farthest when full) -> resolve",
      "mlab.frag", "mlab_resolve.comp", "k nodes of 20 B + node count 4 B + lock 4 B", "mlab"},
+    {GlTechnique::Peel, "peel",
+     "peel passes (the nearest [and farthest] key under the lock, then peel_step.comp blends it "
+     "and advances the bounds) until a pass peels every fragment in range or --max-peels -> "
+     "[tail pass] -> resolve",
+     "peel.frag (+ peel_step.comp)", "peel_resolve.comp",
+     "state 36 B (peel) or 72 B (dual-peel) + lock 4 B [+ tail 20 B]", "peel, dual-peel"},
 };
 
 constexpr bool rowsInEnumOrder() {
@@ -92,6 +98,12 @@ std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
           m.occupancyWords != 0)
         return std::nullopt;
       return GlTechnique::Mlab;
+    case Compositing::Peel:
+    case Compositing::DualPeel:
+      if (m.allocation != AllocationPolicy::NoNodes || m.store != StoreChoice::None ||
+          m.occupancyWords != 0)
+        return std::nullopt;
+      return GlTechnique::Peel;
   }
   return std::nullopt;
 }
@@ -116,7 +128,7 @@ Result<GlTechnique> classifyGl(const MethodDesc& method) {
     return makeError("--engine gl: method " + method.name +
                      " is not in the GL engine (it runs the A-buffer; the k-buffer family with a "
                      "fixed k or a per-pixel k(p), max-array or max-heap stores, occupancy culling "
-                     "and kbuffer or hybrid compositing; wboit; mboit; mlab)");
+                     "and kbuffer or hybrid compositing; wboit; mboit; mlab; peel, dual-peel)");
   return *t;
 }
 

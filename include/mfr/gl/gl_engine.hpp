@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -71,6 +72,9 @@ struct GlRenderOutput {
   uint64_t culledKPlus = 0;        // k-buffers: rejected by the k+ test (depends on arrival order)
   bool atomic64 = false;           // the fixed-k capture took 64-bit atomicMin (no lock)
   std::vector<GlPassTime> passes;  // count, prefix sum, capture, resolve (timed run)
+  /// Depth peeling: the fragments peeled per pixel, and the peel passes run (not the tail's).
+  std::vector<uint32_t> held;
+  std::optional<uint32_t> peelPasses;
 };
 
 /// How the geometry passes make fragments (--gl-raster).

@@ -27,6 +27,8 @@ enum class GlTechnique : uint8_t {
   Wboit,    // weighted blended OIT: one accumulation pass, weighted-average resolve
   Mboit,    // moment-based OIT: moments pass, colour pass, reconstruction resolve
   Mlab,     // multi-layer alpha blending: merge capture of k nodes, front-to-back resolve
+  Peel,     // depth peeling and dual depth peeling: peel passes (geometry + per-pixel step) until
+            // none remains or --max-peels, [tail pass], composite
 };
 
 /// One row of the technique table.
