@@ -19,7 +19,8 @@ GlTechnique expectedTechnique(const std::string& preset) {
   static const std::map<std::string, GlTechnique> peers = {
       {"abuffer", GlTechnique::ABuffer}, {"wboit", GlTechnique::Wboit},
       {"mboit", GlTechnique::Mboit},     {"mboit6", GlTechnique::Mboit},
-      {"mboit8", GlTechnique::Mboit},    {"mlab", GlTechnique::Mlab}};
+      {"mboit8", GlTechnique::Mboit},    {"mlab", GlTechnique::Mlab},
+      {"peel", GlTechnique::Peel},       {"dual-peel", GlTechnique::Peel}};
   const auto it = peers.find(preset);
   return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
 }
@@ -39,7 +40,7 @@ TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
     EXPECT_EQ(*tc, GlTechnique::KBuffer) << name << "+occupancy";
     ++occupancyForms;
   }
-  EXPECT_EQ(presets, 19);
+  EXPECT_EQ(presets, 21);
   EXPECT_EQ(occupancyForms, 13);
 }
 
@@ -57,7 +58,7 @@ TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
 
 TEST(GlTechnique, TableRowsFollowTheEnum) {
   const auto rows = glTechniques();
-  ASSERT_EQ(rows.size(), 5u);
+  ASSERT_EQ(rows.size(), 6u);
   for (size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(static_cast<size_t>(rows[i].technique), i);
     EXPECT_EQ(&techniqueInfo(rows[i].technique), &rows[i]);
@@ -103,6 +104,9 @@ TEST(GlTechnique, CombinationsOutsideTheGlEngineAreOneLineErrors) {
   m = methodPreset("mboit").value();
   m.allocation = AllocationPolicy::FixedK;
   expectRefused(m, "mboit-nodes");
+  m = methodPreset("peel").value();
+  m.allocation = AllocationPolicy::FixedK;
+  expectRefused(m, "peel-nodes");
 }
 
 }  // namespace
