@@ -94,10 +94,13 @@ void main() {
   vec4 base;
   if (!surface(f, false, base)) discard;
   countInCapture(f);
-  const uvec2 key = uvec2(floatBitsToUint(fragmentDepth(f)), shade(f, base));
+  const uint depthBits = floatBitsToUint(fragmentDepth(f));
   const uint p = uint(f.pixel);
   const uint w = (uDual != 0u ? kDualPeelWords : kPeelWords) * p;
-  if (!remains(w, key)) return;  // (the bounds change only between passes)
+  // (the bounds change only between passes): a depth outside them needs no shading
+  if (depthBits < state[w] || (uDual != 0u && depthBits > state[w + 2u])) return;
+  const uvec2 key = uvec2(depthBits, shade(f, base));
+  if (!remains(w, key)) return;
   if (uTail == 0u) atomicAdd(inRange, 1u);
   bool done = false;
   while (!done) {

@@ -46,10 +46,26 @@ struct FragmentTally {
   uint64_t generated = 0, taken = 0;
 };
 
-// Runs update(fragment) for every shaded fragment.
-template <class Update>
+/// A rasterizer sink: emit() hands the shaded fragment to fn; accept() is the early test before
+/// shading (depth peeling rejects a pixel's fragments in front of its peeled layers there).
+template <class Accept, class F>
+struct AcceptEmit {
+  Accept acceptFn;
+  F fn;
+  bool accept(uint32_t pixel, float depth) const { return acceptFn(pixel, depth); }
+  void emit(const Fragment& f) { fn(f); }
+};
+template <class Accept, class F>
+AcceptEmit(Accept, F) -> AcceptEmit<Accept, F>;
+
+struct AcceptAll {
+  bool operator()(uint32_t, float) const { return true; }
+};
+
+// Runs update(fragment) for every shaded fragment `accept` lets through.
+template <class Update, class Accept = AcceptAll>
 FragmentTally forEachFragment(const RasterFrame& frame, CaptureMode mode, Stores& stores,
-                              Update&& update) {
+                              Update&& update, Accept accept = {}) {
   const auto apply = [&](const Fragment& f, FragmentTally& t) {
     ++t.generated;
     if constexpr (std::is_same_v<decltype(update(f)), bool>) {
@@ -63,7 +79,8 @@ FragmentTally forEachFragment(const RasterFrame& frame, CaptureMode mode, Stores
     std::vector<FragmentTally> perTile(static_cast<size_t>(frame.tileCount()));
     frame.forEachTile([&](int tile) {
       FragmentTally t;
-      frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) { apply(f, t); }});
+      frame.rasterizeTile<ShadeMode::Full>(
+          tile, AcceptEmit{accept, [&](const Fragment& f) { apply(f, t); }});
       perTile[tile] = t;
     });
     for (const FragmentTally& t : perTile) {
@@ -80,11 +97,11 @@ FragmentTally forEachFragment(const RasterFrame& frame, CaptureMode mode, Stores
   for (int w = 0; w < frame.threads(); ++w)
     workers.emplace_back([&, w] {
       FragmentTally t;
-      auto sink = EmitAll{[&](const Fragment& f) {
-        lockPixel(stores.locks, f.pixel);
-        apply(f, t);
-        unlockPixel(stores.locks, f.pixel);
-      }};
+      auto sink = AcceptEmit{accept, [&](const Fragment& f) {
+                               lockPixel(stores.locks, f.pixel);
+                               apply(f, t);
+                               unlockPixel(stores.locks, f.pixel);
+                             }};
       for (size_t begin = cursor.fetch_add(kChunk); begin < triangles;
            begin = cursor.fetch_add(kChunk)) {
         const size_t end = std::min(triangles, begin + kChunk);
@@ -114,12 +131,21 @@ struct PeerRun {
 
   static FragmentTally pass(const RasterFrame& frame, const Allocation& a, CaptureMode mode,
                             Stores& stores, int pass) {
-    return forEachFragment(frame, mode, stores, [&](const Fragment& f) {
+    const auto update = [&](const Fragment& f) {
       const uint32_t p = f.pixel;
       return Peer::add(PeerPixel<Slot>{slotsOf(stores, a, p), stores.counts[p],
                                        Peer::kNodes ? a.capacity[p] : 1u},
                        pass, f.depth, f.rgba);
-    });
+    };
+    if constexpr (peerRepeatsCapture<Peer>()) {
+      // depth peeling: a fragment whose depth alone puts it outside the range still to peel is
+      // rejected before shading (the bounds change only between passes)
+      return forEachFragment(frame, mode, stores, update, [&](uint32_t p, float depth) {
+        return Peer::mayRemain(slotsOf(stores, a, p), depth);
+      });
+    } else {
+      return forEachFragment(frame, mode, stores, update);
+    }
   }
 };
 
@@ -184,11 +210,16 @@ void runPeelTail(const RasterFrame& frame, const MethodDesc& method, const Alloc
                  CaptureMode mode, Stores& stores) {
   visitPeer(method.compositing, [&]<class Peer>() {
     if constexpr (peerRepeatsCapture<Peer>())
-      (void)forEachFragment(frame, mode, stores, [&](const Fragment& f) {
-        const uint32_t p = f.pixel;
-        if (Peer::remains(PeerRun<Peer>::slotsOf(stores, allocation, p), f.depth, f.rgba))
-          stores.tails[p].add(f.rgba);
-      });
+      (void)forEachFragment(
+          frame, mode, stores,
+          [&](const Fragment& f) {
+            const uint32_t p = f.pixel;
+            if (Peer::remains(PeerRun<Peer>::slotsOf(stores, allocation, p), f.depth, f.rgba))
+              stores.tails[p].add(f.rgba);
+          },
+          [&](uint32_t p, float depth) {
+            return Peer::mayRemain(PeerRun<Peer>::slotsOf(stores, allocation, p), depth);
+          });
   });
 }
 

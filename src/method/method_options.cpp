@@ -67,7 +67,7 @@ const std::vector<MethodOptionRule>& methodOptionRules() {
        "the k-buffer family (kbuffer / hybrid rules) and depth peeling (hybrid: a tail after "
        "--max-peels)",
        kBufferFamily},
-      {MethodOption::MaxPeels, "--max-peels", "depth peeling (peel, dual-peel)", peeling},
+      {MethodOption::MaxPeels, "--max-peels", "depth peeling", peeling},
   };
   return rules;
 }

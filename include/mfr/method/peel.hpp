@@ -35,6 +35,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -94,6 +95,8 @@ struct PeelPixel {
   float T = 1.0f;                      // front transmittance
 
   bool remains(FragmentNode key) const { return key >= bound.get(); }
+  /// Whether a fragment of this depth may still be to peel (the early test before shading).
+  bool mayRemain(float depth) const { return std::bit_cast<uint32_t>(depth) >= bound.hi; }
   /// One fragment of a pass: true when it is still to peel.
   bool add(FragmentNode key) {
     if (!remains(key)) return false;
@@ -137,6 +140,10 @@ struct DualPeelPixel {
   float br = 0.0f, bg = 0.0f, bb = 0.0f, bT = 1.0f;  // back layers, back to front
 
   bool remains(FragmentNode key) const { return key >= lo.get() && key < hi.get(); }
+  bool mayRemain(float depth) const {
+    const uint32_t bits = std::bit_cast<uint32_t>(depth);
+    return bits >= lo.hi && bits <= hi.hi;
+  }
   bool add(FragmentNode key) {
     if (!remains(key)) return false;
     const uint64_t n = nearest.get();
@@ -196,6 +203,7 @@ struct PeelPasses {
   }
   /// The per-pixel step after a pass: the fragments it peeled (added to the pixel's count).
   static uint32_t endPass(Pixel* slot) { return slot->endPass(); }
+  static bool mayRemain(const Pixel* slot, float depth) { return slot->mayRemain(depth); }
   static bool remains(const Pixel* slot, float depth, uint32_t rgba) {
     return slot->remains(makeNode(depth, rgba));
   }

@@ -13,12 +13,14 @@
 // A peer whose capture is repeated a number of times decided at run time (depth peeling,
 // peel.hpp) also says
 //
-//   kRepeatsCapture  true: the engine runs the capture pass again and again; add() returns whether
-//                    the fragment is still to process (counted over the frame)
-//   endPass(slot)    the per-pixel step after each pass (blend the layer found, advance); returns
-//                    the fragments it took, added to the pixel's count
-//   remains(slot, depth, rgba)     after the last pass: the fragment was not taken (the hybrid
-//   tail) composite(slot, tail, bg)      the colour with the pixel's hybrid tail (null: none)
+//   kRepeatsCapture      true: the engine runs the capture pass again and again; add() returns
+//                        whether the fragment is still to process (counted over the frame)
+//   endPass(slot)        the per-pixel step after each pass (blend the layer found, advance);
+//                        returns the fragments it took, added to the pixel's count
+//   mayRemain(slot, z)   the early test before shading: false when the depth alone puts the
+//                        fragment outside what is still to process
+//   remains(slot, z, c)  after the last pass: the fragment was not taken (to the hybrid tail)
+//   composite(slot, tail, bg)  the colour with the pixel's hybrid tail (null: none)
 //
 // and the engine stops after the pass that took every fragment still to process, or after
 // MethodDesc::maxPeels passes; then, under MethodDesc::peelTail, one more pass adds the fragments
