@@ -85,7 +85,13 @@ TEST(PassPlan, TheCpuEngineRunsThePlanOfEveryPreset) {
       auto out = cpu.render(view, *method, options);
       ASSERT_TRUE(out.ok()) << out.error().message;
       Names ran;
-      for (const PassTime& t : out->stats.passes) ran.push_back(t.name);
+      for (const PassTime& t : out->stats.passes) {
+        // depth peeling's numbered passes are the plan's one entry "peel N"
+        const bool peelPass =
+            plan->peel && t.name.rfind("peel ", 0) == 0 && t.name != kPeelTailPass;
+        if (peelPass && !ran.empty() && ran.back() == kPeelPasses) continue;
+        ran.push_back(peelPass ? std::string(kPeelPasses) : t.name);
+      }
       EXPECT_EQ(ran, plan->names());
       EXPECT_EQ(out->depthComplexity.empty(),
                 !(plan->count || plan->oracle || plan->predictedCurves));

@@ -23,6 +23,8 @@
 #include "mfr/engine/render_views.hpp"
 #include "mfr/method/dkb_model.hpp"
 #include "mfr/method/make_method.hpp"
+#include "mfr/method/method_options.hpp"
+#include "mfr/method/peel.hpp"
 
 namespace mfr::cli {
 namespace {
@@ -35,10 +37,11 @@ struct CompareArgs {
   std::string methods =
       "fkb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,optimal,wboit,mboit,mboit6,mboit8,mboit-trig3,"
       "mboit-trig4,mboit-q16,mboit6-q16,mboit8-q16,mboit-trig3-q16,mboit-trig4-q16,mlab,aoit4,"
-      "aoit8,aoit16,linked-list";
+      "aoit8,aoit16,linked-list,peel,dual-peel";
   std::string model;
   std::string out;
-  std::string composite;  // empty: each preset's own rule
+  std::string composite;            // empty: each preset's own rule
+  std::optional<int64_t> maxPeels;  // --max-peels (peel, dual-peel)
   std::string capture = "tile";
   double pixelsPerDegree = kFlipDefaultPixelsPerDegree;
   double orbitStep = 0.0;  // --orbit N without --orbit-view: degrees between frames (0: 360 / N)
@@ -222,6 +225,24 @@ int run(const CompareArgs& a, const std::string& version) {
     if (!compositing) return fail("--composite: " + compositing.error().message);
     options.compositing = compositing.value();
   }
+  if (a.maxPeels) {  // checked by the one option check, on the first peeling method listed
+    bool used = false;
+    for (const std::string& name : options.methods) {
+      auto preset = methodPreset(name);
+      if (!preset || !peelingRule(preset->compositing)) continue;
+      MethodOverrides o;
+      o.maxPeels = a.maxPeels;
+      auto m = makeMethod(name, o);
+      if (!m) return fail(m.error().message);
+      options.maxPeels = m->maxPeels;
+      used = true;
+      break;
+    }
+    if (!used)
+      return fail("--max-peels: none of the methods peels (only " +
+                  std::string(methodOptionRule(MethodOption::MaxPeels).appliesTo) + ": " +
+                  presetsAccepting(MethodOption::MaxPeels) + ")");
+  }
   if (options.model)  // a model trained for the other compositing rule is refused up front
     if (auto fits =
             checkComparisonModel(*options.model, a.model, options.methods, options.compositing);
@@ -306,6 +327,9 @@ Runner addCompareCommand(CLI::App& app) {
                   "kbuffer or hybrid for every method (default: each preset's own rule, hybrid "
                   "for dkb* and optimal*, else kbuffer)");
   cmd->add_option("--capture", args->capture, "tile (default) or parallel");
+  cmd->add_option("--max-peels", args->maxPeels,
+                  "Depth peeling (peel, dual-peel): at most P geometry passes; the rest dropped, "
+                  "or with --composite hybrid blended into a tail (default: until none remains)");
   cmd->add_option("--model", args->model,
                   "Deep k-buffer model (.mfrnn, from mfr train; default: the built-in model)");
   cmd->add_option("--ppd", args->pixelsPerDegree, "FLIP pixels per degree (default 67.02)");

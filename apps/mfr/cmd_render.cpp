@@ -222,6 +222,11 @@ Runner addRenderCommand(CLI::App& app) {
                   "Occupancy map: 32*d buckets (default 1)" + appliesTo(MethodOption::OccupancyD));
   cmd->add_option("--capture", args->capture,
                   "tile (tile-owned, lock-free) or parallel (fragment-parallel, spin-locks)");
+  cmd->add_option("--max-peels", args->overrides.maxPeels,
+                  "Depth peeling: at most P geometry passes (dual-peel: 2P layers); the rest is "
+                  "dropped, or with --composite hybrid blended into a tail (default: until no "
+                  "fragment remains)" +
+                      appliesTo(MethodOption::MaxPeels));
   cmd->add_option(
       "--importance-map", args->importanceMap,
       "Write the importance map I(p) (colour-mapped PNG)" + appliesTo(MethodOption::ImportanceMap));

@@ -26,6 +26,8 @@ Runner addViewCommand(CLI::App& app) {
   cmd->add_option("--k", args->k, "Explicit k (otherwise derived from the budget)");
   cmd->add_option("--composite", args->composite, "kbuffer or hybrid (default: the preset's)");
   cmd->add_option("--occupancy-d", args->occupancyD, "+occupancy presets: bucket words d (1-64)");
+  cmd->add_option("--max-peels", args->maxPeels,
+                  "peel, dual-peel: at most P geometry passes (default: until none remains)");
   cmd->add_option("--model", args->model, "dkb*: network model (.mfrnn; default: built-in)");
   cmd->add_option("--mode", args->mode,
                   "View: image, depth, kmap, importance, truth, flip or wiper (default image)");

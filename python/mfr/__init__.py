@@ -111,7 +111,8 @@ _compare = _named_type_errors(_mfr._compare)
 DEFAULT_COMPARE_METHODS = ("fkb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "dkb-fill", "optimal",
                            "wboit", "mboit", "mboit6", "mboit8", "mboit-trig3", "mboit-trig4",
                            "mboit-q16", "mboit6-q16", "mboit8-q16", "mboit-trig3-q16",
-                           "mboit-trig4-q16", "mlab", "aoit4", "aoit8", "aoit16", "linked-list")
+                           "mboit-trig4-q16", "mlab", "aoit4", "aoit8", "aoit16", "linked-list",
+                           "peel", "dual-peel")
 
 
 def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1024, camera=None,
@@ -119,7 +120,7 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
            threads=0, seed=1, model=None, occupancy_d=None, importance=None, alpha=None,
            background=None, transmission_floor=0.1, shuffle_draw_order=None, gltf_scene=None,
            cull=None, engine="cpu", gl_sync="auto", gl_raster="native", memory_limit=None,
-           allow_outside_references=False, depth_complexity=True):
+           allow_outside_references=False, depth_complexity=True, max_peels=None):
     """Renders with one method, exactly as `mfr render` with the same options (the library checks
     both the same way: its errors name the Python argument where the CLI names its flag).
 
@@ -153,6 +154,8 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
         of the physical memory, the address-space limit and the cgroup limit, as
         `mfr --memory-limit`). allow_outside_references: as `mfr --allow-outside-references`.
     depth_complexity: also count the fragments per pixel when the method does not.
+    max_peels: depth peeling (peel, dual-peel): at most this many geometry passes, as
+        `mfr render --max-peels` (the rest dropped, or with composite="hybrid" blended into a tail).
 
     Returns an mfr.RenderResult (a list of them with orbit and no orbit_view): image (float32
     (h, w, 3) linear RGB), srgb (uint8 (h, w, 4), the PNG's pixels), k_map (uint32 (h, w); None
@@ -168,7 +171,7 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
                    shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
                    engine=engine, gl_sync=gl_sync, gl_raster=gl_raster, memory_limit=memory_limit,
                    allow_outside_references=allow_outside_references,
-                   depth_complexity=depth_complexity)
+                   depth_complexity=depth_complexity, max_peels=max_peels)
 
 
 def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_METHODS, width=1024,

@@ -62,8 +62,10 @@ py::array viewOf(const Scalar* data, std::vector<py::ssize_t> shape, py::handle 
 /// The method as `mfr render` builds it from the same options: the library's makeMethod.
 MethodDesc buildMethod(const std::string& name, const py::object& k, const py::object& composite,
                        const py::object& model, const py::object& occupancyD,
-                       const py::object& importance, uint64_t seed) {
+                       const py::object& importance, uint64_t seed,
+                       const py::object& maxPeels = py::none()) {
   MethodOverrides o;
+  if (!maxPeels.is_none()) o.maxPeels = castArgument<long long>(maxPeels, "max_peels");
   if (!k.is_none()) o.k = castArgument<long long>(k, "k");
   if (!composite.is_none()) {
     o.composite = castArgument<std::string>(composite, "composite");
@@ -119,13 +121,14 @@ py::object renderScene(
     const py::object& background, double transmissionFloor, const py::object& shuffleDrawOrder,
     const py::object& gltfScene, const py::object& cull, const std::string& engineName,
     const std::string& glSync, const std::string& glRaster, const py::object& memoryLimitArg,
-    bool allowOutsideReferences, bool wantDepthComplexity) {
+    bool allowOutsideReferences, bool wantDepthComplexity, const py::object& maxPeels) {
   const std::optional<uint64_t> memoryLimit = memoryLimitArgument(memoryLimitArg);
   const SceneRequest request =
       sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
                            transmissionFloor, shuffleDrawOrder, gltfScene, cull);
   unwrap(checkThreads(threads, "threads"));
-  const MethodDesc m = buildMethod(method, k, composite, model, occupancyD, importance, seed);
+  const MethodDesc m =
+      buildMethod(method, k, composite, model, occupancyD, importance, seed, maxPeels);
   RenderOptions options;
   std::optional<BudgetSpec> spec;
   if (!budget.is_none()) spec = budgetSpecArgument(budget);
@@ -348,6 +351,7 @@ lines are not rendered: Scene.primitives_skipped counts them.)");
         py::arg("cull") = py::none(), py::arg("engine") = "cpu", py::arg("gl_sync") = "auto",
         py::arg("gl_raster") = "native", py::arg("memory_limit") = py::none(),
         py::arg("allow_outside_references") = false, py::arg("depth_complexity") = true,
+        py::arg("max_peels") = py::none(),
         R"(Renders a scene (an mfr.Scene, or a source string loaded with `seed`) with one method, as
 `mfr render` does with the same options, and returns an mfr.RenderResult (a list of them for an
 orbit of several views). See mfr.render's Python documentation (python/mfr/__init__.py) for the

@@ -140,6 +140,9 @@ CASES = [
     (dict(method="kplus-heap", k=2, composite="hybrid", engine="gl", gl_raster="exact"),
      ["-m", "kplus-heap", "--k", "2", "--composite", "hybrid", "--engine", "gl", "--gl-raster",
       "exact"]),
+    (dict(method="peel", max_peels=2), ["-m", "peel", "--max-peels", "2"]),
+    (dict(method="dual-peel", max_peels=1, composite="hybrid"),
+     ["-m", "dual-peel", "--max-peels", "1", "--composite", "hybrid"]),
 ]
 
 
@@ -351,6 +354,9 @@ def test_errors_carry_the_librarys_messages(tmp_path, cli_error):
     (dict(method="fkb", k=0), r"^k: must be in \[1, 1048576\]"),
     (dict(method="zbuffer", k=2), r"^k: zbuffer has k = 1"),
     (dict(method="fkb", k=2, occupancy_d=2), r"^occupancy_d: does not apply to fkb"),
+    (dict(method="fkb", k=2, max_peels=2), r"^max_peels: does not apply to fkb"),
+    (dict(method="peel", max_peels=0), r"^max_peels: must be in \[1, 65536\]$"),
+    (dict(method="dual-peel", max_peels=-3), r"^max_peels: must be in \[1, 65536\]$"),
     (dict(method="vkb", budget="1MB", model="x.mfrnn"), r"^model: does not apply to vkb"),
     (dict(method="fkb", k=2, importance={"alpha": 0.5}), r"^importance: does not apply to fkb"),
     (dict(method="vkb", budget="1MB", importance={"colour": 1}), r"unknown parameter 'colour'"),
@@ -428,6 +434,7 @@ def test_wrong_types_raise_type_error():
     (dict(method="fkb", k=2.5), "k: expected an integer, got float"),
     (dict(method="fkb+occupancy", budget="1MB", occupancy_d="x"),
      "occupancy_d: expected an integer, got str"),
+    (dict(method="peel", max_peels="4"), "max_peels: expected an integer, got str"),
     (dict(camera=[0, 0, 3, 0, 0, "z"]), "camera[5]: expected a number, got str"),
     (dict(camera=5), "camera: expected 6, 9 or 10 numbers or a str, got int"),
     (dict(view="first"), "view: expected an integer, got str"),

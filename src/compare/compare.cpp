@@ -2,6 +2,8 @@
 // results as JSON and CSV (the HTML page is in report_html.cpp).
 #include "mfr/compare/compare.hpp"
 
+#include "mfr/method/peel.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -130,6 +132,11 @@ Result<std::vector<MethodDesc>> comparedMethods(const CompareOptions& options) {
     // mlab) keep their own (each run records the rule it used)
     if (options.compositing && kBufferFamilyRule(m.compositing))
       m.compositing = *options.compositing;
+    // depth peeling: --max-peels bounds its passes, hybrid blends what remains into a tail
+    if (peelingRule(m.compositing)) {
+      m.maxPeels = options.maxPeels;
+      m.peelTail = options.compositing == Compositing::Hybrid;
+    }
     m.importance.seed = options.seed;
     m.model = options.model;
     methods.push_back(m);

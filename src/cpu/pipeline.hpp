@@ -161,6 +161,18 @@ void allocatePeerStores(const MethodDesc& method, const Allocation& allocation, 
                         Stores& stores);
 void runPeerPass(const RasterFrame& frame, const MethodDesc& method, const Allocation& allocation,
                  CaptureMode mode, Stores& stores, int pass);
+/// Depth peeling (peerRepeatsCapture): one geometry pass `pass` and each pixel's step after it;
+/// the fragments generated, those still in range (not peeled before the pass) and those the step
+/// peeled. Every fragment in range was peeled when inRange == peeled.
+struct PeelPassCounters {
+  uint64_t generated = 0, inRange = 0, peeled = 0;
+};
+PeelPassCounters runPeelPass(const RasterFrame& frame, const MethodDesc& method,
+                             const Allocation& allocation, CaptureMode mode, Stores& stores,
+                             int pass);
+/// After the last peel pass: the fragments that remain into the pixels' hybrid tails.
+void runPeelTail(const RasterFrame& frame, const MethodDesc& method, const Allocation& allocation,
+                 CaptureMode mode, Stores& stores);
 CaptureCounters capturePeer(const RasterFrame& frame, const MethodDesc& method,
                             const Allocation& allocation, CaptureMode mode, Stores& stores);
 ImageRGB resolvePeer(const RasterFrame& frame, const MethodDesc& method,

@@ -36,22 +36,25 @@ const char*& currentPass() {
 class PassTimer {
  public:
   explicit PassTimer(std::vector<PassTime>& passes) : passes_(passes) {}
+  /// `name`: a static string (the out-of-memory error may name it after the pass); `recorded`:
+  /// the name the statistics keep, when it differs (depth peeling's numbered passes).
   template <class Fn>
-  auto run(const char* name, Fn&& fn) {
+  auto run(const char* name, Fn&& fn, const std::string& recorded = {}) {
     currentPass() = name;
+    const std::string& kept = recorded.empty() ? std::string(name) : recorded;
     const auto start = std::chrono::steady_clock::now();
     if constexpr (std::is_void_v<decltype(fn())>) {
       fn();
-      record(name, start);
+      record(kept, start);
     } else {
       auto result = fn();
-      record(name, start);
+      record(kept, start);
       return result;
     }
   }
 
  private:
-  void record(const char* name, std::chrono::steady_clock::time_point start) {
+  void record(const std::string& name, std::chrono::steady_clock::time_point start) {
     const std::chrono::duration<double, std::milli> d = std::chrono::steady_clock::now() - start;
     passes_.push_back({name, d.count()});
   }
@@ -314,7 +317,7 @@ void clearStores(const MethodDesc& method, const RenderOptions& options, const A
     std::fill(stores.nodes.data(), stores.nodes.data() + alloc.slots, FragmentNode{0});
   stores.counts.assign(pixels, 0);
   if (options.capture == CaptureMode::FragmentParallel && !lists) stores.locks.assign(pixels, 0);
-  if (method.compositing == Compositing::Hybrid) stores.tails.allocate(pixels);
+  if (method.compositing == Compositing::Hybrid || method.peelTail) stores.tails.allocate(pixels);
   ledger.addBytes("nodes", stores.nodes.size() * sizeof(FragmentNode));
   ledger.addBytes("nodes", stores.pool.size() * sizeof(LinkedNode));
   ledger.add("heads", stores.heads);
@@ -322,6 +325,35 @@ void clearStores(const MethodDesc& method, const RenderOptions& options, const A
   ledger.add("locks", stores.locks);
   ledger.addBytes("tail", stores.tails.bytes());
   ledger.addBytes(stores.peerHoldsNodes ? "nodes" : "accumulators", stores.peer.bytes());
+}
+
+/// Depth peeling's capture: peel passes until one takes every fragment still in range (or
+/// maxPeels of them), then under peelTail the fragments left into the tails.
+detail::CaptureCounters peelStep(const RasterFrame& frame, const MethodDesc& method,
+                                 const RenderOptions& options, const PassPlan& plan,
+                                 const Allocation& alloc, detail::Stores& stores, PassTimer& timer,
+                                 RenderStats& stats) {
+  detail::CaptureCounters c;
+  uint32_t passes = 0;
+  bool remaining = true;
+  while (remaining && (!plan.maxPeels || passes < *plan.maxPeels)) {
+    const detail::PeelPassCounters pc = timer.run(
+        "peel",
+        [&] {
+          return detail::runPeelPass(frame, method, alloc, options.capture, stores,
+                                     static_cast<int>(passes));
+        },
+        peelPassName(passes));
+    if (passes == 0) c.generated = pc.generated;
+    c.inserted += pc.peeled;
+    ++passes;
+    remaining = pc.peeled < pc.inRange;
+  }
+  stats.peelPasses = passes;
+  if (remaining && plan.tail)
+    timer.run(kPeelTailPass,
+              [&] { detail::runPeelTail(frame, method, alloc, options.capture, stores); });
+  return c;
 }
 
 /// The capture's counters and what only the CPU engine measures, beside fillSharedStats.
@@ -395,11 +427,14 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
   // capture
   out.stats.isa = std::string(isaName(detail::captureIsaFor(method, options.capture)));
   const bool lists = method.store == StoreChoice::LinkedList;
-  const detail::CaptureCounters counters = timer.run("capture", [&] {
-    if (lists) return detail::captureLinkedList(frame, method, alloc, stores, ledger);
-    return detail::capture(frame, method, alloc, plan.occupancy ? &occupancy : nullptr,
-                           options.capture, stores);
-  });
+  const detail::CaptureCounters counters =
+      plan.peel
+          ? peelStep(frame, method, options, plan, alloc, stores, timer, out.stats)
+          : timer.run("capture", [&] {
+              if (lists) return detail::captureLinkedList(frame, method, alloc, stores, ledger);
+              return detail::capture(frame, method, alloc, plan.occupancy ? &occupancy : nullptr,
+                                     options.capture, stores);
+            });
   if (lists) alloc.capacity = stores.counts;  // k(p): the nodes each list got
 
   // resolve

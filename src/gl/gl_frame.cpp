@@ -4,6 +4,9 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <bit>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "gl/gl_state.hpp"
@@ -12,6 +15,7 @@
 #include "mfr/gl/shared_layout.h"
 #include "mfr/method/aoit.hpp"
 #include "mfr/method/mboit.hpp"
+#include "mfr/method/pass_plan.hpp"
 
 namespace mfr::gl {
 namespace {
@@ -28,6 +32,7 @@ bool countPassFirst(GlTechnique t) {
     case GlTechnique::Mlab:
     case GlTechnique::Aoit:
     case GlTechnique::LinkedList:
+    case GlTechnique::Peel:
       return false;
   }
   return false;
@@ -44,6 +49,7 @@ bool fragmentNodes(GlTechnique t) {
     case GlTechnique::Mlab:        // (mlab's nodes are merged layers, not fragments)
     case GlTechnique::Aoit:        // (aoit's are visibility steps)
     case GlTechnique::LinkedList:  // (read by walking the lists: readLists)
+    case GlTechnique::Peel:
       return false;
   }
   return false;
@@ -61,6 +67,11 @@ uint32_t mboitWords(const MethodDesc& m) {
 // the AOIT technique's floats per pixel: N nodes of (depth, transmittance), the colour sum
 uint32_t aoitWords(const MethodDesc& m) {
   return kAoitNodeWords * static_cast<uint32_t>(aoitNodeCount(m.compositing)) + kAoitColorWords;
+}
+
+// depth peeling's words per pixel (peel.frag)
+uint32_t peelWords(const MethodDesc& m) {
+  return m.compositing == Compositing::DualPeel ? kDualPeelWords : kPeelWords;
 }
 
 // bytes per pixel of the frame's largest per-pixel buffer (each must fit one storage block)
@@ -82,6 +93,8 @@ uint64_t largestPerPixelBytes(const RenderPlan& p) {
       return std::max<uint64_t>(12, aoitWords(p.method) * 4);
     case GlTechnique::LinkedList:
       return std::max<uint64_t>(12, p.hybrid ? kTailWords * 4 : 0);
+    case GlTechnique::Peel:
+      return std::max<uint64_t>({12, peelWords(p.method) * 4, p.hybrid ? kTailWords * 4 : 0});
   }
   return 12;
 }
@@ -94,7 +107,7 @@ struct GlEngine::State::FrameRun {
   const RenderPlan& plan;
   GlRenderOutput& out;
   FrameBuffers fb;
-  GLuint counts = 0, offsets = 0, nodes = 0, tails = 0, accum = 0, image = 0, heads = 0;
+  GLuint counts = 0, offsets = 0, nodes = 0, tails = 0, accum = 0, image = 0, heads = 0, peeled = 0;
   uint64_t nodeCount = 0;
   bool countInCapture = false;  // the capture adds n(p) (no count pass ran)
 
@@ -441,6 +454,94 @@ struct GlEngine::State::FrameRun {
     }
   }
 
+  // depth peeling (peel.frag, peel_step.comp): passes until one peels every fragment still in
+  // range (the frame's two counters read back after each) or --max-peels, then under hybrid the
+  // tail pass when fragments remain
+  void capturePeel() {
+    const MethodDesc& method = plan.method;
+    const uint32_t pixels = plan.pixels;
+    const bool dual = method.compositing == Compositing::DualPeel;
+    const uint32_t words = peelWords(method);
+    accum = fb.make("accumulators", uint64_t{pixels} * words * 4);
+    {  // mfr::PeelPixel / mfr::DualPeelPixel's initial words
+      std::vector<uint32_t> init(uint64_t{pixels} * words, 0u);
+      const uint32_t one = std::bit_cast<uint32_t>(1.0f), none = 0xffffffffu;
+      for (uint64_t w = 0; w < init.size(); w += words) {
+        if (dual) {
+          init[w + 2] = init[w + 3] = init[w + 4] = init[w + 5] = none;  // hi, nearest
+          init[w + 13] = init[w + 17] = one;                             // front T, back T
+        } else {
+          init[w + 2] = init[w + 3] = none;  // candidate
+          init[w + 8] = one;                 // T
+        }
+      }
+      glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
+    }
+    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+    clearUint(locks, kLockFree);
+    peeled = fb.make("peeled", uint64_t{pixels} * 4);  // fragments peeled per pixel (statistics)
+    clearUint(peeled, 0);
+    const GLuint stats = fb.make("capture counters", 8);
+    if (plan.hybrid) {
+      tails = fb.make("tails", uint64_t{pixels} * kTailWords * 4);
+      clearUint(tails, 0);
+    }
+    const GLuint draw = s.program(ProgramId::Peel), step = s.program(ProgramId::PeelStep);
+    glProgramUniform1ui(draw, loc(draw, "uDual"), dual ? 1u : 0u);
+    glProgramUniform1ui(step, loc(step, "uDual"), dual ? 1u : 0u);
+    glProgramUniform1ui(step, loc(step, "uPixels"), pixels);
+    glProgramUniform1f(step, loc(step, "uInv255"), 1.0f / 255.0f);
+    const auto geometry = [&](bool tail) {
+      useCapture(draw);
+      glProgramUniform1ui(draw, loc(draw, "uTail"), tail ? 1u : 0u);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCaptureStats, stats);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTails, tails ? tails : stats);
+      fb.bindImage(locks, kBindLocks);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    };
+    const std::optional<uint32_t> maxPeels = method.maxPeels;
+    uint32_t passes = 0;
+    bool remaining = true;
+    while (remaining && (!maxPeels || passes < *maxPeels) && !fb.failure) {
+      clearUint(stats, 0);
+      const std::string name = peelPassName(passes);
+      pass(name.c_str(), [&] {
+        geometry(false);
+        glUseProgram(step);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCaptureStats, stats);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindOffsets, peeled);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
+        dispatchPixels();
+      });
+      countInCapture = false;         // n(p) once, in the first pass
+      uint32_t counters[2] = {0, 0};  // fragments in range, fragments peeled
+      glGetNamedBufferSubData(stats, 0, 8, counters);
+      ++passes;
+      remaining = counters[1] < counters[0];
+    }
+    out.peelPasses = passes;
+    if (remaining && plan.hybrid) pass(kPeelTailPass, [&] { geometry(true); });
+  }
+
+  // depth peeling: the front layers over [the tail over] [the back layers over] the background
+  void resolvePeel() {
+    image = fb.make("image", uint64_t{plan.pixels} * 12);
+    pass("resolve", [&] {
+      const GLuint p = s.program(ProgramId::PeelResolve);
+      useResolve(p);
+      glProgramUniform1ui(p, loc(p, "uDual"),
+                          plan.method.compositing == Compositing::DualPeel ? 1u : 0u);
+      glProgramUniform1ui(p, loc(p, "uHybrid"), plan.hybrid ? 1u : 0u);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : accum);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+      dispatchPixels();
+    });
+  }
+
   // mlab: its nodes front to back over the background
   void resolveMlab() {
     image = fb.make("image", uint64_t{plan.pixels} * 12);
@@ -528,6 +629,10 @@ struct GlEngine::State::FrameRun {
     out.image = ImageRGB(s.width, s.height);
     glGetNamedBufferSubData(image, 0, uint64_t{pixels} * 12ll, out.image.pixels.data());
     if (options.readNodes && fragmentNodes(plan.technique)) readNodes();
+    if (peeled) {  // depth peeling: the fragments it peeled, per pixel
+      out.held.resize(pixels);
+      glGetNamedBufferSubData(peeled, 0, uint64_t{pixels} * 4ll, out.held.data());
+    }
     if (plan.technique == GlTechnique::LinkedList) {
       out.held.resize(pixels);
       glGetNamedBufferSubData(offsets, 0, uint64_t{pixels} * 4ll, out.held.data());
@@ -603,6 +708,9 @@ Result<RenderPlan> GlEngine::State::planRender(const MethodDesc& method,
       if (plan.allocSlots * kListNodeWords * 4 > maxBlockBytes)
         return tooLarge(method, "node pool", plan.allocSlots * kListNodeWords * 4);
       break;
+    case GlTechnique::Peel:
+      plan.hybrid = method.peelTail;
+      break;
     case GlTechnique::KBuffer:
       plan.perPixel = alloc != nullptr || device;
       plan.allocSlots = device ? deviceSlots : alloc ? alloc->slots : 0;
@@ -671,6 +779,10 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       case GlTechnique::LinkedList:
         frame.captureList();
         frame.resolveList();
+        break;
+      case GlTechnique::Peel:
+        frame.capturePeel();
+        frame.resolvePeel();
         break;
     }
     MFR_TRY(frame.checkErrors());

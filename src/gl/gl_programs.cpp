@@ -113,6 +113,9 @@ constexpr ProgramRow kPrograms[] = {
     {ProgramId::AoitResolve, "aoit_resolve.comp", Stages::Compute, Prelude::None},
     {ProgramId::ListCapture, "capture_list.frag", Stages::Raster, Prelude::None},
     {ProgramId::ListResolve, "resolve_list.comp", Stages::Compute, Prelude::None},
+    {ProgramId::Peel, "peel.frag", Stages::Raster, Prelude::None},
+    {ProgramId::PeelStep, "peel_step.comp", Stages::Compute, Prelude::None},
+    {ProgramId::PeelResolve, "peel_resolve.comp", Stages::Compute, Prelude::None},
 };
 constexpr bool rowsInIdOrder() {
   if (std::size(kPrograms) != kProgramCount) return false;

@@ -49,8 +49,11 @@ enum class ProgramId : uint8_t {
   AoitResolve,      // aoit_resolve.comp
   ListCapture,      // capture_list.frag (per-pixel linked lists)
   ListResolve,      // resolve_list.comp
+  Peel,             // peel.frag (depth peeling's passes and tail pass)
+  PeelStep,         // peel_step.comp (between peel passes)
+  PeelResolve,      // peel_resolve.comp
 };
-inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::ListResolve) + 1;
+inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::PeelResolve) + 1;
 
 /// The linked programs of one engine, deleted with it (in the context current then).
 class Programs {

@@ -310,10 +310,12 @@ class GlFrame {
     // stores hold min(n(p), k(p)) of the n(p) the capture counted
     const bool counted = plan_.count || plan_.oracle || plan_.predictedCurves;
     static const std::vector<uint32_t> none;
+    // (depth peeling holds the fragments it peeled, counted per pixel by peel_step.comp)
     fillSharedStats(
         SharedMeasures{method_, memory_, a, counted ? g.counts : none, g.held,
                        g.held.empty() ? g.counts : none, g.fragments, options_.budgetBytes},
         s);
+    s.peelPasses = g.peelPasses;
     s.bytesAllocatedByCategory = g.bufferBytes;
     s.bytesAllocated = g.totalBufferBytes();
     s.culledOccupancy = g.culledOccupancy;

@@ -40,6 +40,12 @@ constexpr GlTechniqueInfo kTechniques[] = {
      "lost or hybrid tail) -> resolve (walk, selection sort in place, kbuffer or hybrid)",
      "capture_list.frag", "resolve_list.comp",
      "head 4 B [+ tail 20 B]; per image: pool counter 4 B + F(M) nodes of 12 B", "linked-list"},
+    {GlTechnique::Peel, "peel",
+     "peel passes (the nearest [and farthest] key under the lock, then peel_step.comp blends it "
+     "and advances the bounds) until a pass peels every fragment in range or --max-peels -> "
+     "[tail pass] -> resolve",
+     "peel.frag (+ peel_step.comp)", "peel_resolve.comp",
+     "state 36 B (peel) or 72 B (dual-peel) + lock 4 B [+ tail 20 B]", "peel, dual-peel"},
 };
 
 constexpr bool rowsInEnumOrder() {
@@ -123,6 +129,12 @@ std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
           m.occupancyWords != 0)
         return std::nullopt;
       return GlTechnique::Aoit;
+    case Compositing::Peel:
+    case Compositing::DualPeel:
+      if (m.allocation != AllocationPolicy::NoNodes || m.store != StoreChoice::None ||
+          m.occupancyWords != 0)
+        return std::nullopt;
+      return GlTechnique::Peel;
   }
   return std::nullopt;
 }
@@ -144,10 +156,12 @@ const char* toString(GlTechnique technique) {
 Result<GlTechnique> classifyGl(const MethodDesc& method) {
   const std::optional<GlTechnique> t = techniqueOf(method);
   if (!t || method.occupancyWords < 0 || method.occupancyWords > 64)
-    return makeError("--engine gl: method " + method.name +
-                     " is not in the GL engine (it runs the A-buffer; the k-buffer family with a "
-                     "fixed k or a per-pixel k(p), max-array or max-heap stores, occupancy culling "
-                     "and kbuffer or hybrid compositing; wboit; mboit; mlab; aoit; linked-list)");
+    return makeError(
+        "--engine gl: method " + method.name +
+        " is not in the GL engine (it runs the A-buffer; the k-buffer family with a "
+        "fixed k or a per-pixel k(p), max-array or max-heap stores, occupancy culling "
+        "and kbuffer or hybrid compositing; wboit; mboit; mlab; aoit; linked-list; peel, "
+        "dual-peel)");
   return *t;
 }
 

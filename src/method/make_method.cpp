@@ -9,6 +9,7 @@
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/dkb_model.hpp"
 #include "mfr/method/method_options.hpp"
+#include "mfr/method/peel.hpp"
 
 namespace mfr {
 namespace {
@@ -131,7 +132,10 @@ Result<MethodDesc> makeMethod(const std::string& name, const MethodOverrides& o,
     if (*applies) {
       auto rule = parseCompositing(o.composite);
       if (!rule) return makeError(flag("--composite") + ": " + rule.error().message);
-      m.compositing = rule.value();
+      if (peelingRule(m.compositing))  // depth peeling keeps its rule: hybrid adds the tail
+        m.peelTail = rule.value() == Compositing::Hybrid;
+      else
+        m.compositing = rule.value();
     }
   }
   if (o.occupancyD) {
@@ -141,6 +145,16 @@ Result<MethodDesc> makeMethod(const std::string& name, const MethodOverrides& o,
       if (*o.occupancyD < 1 || *o.occupancyD > 64)
         return makeError(flag("--occupancy-d") + ": must be in [1, 64]");
       m.occupancyWords = static_cast<int>(*o.occupancyD);
+    }
+  }
+  if (o.maxPeels) {
+    auto applies = takes(MethodOption::MaxPeels, m, o, flag("--max-peels"));
+    if (!applies) return applies.error();
+    if (*applies) {
+      if (*o.maxPeels < 1 || *o.maxPeels > kMaxPeels)
+        return makeError(flag("--max-peels") + ": must be in [1, " + std::to_string(kMaxPeels) +
+                         "]");
+      m.maxPeels = static_cast<uint32_t>(*o.maxPeels);
     }
   }
   if (const std::string given = o.importance.firstGiven(); !given.empty() || o.importance.asGroup) {

@@ -12,7 +12,7 @@ MemoryModel MemoryModel::of(const MethodDesc& method, bool fragmentParallel) {
   m.offset = prefixSum ? 4 : 0;
   m.lock = method.perPixelLock || fragmentParallel ? 4 : 0;
   m.occupancy = method.occupancyWords > 0 ? occupancyBytesPerPixel(method.occupancyWords) : 0;
-  m.tail = method.compositing == Compositing::Hybrid ? 20 : 0;
+  m.tail = method.compositing == Compositing::Hybrid || method.peelTail ? 20 : 0;
   m.previous = method.allocation == AllocationPolicy::Importance &&
                        method.importanceSource == ImportanceSource::Heuristic
                    ? 1

@@ -1,6 +1,8 @@
 // The table of method options and the presets they apply to (method_options.hpp).
 #include "mfr/method/method_options.hpp"
 
+#include "mfr/method/peel.hpp"
+
 namespace mfr {
 namespace {
 
@@ -40,7 +42,11 @@ bool occupancy(const MethodDesc& m) {
 }
 
 bool kBufferFamily(const MethodDesc& m) {
-  return kBufferFamilyRule(m.compositing);
+  return kBufferFamilyRule(m.compositing) || peelingRule(m.compositing);
+}
+
+bool peeling(const MethodDesc& m) {
+  return peelingRule(m.compositing);
 }
 
 }  // namespace
@@ -58,8 +64,11 @@ const std::vector<MethodOptionRule>& methodOptionRules() {
        "--importance-alpha/--n-limit/--periphery-d/--fovea/--noise/--no-*-term/"
        "--importance-factors",
        "the variable k-buffer's heuristic importance", heuristicImportance},
-      {MethodOption::Composite, "--composite", "the k-buffer family (kbuffer / hybrid rules)",
+      {MethodOption::Composite, "--composite",
+       "the k-buffer family (kbuffer / hybrid rules) and depth peeling (hybrid: a tail after "
+       "--max-peels)",
        kBufferFamily},
+      {MethodOption::MaxPeels, "--max-peels", "depth peeling", peeling},
   };
   return rules;
 }

@@ -44,6 +44,10 @@ Result<void> checkComposition(const MethodDesc& m) {
 
 }  // namespace
 
+std::string peelPassName(uint32_t index) {
+  return "peel " + std::to_string(index + 1);
+}
+
 std::vector<std::string> PassPlan::names() const {
   std::vector<std::string> n;
   if (count) n.push_back("count");
@@ -60,7 +64,7 @@ std::vector<std::string> PassPlan::names() const {
   if (occupancy)
     for (const char* pass : {"depth_range", "occupancy_fill", "occupancy_count"}) n.push_back(pass);
   for (const std::string& pass : peerPasses) n.push_back(pass);
-  n.push_back("capture");
+  n.push_back(peel ? kPeelPasses : "capture");
   n.push_back("resolve");
   return n;
 }
@@ -81,10 +85,17 @@ Result<PassPlan> planPasses(const MethodDesc& m, const RenderOptions& options) {
                m.allocation != AllocationPolicy::NoNodes && !optimal;
   if (plan.networkImportance && !options.budgetBytes) return makeError(m.name + ": needs a budget");
   plan.occupancy = m.occupancyWords > 0;
-  plan.tail = m.compositing == Compositing::Hybrid;
+  plan.tail = m.compositing == Compositing::Hybrid || m.peelTail;
   visitPeer(m.compositing, [&]<class Peer>() {
     for (const char* pass : Peer::kExtraPasses) plan.peerPasses.push_back(pass);
+    plan.peel = peerRepeatsCapture<Peer>();
   });
+  if (!plan.peel && (m.maxPeels || m.peelTail))
+    return makeError(m.name +
+                     ": --max-peels and the peeled hybrid tail apply to depth peeling "
+                     "(peel, dual-peel) only");
+  if (m.maxPeels && *m.maxPeels == 0) return makeError(m.name + ": --max-peels must be >= 1");
+  plan.maxPeels = m.maxPeels;
   return plan;
 }
 

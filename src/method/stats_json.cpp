@@ -36,6 +36,7 @@ nlohmann::json statsToJson(const RenderStats& s) {
   if (!s.isa.empty()) j["isa"] = s.isa;
   for (const auto& [name, value] : s.engineCounters) j["engine_counters"][name] = value;
   j["total_ms"] = s.totalMs();
+  if (s.peelPasses) j["peel_passes"] = *s.peelPasses;
   if (s.oracle) {
     const OracleReport& o = *s.oracle;
     j["oracle_error"] = o.error;

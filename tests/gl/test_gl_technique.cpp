@@ -16,24 +16,25 @@ using namespace mfr::gl;
 
 // what each preset is, written from the papers rather than from classifyGl's rules
 GlTechnique expectedTechnique(const std::string& preset) {
-  static const std::map<std::string, GlTechnique> peers = {
-      {"abuffer", GlTechnique::ABuffer},
-      {"wboit", GlTechnique::Wboit},
-      {"mboit", GlTechnique::Mboit},
-      {"mboit6", GlTechnique::Mboit},
-      {"mboit8", GlTechnique::Mboit},
-      {"mlab", GlTechnique::Mlab},
-      {"mboit-trig3", GlTechnique::Mboit},
-      {"mboit-trig4", GlTechnique::Mboit},
-      {"mboit-q16", GlTechnique::Mboit},
-      {"mboit6-q16", GlTechnique::Mboit},
-      {"mboit8-q16", GlTechnique::Mboit},
-      {"mboit-trig3-q16", GlTechnique::Mboit},
-      {"mboit-trig4-q16", GlTechnique::Mboit},
-      {"aoit4", GlTechnique::Aoit},
-      {"aoit8", GlTechnique::Aoit},
-      {"aoit16", GlTechnique::Aoit},
-      {"linked-list", GlTechnique::LinkedList}};
+  static const std::map<std::string, GlTechnique> peers = {{"abuffer", GlTechnique::ABuffer},
+                                                           {"wboit", GlTechnique::Wboit},
+                                                           {"mboit", GlTechnique::Mboit},
+                                                           {"mboit6", GlTechnique::Mboit},
+                                                           {"mboit8", GlTechnique::Mboit},
+                                                           {"mlab", GlTechnique::Mlab},
+                                                           {"mboit-trig3", GlTechnique::Mboit},
+                                                           {"mboit-trig4", GlTechnique::Mboit},
+                                                           {"mboit-q16", GlTechnique::Mboit},
+                                                           {"mboit6-q16", GlTechnique::Mboit},
+                                                           {"mboit8-q16", GlTechnique::Mboit},
+                                                           {"mboit-trig3-q16", GlTechnique::Mboit},
+                                                           {"mboit-trig4-q16", GlTechnique::Mboit},
+                                                           {"aoit4", GlTechnique::Aoit},
+                                                           {"aoit8", GlTechnique::Aoit},
+                                                           {"aoit16", GlTechnique::Aoit},
+                                                           {"linked-list", GlTechnique::LinkedList},
+                                                           {"peel", GlTechnique::Peel},
+                                                           {"dual-peel", GlTechnique::Peel}};
   const auto it = peers.find(preset);
   return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
 }
@@ -53,7 +54,7 @@ TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
     EXPECT_EQ(*tc, GlTechnique::KBuffer) << name << "+occupancy";
     ++occupancyForms;
   }
-  EXPECT_EQ(presets, 30);  // 13 of the k-buffer family, the A-buffer, linked-list, 15 peers
+  EXPECT_EQ(presets, 32);  // 13 of the k-buffer family, the A-buffer, linked-list, 17 peers
   EXPECT_EQ(occupancyForms, 13);
 }
 
@@ -71,7 +72,7 @@ TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
 
 TEST(GlTechnique, TableRowsFollowTheEnum) {
   const auto rows = glTechniques();
-  ASSERT_EQ(rows.size(), 7u);
+  ASSERT_EQ(rows.size(), 8u);
   for (size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(static_cast<size_t>(rows[i].technique), i);
     EXPECT_EQ(&techniqueInfo(rows[i].technique), &rows[i]);
@@ -120,6 +121,9 @@ TEST(GlTechnique, CombinationsOutsideTheGlEngineAreOneLineErrors) {
   m = methodPreset("mboit").value();
   m.allocation = AllocationPolicy::FixedK;
   expectRefused(m, "mboit-nodes");
+  m = methodPreset("peel").value();
+  m.allocation = AllocationPolicy::FixedK;
+  expectRefused(m, "peel-nodes");
 }
 
 }  // namespace

@@ -53,6 +53,7 @@ Result<MethodDesc> settingsMethod(const ViewSettings& s) {
   if (s.k > 0) o.k = s.k;
   if (!s.composite.empty()) o.composite = s.composite;
   if (s.occupancyD > 0) o.occupancyD = s.occupancyD;
+  if (s.maxPeels > 0) o.maxPeels = s.maxPeels;
   if (!s.model.empty()) o.modelPath = s.model;
   o.importance = ImportanceOverrides::all(s.importance);
   o.seed = s.importance.seed;

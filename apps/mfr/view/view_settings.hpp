@@ -17,6 +17,7 @@ struct ViewSettings {
   uint64_t budgetBytes = 0;        // 0: no budget
   uint32_t k = 0;                  // 0: derived from the budget
   int occupancyD = 0;              // +occupancy presets: bucket words d (0: the preset's)
+  int maxPeels = 0;                // peel, dual-peel: at most this many passes (0: unbounded)
   ImportanceParams importance;     // vkb*: Eq. 3-6 parameters and factor switches
   std::string model;               // dkb*: a .mfrnn network (empty: the built-in one)
   ViewMode mode = ViewMode::Image;

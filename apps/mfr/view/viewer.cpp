@@ -25,6 +25,7 @@
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/method.hpp"
+#include "mfr/method/peel.hpp"
 #include "panel.hpp"
 #include "script.hpp"
 
@@ -70,6 +71,8 @@ std::string methodParameters(const ViewSettings& s) {
   const MethodDesc& m = preset.value();
   if (m.occupancyWords > 0 && s.occupancyD > 0)
     cmd += " --occupancy-d " + std::to_string(s.occupancyD);
+  if (peelingRule(m.compositing) && s.maxPeels > 0)
+    cmd += " --max-peels " + std::to_string(s.maxPeels);
   if (m.allocation == AllocationPolicy::Importance) {
     const ImportanceParams ip = s.importance, d{};
     if (ip.alpha != d.alpha) cmd += " --importance-alpha " + number(ip.alpha);
@@ -189,6 +192,7 @@ Result<SessionSetup> setUpSession(const ViewerArgs& a) {
   }
   if (a.k) settings.k = *a.k;
   settings.occupancyD = a.occupancyD;
+  settings.maxPeels = a.maxPeels;
   settings.model = a.model;
   settings.importance.seed = a.scene.seed;  // as render's ImportanceParams
   auto mode = parseViewMode(a.mode);

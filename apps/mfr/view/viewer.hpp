@@ -16,6 +16,7 @@ struct ViewerArgs {
   std::optional<uint32_t> k;
   std::string composite;
   int occupancyD = 0;  // 0: the preset's
+  int maxPeels = 0;    // peel, dual-peel: at most this many passes (0: until none remains)
   std::string model;
   std::string mode = "image";
   int frames = 0;  // 0: interactive (until the window closes or the script ends)

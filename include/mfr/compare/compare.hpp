@@ -34,6 +34,9 @@ struct CompareOptions {
   /// Compositing of every method (ground truth: exact); none: each preset's own rule (hybrid for
   /// dkb*, optimal*; kbuffer for the others).
   std::optional<Compositing> compositing;
+  /// Depth peeling (peel, dual-peel): --max-peels, at most this many geometry passes (none: until
+  /// no fragment remains); under hybrid compositing what remains goes to a tail.
+  std::optional<uint32_t> maxPeels;
   CaptureMode capture = CaptureMode::TileOwned;
   glm::vec3 background{1.0f};  // linear RGB
   std::string scene;           // the scene's name or source, for the results

@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -73,7 +74,10 @@ struct GlRenderOutput {
   uint64_t culledKPlus = 0;        // k-buffers: rejected by the k+ test (depends on arrival order)
   bool atomic64 = false;           // the fixed-k capture took 64-bit atomicMin (no lock)
   std::vector<GlPassTime> passes;  // count, prefix sum, capture, resolve (timed run)
-  std::vector<uint32_t> held;      // linked lists: the nodes each pixel's list holds
+  /// Linked lists: the nodes each pixel's list holds; depth peeling: the fragments peeled per
+  /// pixel. And the peel passes run (not the tail's).
+  std::vector<uint32_t> held;
+  std::optional<uint32_t> peelPasses;
 };
 
 /// How the geometry passes make fragments (--gl-raster).

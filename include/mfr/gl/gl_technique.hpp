@@ -29,6 +29,8 @@ enum class GlTechnique : uint8_t {
   Mlab,     // multi-layer alpha blending: merge capture of k nodes, front-to-back resolve
   Aoit,     // adaptive transparency: visibility pass (N nodes), colour pass, composite
   LinkedList,  // per-pixel linked lists: pool counter + head exchange capture, walk-sort resolve
+  Peel,  // depth peeling and dual depth peeling: peel passes (geometry + per-pixel step) until
+         // none remains or --max-peels, [tail pass], composite
 };
 
 /// One row of the technique table.

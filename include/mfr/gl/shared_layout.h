@@ -77,6 +77,11 @@ MFR_GL_CONST(uint, kAoitNodeWords, 2u)
 MFR_GL_CONST(uint, kAoitColorWords, 3u)
 // multi-layer alpha blending: per node depth, premultiplied r, g, b, transmittance (mfr::MlabNode)
 MFR_GL_CONST(uint, kMlabWords, 5u)
+// depth peeling: per pixel bound, candidate key, multiplicity, front r, g, b, T (mfr::PeelPixel);
+// dual depth peeling: lo, hi, nearest and farthest keys, their multiplicities, front and back
+// r, g, b, T (mfr::DualPeelPixel); peel.frag lists the words
+MFR_GL_CONST(uint, kPeelWords, 9u)
+MFR_GL_CONST(uint, kDualPeelWords, 18u)
 // deep k-buffer: feature accumulators per pixel (n, nearest depth bits and colour, farthest depth
 // bits, premultiplied colour sum r, g, b), the network's weights, the importance
 MFR_GL_CONST(uint, kDkbAccWords, 7u)
@@ -154,6 +159,7 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //   nearest_cosine.frag: kBindNearest kBindLocks(image)
 //   occupancy_fill.frag: kBindOccupancy kBindOccBits
 //   wboit.frag: kBindAccum kBindLocks(image)
+//   peel.frag: kBindAccum kBindCaptureStats kBindTails kBindLocks(image)
 //   alloc_histogram.comp: kBindAllocCounts kBindAllocSummary
 //   alloc_k.comp: kBindAllocCounts kBindAllocSummary kBindAllocK kBindAllocReserved kBindImportance
 //       kBindImportanceTotal
@@ -171,6 +177,8 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //       kBindAllocation(texture)
 //   swap_node_words.comp: kBindNodes
 //   wboit_resolve.comp: kBindAccum kBindImage
+//   peel_step.comp: kBindAccum kBindCaptureStats kBindOffsets kBindColorTables
+//   peel_resolve.comp: kBindAccum kBindResolveTails kBindImage
 //   raster_common.glsl: kBindMaterials kBindColorTables kBindTexels kBindCounts(image)
 //   raster_native.glsl: kBindTriMaterial
 //   raster.geom: kBindTriMaterial kBindMaterials

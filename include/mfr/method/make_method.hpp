@@ -47,6 +47,7 @@ struct MethodOverrides {
   std::optional<int64_t> k;                   // --k, in [1, 2^20]
   std::string composite;                      // --composite kbuffer|hybrid (empty: the preset's)
   std::optional<int64_t> occupancyD;          // --occupancy-d, in [1, 64]
+  std::optional<int64_t> maxPeels;            // --max-peels, in [1, 65536] (peel, dual-peel)
   std::string modelPath;                      // --model: a .mfrnn file (empty: none)
   std::shared_ptr<const learn::Model> model;  // or a model already in memory (mfr.Model)
   std::string modelName = "(mfr.Model)";      // how errors name `model`

@@ -75,6 +75,8 @@ enum class Compositing : uint8_t {
   Adaptive4,            // aoit4: adaptive transparency, 4 visibility nodes (Salvi 2011), aoit.hpp
   Adaptive8,            // aoit8: the same with 8 nodes
   Adaptive16,           // aoit16: the same with 16 nodes
+  Peel,                 // peel: depth peeling, one nearest layer per geometry pass (Everitt 2001)
+  DualPeel,             // dual-peel: nearest and farthest layer per pass (Bavoil & Myers 2008)
 };
 
 /// True for kbuffer and hybrid, the rules `--composite` chooses between (the k-buffer family).
@@ -104,6 +106,13 @@ struct MethodDesc {
   /// (dkb-curve, mfr/method/dkb_curve.hpp) instead of the exact A-buffer pre-pass's; `model`
   /// then holds a curve model (null: the built-in one).
   bool predictedCurves = false;
+  /// Depth peeling (peel, dual-peel; peel.hpp): at most this many geometry passes (--max-peels;
+  /// none: until no fragment remains). The fragments left after them are dropped, or blended
+  /// into the hybrid tail when `peelTail`.
+  std::optional<uint32_t> maxPeels;
+  /// Depth peeling under --composite hybrid: the fragments left after maxPeels passes go to the
+  /// order-independent tail (compositing.hpp's rule) behind the peeled front layers.
+  bool peelTail = false;
 };
 
 /// One row of the preset table (src/method/method.cpp): the name, the paper it follows and a

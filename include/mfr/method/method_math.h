@@ -14,6 +14,9 @@
 //     Eq. 10 (weight) and the resolve's clamp of the denominator; see wboit.hpp;
 //   MLAB: Salvi and Vaidyanathan, "Multi-layer Alpha Blending", I3D 2014 (the merge by "over");
 //     see mlab.hpp;
+//   depth peeling: Everitt, "Interactive Order-Independent Transparency", NVIDIA 2001; dual depth
+//     peeling: Bavoil and Myers, "Order Independent Transparency with Dual Depth Peeling", NVIDIA
+//     2008 (underStep, the back layers); see peel.hpp;
 //   MBOIT: Muenstermann, Krumpen, Klein, Peters, "Moment-Based Order-Independent Transparency",
 //     HPG 2018 (4 power moments, bias 5e-7, overestimation 0.25); see mboit.hpp;
 //   AOIT: Salvi, Montgomery, Lefohn, "Adaptive Transparency", HPG 2011 (the visibility function's
@@ -278,6 +281,22 @@ MFR_MATH_FN void overStep(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(floa
   MFR_PRECISE float ng = g + cg * w;
   MFR_PRECISE float nb = b + cb * w;
   MFR_PRECISE float nextT = T * (1.0f - a);
+  r = nr;
+  g = ng;
+  b = nb;
+  T = nextT;
+}
+
+/// Dual depth peeling's back side (Bavoil & Myers 2008, peel.hpp): a layer (linear colour c,
+/// alpha a) blended back to front in front of the back colour (r, g, b) and its transmittance T:
+///   (r, g, b) = c a + (1 - a) (r, g, b),  T *= 1 - a.
+MFR_MATH_FN void underStep(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(float) b,
+                           MFR_INOUT(float) T, float a, float cr, float cg, float cb) {
+  MFR_PRECISE float keep = 1.0f - a;
+  MFR_PRECISE float nr = cr * a + keep * r;
+  MFR_PRECISE float ng = cg * a + keep * g;
+  MFR_PRECISE float nb = cb * a + keep * b;
+  MFR_PRECISE float nextT = T * keep;
   r = nr;
   g = ng;
   b = nb;

@@ -18,7 +18,9 @@ enum class MethodOption : uint8_t {
   Model,             // --model: the deep k-buffer's network
   ImportanceMap,     // --importance-map: write I(p)
   ImportanceParams,  // vkb's Eq. 3-6 parameters and factor switches, --importance-factors
-  Composite,         // --composite kbuffer|hybrid: the k-buffer family (not wboit, mboit, mlab)
+  Composite,         // --composite kbuffer|hybrid: the k-buffer family and depth peeling (its
+                     // tail; not wboit, mboit, mlab)
+  MaxPeels,          // --max-peels: the geometry passes of depth peeling (peel, dual-peel)
 };
 
 struct MethodOptionRule {

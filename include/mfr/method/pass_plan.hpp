@@ -6,6 +6,9 @@
 //   [count | count + depth range] -> [nearest normal -> importance | features -> inference]
 //   -> [oracle | curves] -> allocate -> [depth range -> occupancy fill -> occupancy count]
 //   -> [peer passes, e.g. mboit's moments] -> capture -> resolve
+// Depth peeling (peel, dual-peel) repeats its capture: its passes are "peel 1", "peel 2", ... (as
+// many as the frame needs, at most MethodDesc::maxPeels), then "peel tail" under peelTail when
+// fragments remain, in place of "capture".
 #pragma once
 
 #include <cstdint>
@@ -21,6 +24,13 @@
 
 namespace mfr {
 
+/// PassPlan::names()' entry for depth peeling's numbered passes "peel 1", "peel 2", ...
+inline constexpr const char* kPeelPasses = "peel N";
+
+/// The name of depth peeling's pass `index` (0-based): "peel 1", ...; and of its tail pass.
+std::string peelPassName(uint32_t index);
+inline constexpr const char* kPeelTailPass = "peel tail";
+
 struct PassPlan {
   bool count = false;          // n(p) before the allocation (exact, counted, dynamic, importance k)
   bool depthRange = false;     // the count pass also finds the image's depth range (dkb's input)
@@ -33,8 +43,13 @@ struct PassPlan {
   /// The peer method's own geometry passes before its capture (mboit: "moments").
   std::vector<std::string> peerPasses;
   bool tail = false;  // hybrid compositing: the order-independent tail beside the core
+  /// Depth peeling: the capture repeated, at most maxPeels times (none: until nothing remains),
+  /// then the tail pass under tail.
+  bool peel = false;
+  std::optional<uint32_t> maxPeels;
 
-  /// The passes in order, as RenderStats::passes names them ("count", "allocate", ...).
+  /// The passes in order, as RenderStats::passes names them ("count", "allocate", ...); depth
+  /// peeling's passes, whose number the frame decides, are the one entry "peel N" (kPeelPasses).
   std::vector<std::string> names() const;
 };
 

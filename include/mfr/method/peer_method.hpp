@@ -11,6 +11,22 @@
 //   add(px, pass, depth, rgba)   one fragment in pass `pass` (0..extra-1, then the capture's)
 //   composite(slots, count, bg)  the pixel's colour over the background
 //
+// A peer whose capture is repeated a number of times decided at run time (depth peeling,
+// peel.hpp) also says
+//
+//   kRepeatsCapture      true: the engine runs the capture pass again and again; add() returns
+//                        whether the fragment is still to process (counted over the frame)
+//   endPass(slot)        the per-pixel step after each pass (blend the layer found, advance);
+//                        returns the fragments it took, added to the pixel's count
+//   mayRemain(slot, z)   the early test before shading: false when the depth alone puts the
+//                        fragment outside what is still to process
+//   remains(slot, z, c)  after the last pass: the fragment was not taken (to the hybrid tail)
+//   composite(slot, tail, bg)  the colour with the pixel's hybrid tail (null: none)
+//
+// and the engine stops after the pass that took every fragment still to process, or after
+// MethodDesc::maxPeels passes; then, under MethodDesc::peelTail, one more pass adds the fragments
+// that remain to the pixel's hybrid tail (peerRepeatsCapture below tells the two kinds apart).
+//
 // and the memory model, the pass plan and the CPU engine's one template (src/cpu/peer_methods.cpp)
 // read everything else from it. visitPeer is the one switch from a rule to its type.
 //
@@ -27,6 +43,7 @@
 #include "mfr/method/mboit.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/method/mlab.hpp"
+#include "mfr/method/peel.hpp"
 #include "mfr/method/wboit.hpp"
 
 namespace mfr {
@@ -48,10 +65,19 @@ struct PeerList {
     (f.template operator()<Peers>(), ...);
   }
 };
-using PeerMethods =
-    PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Method, MboitTrig3Method,
-             MboitTrig4Method, Mboit16Method, Mboit6_16Method, Mboit8_16Method, MboitTrig3_16Method,
-             MboitTrig4_16Method, MlabMethod, Aoit4Method, Aoit8Method, Aoit16Method>;
+using PeerMethods = PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Method, MboitTrig3Method,
+                             MboitTrig4Method, Mboit16Method, Mboit6_16Method, Mboit8_16Method,
+                             MboitTrig3_16Method, MboitTrig4_16Method, MlabMethod, Aoit4Method,
+                             Aoit8Method, Aoit16Method, PeelMethod, DualPeelMethod>;
+
+/// Whether a peer's capture repeats (depth peeling's kRepeatsCapture); false when it does not say.
+template <class Peer>
+constexpr bool peerRepeatsCapture() {
+  if constexpr (requires { Peer::kRepeatsCapture; })
+    return Peer::kRepeatsCapture;
+  else
+    return false;
+}
 
 /// Calls `f.template operator()<Peer>()` with the peer type of `rule`; false (and no call) for
 /// the k-buffer family's rules.

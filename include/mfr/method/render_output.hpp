@@ -88,8 +88,11 @@ struct RenderStats {
   std::optional<double> meanDepthComplexity;   // over covered pixels
   std::vector<PassTime> passes;
   std::optional<OracleReport> oracle;  // optimal / optimal-greedy
-  uint64_t primitivesSkipped = 0;      // the scene's points and lines, not rendered
-  CullMode cull = CullMode::Auto;      // the back faces the raster culled (Scene::cull)
+  /// Depth peeling (peel, dual-peel): the geometry passes that peeled layers ("peel 1", ... in
+  /// `passes`), not counting the hybrid tail's pass.
+  std::optional<uint32_t> peelPasses;
+  uint64_t primitivesSkipped = 0;  // the scene's points and lines, not rendered
+  CullMode cull = CullMode::Auto;  // the back faces the raster culled (Scene::cull)
   /// The engine that rendered (Engine::name) and what only it measures (the CPU engine: threads,
   /// tile_workers), beside the shared fields above.
   std::string engine;
