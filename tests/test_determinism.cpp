@@ -49,8 +49,9 @@ void expectThreadIndependent(const std::string& preset, const std::string& compo
                        capture + " --threads " + std::to_string(threads) + " -o " + png.string() +
                        " --stats-json " + stats.string();
     // (the aoit family's fixed 44, 76, 140 B per pixel: up to 788 KiB here)
-    if (preset.starts_with("aoit")) args += " --budget 1MB";
-    if (preset == "dual-peel")  // its 72 B per pixel
+    if (preset.starts_with("aoit"))
+      args += " --budget 1MB";
+    else if (preset == "dual-peel")  // its 72 B per pixel
       args += " --budget 420KB";
     else if (preset != "abuffer")
       args += composite == "hybrid" || peer ? " --budget 310KB" : " --budget 200KB";

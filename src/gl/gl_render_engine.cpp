@@ -167,7 +167,8 @@ class GlFrame {
       a->globalK = deviceGlobalK;
       MFR_TRY(readDeviceMaps());
     }
-    if (!g.held.empty()) a->capacity = g.held;  // linked lists: k(p), the nodes each list got
+    // linked lists: k(p), the nodes each list got (depth peeling's held are fragments, not k)
+    if (method_.store == StoreChoice::LinkedList && !g.held.empty()) a->capacity = g.held;
     fillStats(g, a.value(), interlock);
     out_.image = std::move(g.image);
     out_.kMap = a->reservedK.empty() ? std::move(a->capacity) : std::move(a->reservedK);

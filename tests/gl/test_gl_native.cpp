@@ -22,6 +22,7 @@
 #include "mfr/core/image.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/gl/gl_render_engine.hpp"
+#include "mfr/method/aoit.hpp"
 #include "mfr/method/mboit.hpp"
 #include "mfr/method/peel.hpp"
 #include "mfr/metrics/flip.hpp"
@@ -122,10 +123,15 @@ TEST_P(GlNative, AgreesWithTheCpuEngineOnEveryPreset) {
       }
       auto flip = computeFlip(encodeSrgb(r->image), encodeSrgb(g->image));
       ASSERT_TRUE(flip.ok()) << flip.error().message;
-      // the 16-bit moments re-round their codes per fragment in the arrival order (the GL lock's,
-      // not primitive order): measured mean FLIP up to 1.0e-2 (mboit-trig4-q16 on the layers,
-      // varying from run to run); every other preset within 2e-3
-      EXPECT_LE(flip->mean, mboitQuantized(method.compositing) ? 2e-2 : 2e-3);
+      // the order-dependent rules see GL's arrival order under the lock, not primitive order, and
+      // vary from run to run: the 16-bit moments re-round their codes per fragment (measured mean
+      // FLIP up to 1.2e-2, mboit-trig4-q16 on the layers), AOIT's removals beyond N + 1
+      // fragments follow the order (up to 6.6e-2, aoit4 on the layers' equal-area steps; where
+      // n(p) <= N + 1 GlAoit compares pixel by pixel); every other preset within 2e-3
+      const double limit = mboitQuantized(method.compositing)      ? 2e-2
+                           : aoitNodeCount(method.compositing) > 0 ? 1e-1
+                                                                   : 2e-3;
+      EXPECT_LE(flip->mean, limit);
       if (flip->mean >= worstFlip) {
         worstFlip = flip->mean;
         worstPreset = name;
