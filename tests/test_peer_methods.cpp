@@ -376,7 +376,8 @@ TEST(MomentFamily, ThreeLayersRenderAsTheClosedForm) {
   const auto frags = fragmentsOf(frame);
   ASSERT_GT(frags[0][1].d - frags[0][0].d, 0.2);
   ASSERT_GT(frags[0][2].d - frags[0][1].d, 0.2);
-  for (const char* preset : {"mboit6", "mboit8"}) {
+  // (and 3 and 4 trigonometric moments, which carry three layers too)
+  for (const char* preset : {"mboit6", "mboit8", "mboit-trig3", "mboit-trig4"}) {
     const RenderOutput out = run(frame, preset);
     EXPECT_EQ(out.stats.lost, 0u);
     for (size_t p = 0; p < frags.size(); ++p) {
@@ -489,36 +490,6 @@ TEST(MomentFamily, TrigonometricBoundsHoldAwayFromTheWrappingZone) {
                          trigMomentT(3, steps, z, 1.0f) - stepT(steps, z, true)});
   }
   EXPECT_GT(broken, 0.01);
-}
-
-TEST(MomentFamily, TrigonometricLayersRenderAsTheClosedForm) {
-  // through the CPU engine, as ThreeLayersRenderAsTheClosedForm: three separated layers, 3 and 4
-  // trigonometric moments; T in front of layer i is the product of the layers in front times
-  // (1 - a_i)^0.25, up to the bias
-  const Layer nearL{0.85f, {1.0f, 0.1f, 0.1f, 0.5f}}, midL{0.75f, {0.1f, 0.9f, 0.2f, 0.6f}},
-      farL{0.4f, {0.1f, 0.2f, 1.0f, 0.7f}};
-  const RasterFrame frame = frameOf({midL, farL, nearL});
-  const auto frags = fragmentsOf(frame);
-  for (const char* preset : {"mboit-trig3", "mboit-trig4"}) {
-    const RenderOutput out = run(frame, preset);
-    EXPECT_EQ(out.stats.lost, 0u);
-    double worst = 0.0;
-    for (size_t p = 0; p < frags.size(); ++p) {
-      const std::vector<Frag>& f = frags[p];
-      ASSERT_EQ(f.size(), 3u);
-      glm::dvec3 acc(0.0);
-      double accA = 0.0, front = 1.0;
-      for (const Frag& x : f) {
-        const double t = front * std::pow(1.0 - x.a, 0.25);
-        acc += t * x.a * glm::dvec3(x.r, x.g, x.b);
-        accA += t * x.a;
-        front *= 1.0 - x.a;
-      }
-      const glm::dvec3 expected = (1.0 - front) * acc / accA + front * glm::dvec3(kBg);
-      worst = std::max(worst, maxDiff(out.image, p, expected));
-    }
-    EXPECT_LT(worst, 2e-3) << preset;
-  }
 }
 
 // ---- the moment family's 16-bit storage (mboit-q16 .. mboit-trig4-q16) ------------------------
