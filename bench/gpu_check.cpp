@@ -20,7 +20,8 @@
 // the GlNative ctest checks it: the fraction of pixels whose n(p) is equal (each engine's count
 // pass, once per scene), bytes_used of both, the mean LDR-FLIP of the GL image against the CPU
 // engine's and the largest per-channel difference (linear RGB). Status: ok (n(p) equal on >= 99.9%
-// of the pixels, bytes_used equal (vkb, dkb: within 0.1% and the budget), mean FLIP <= 2e-3),
+// of the pixels, bytes_used equal (vkb, dkb: within 0.1% and the budget), mean FLIP <= 2e-3, or the
+// bound of an arrival-order-dependent rule: flipBound),
 // refused (both engines refused the budget with the same message), differs (an agreement figure out
 // of bounds), error (one engine failed; the message in the error column), skipped (--time-limit
 // reached, or the Dish absent). Exit status: 0 when every row is ok, refused or skipped; 1 when one
@@ -41,6 +42,8 @@
 #include "gl_pass_timer.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/gl/gl_render_engine.hpp"
+#include "mfr/method/aoit.hpp"
+#include "mfr/method/mboit.hpp"
 #include "mfr/metrics/flip.hpp"
 
 namespace {
@@ -67,6 +70,17 @@ constexpr Program kProgram{
 constexpr uint64_t kBudgetAt1024 = 64ull << 20;  // 64 bytes per pixel
 constexpr double kMinEqualCounts = 0.999;        // the GlNative ctest's bounds
 constexpr double kMaxFlipMean = 2e-3;
+
+// The rules whose image depends on the order fragments reach a pixel, which the GL engine's lock
+// does not fix (the GlNative ctest's bounds, measured there): the 16-bit moments re-round per
+// fragment (2e-2), AOIT's removals beyond N + 1 fragments (1e-1); a linked list whose pool
+// overflowed admits other fragments (its counts are checked instead, no FLIP bound).
+std::optional<double> flipBound(const MethodDesc& m, uint64_t cpuLost) {
+  if (m.store == StoreChoice::LinkedList && cpuLost > 0) return std::nullopt;
+  if (mboitQuantized(m.compositing)) return 2e-2;
+  if (aoitNodeCount(m.compositing) > 0) return 1e-1;
+  return kMaxFlipMean;
+}
 constexpr double kImportanceBytesApart = 1e-3;
 
 const char* const kHeader =
@@ -331,7 +345,11 @@ class Checker {
                          (options.budgetBytes && r.bytesGl > *options.budgetBytes)
                    : r.bytesGl != r.bytesCpu)
       out.push_back(importance ? "bytes_used more than 0.1% apart" : "bytes_used differ");
-    if (!(r.flip <= kMaxFlipMean)) out.push_back("mean FLIP above 2e-3");
+    const std::optional<double> bound = flipBound(method, c->stats.lost);
+    if (bound && !(r.flip <= *bound)) out.push_back("mean FLIP above " + std::to_string(*bound));
+    if (!bound && (g->stats.captured != g->stats.fragmentSlots ||
+                   c->stats.captured != c->stats.fragmentSlots))
+      out.push_back("a full pool's captured fragments are not its size");
     r.status = out.empty() ? "ok" : "differs";
     for (const std::string& why : out) r.error += (r.error.empty() ? "" : "; ") + why;
     return r;
