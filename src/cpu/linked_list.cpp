@@ -137,31 +137,15 @@ CaptureCounters captureLinkedList(const RasterFrame& frame, const MethodDesc& me
 
 ImageRGB resolveLinkedList(const RasterFrame& frame, const MethodDesc& method, Stores& stores,
                            glm::vec3 background) {
-  const bool hybrid = method.compositing == Compositing::Hybrid;
-  const glm::vec3 empty = hybrid ? compositeHybrid(nullptr, 0, HybridTail{}, background)
-                                 : compositeKBuffer(nullptr, 0, background);
-  ImageRGB image(frame.width(), frame.height(), empty);
   const LinkedNode* pool = stores.pool.data();
-  frame.forEachTile([&](int tile) {
-    if (frame.tileBegin(tile) == frame.tileEnd(tile)) return;
-    FragmentNode small[kSortNetworkSize];
-    std::vector<FragmentNode> keys, large;
-    const TileRect r = frame.tileRect(tile);
-    for (int y = r.y0; y <= r.y1; ++y)
-      for (int x = r.x0; x <= r.x1; ++x) {
-        const size_t p = static_cast<size_t>(y) * frame.width() + x;
-        const uint32_t n = stores.counts[p];
-        if (n == 0 && (!hybrid || stores.tails[p].count == 0)) continue;
-        keys.clear();
-        for (uint32_t i = stores.heads[p]; i != kListEnd; i = pool[i].next)
-          keys.push_back(sortKey(pool[i]));
-        MFR_CHECK_EQ(keys.size(), n);
-        const FragmentNode* sorted = sortNodes(keys.data(), n, small, large);
-        image.pixels[p] = hybrid ? compositeHybrid(sorted, n, stores.tails[p], background)
-                                 : compositeKBuffer(sorted, n, background);
-      }
-  });
-  return image;
+  return resolveSortedNodes(frame, method, stores, background,
+                            [&](size_t p, uint32_t n, std::vector<FragmentNode>& keys) {
+                              keys.clear();
+                              for (uint32_t i = stores.heads[p]; i != kListEnd; i = pool[i].next)
+                                keys.push_back(sortKey(pool[i]));
+                              MFR_CHECK_EQ(keys.size(), n);
+                              return static_cast<const FragmentNode*>(keys.data());
+                            });
 }
 
 void exportLinkedLists(const Stores& stores, RenderOutput& out) {

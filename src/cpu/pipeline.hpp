@@ -22,6 +22,7 @@
 #include "mfr/method/linked_list.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/peer_method.hpp"
+#include "sort_nodes.hpp"
 
 namespace mfr::detail {
 
@@ -187,6 +188,37 @@ CaptureCounters captureLinkedList(const RasterFrame& frame, const MethodDesc& me
                                   BufferLedger& ledger);
 ImageRGB resolveLinkedList(const RasterFrame& frame, const MethodDesc& method, Stores& stores,
                            glm::vec3 background);
+
+/// The k-buffer family's resolve over the frame, for any store: each covered pixel's n = counts[p]
+/// nodes, from `nodesOf(p, n, scratch)` (a pointer to them; `scratch` a per-tile vector the
+/// gatherer may fill), sorted and composited by the method's rule (kbuffer or hybrid) over the
+/// background. A pixel no fragment reached (no node, an empty tail) shows the rule's empty
+/// composite: the same bits as compositing it, without the sort and the blend. The image starts as
+/// that colour, so a tile no triangle reaches is never visited (most of a sparse view).
+template <class NodesOf>
+ImageRGB resolveSortedNodes(const RasterFrame& frame, const MethodDesc& method,
+                            const Stores& stores, glm::vec3 background, NodesOf&& nodesOf) {
+  const bool hybrid = method.compositing == Compositing::Hybrid;
+  const glm::vec3 empty = hybrid ? compositeHybrid(nullptr, 0, HybridTail{}, background)
+                                 : compositeKBuffer(nullptr, 0, background);
+  ImageRGB image(frame.width(), frame.height(), empty);
+  frame.forEachTile([&](int tile) {
+    if (frame.tileBegin(tile) == frame.tileEnd(tile)) return;
+    FragmentNode small[kSortNetworkSize];
+    std::vector<FragmentNode> scratch, large;  // grow once per tile
+    const TileRect r = frame.tileRect(tile);
+    for (int y = r.y0; y <= r.y1; ++y)
+      for (int x = r.x0; x <= r.x1; ++x) {
+        const size_t p = static_cast<size_t>(y) * frame.width() + x;
+        const uint32_t n = stores.counts[p];
+        if (n == 0 && (!hybrid || stores.tails[p].count == 0)) continue;
+        const FragmentNode* sorted = sortNodes(nodesOf(p, n, scratch), n, small, large);
+        image.pixels[p] = hybrid ? compositeHybrid(sorted, n, stores.tails[p], background)
+                                 : compositeKBuffer(sorted, n, background);
+      }
+  });
+  return image;
+}
 void exportLinkedLists(const Stores& stores, RenderOutput& out);
 
 }  // namespace mfr::detail

@@ -93,30 +93,11 @@ ImageRGB resolve(const RasterFrame& frame, const MethodDesc& method, const Alloc
     return detail::resolvePeer(frame, method, alloc, stores, background);
   if (method.store == StoreChoice::LinkedList)
     return detail::resolveLinkedList(frame, method, stores, background);
-  const bool hybrid = method.compositing == Compositing::Hybrid;
-  // a pixel no fragment reached (no node, an empty tail) shows the rule's empty composite: the
-  // same bits as compositing it, without the sort and the blend. The image starts as that colour,
-  // so a tile no triangle reaches is never visited (most of a sparse view).
-  const glm::vec3 empty = hybrid ? compositeHybrid(nullptr, 0, HybridTail{}, background)
-                                 : compositeKBuffer(nullptr, 0, background);
-  ImageRGB image(frame.width(), frame.height(), empty);
-  frame.forEachTile([&](int tile) {
-    if (frame.tileBegin(tile) == frame.tileEnd(tile)) return;
-    FragmentNode small[detail::kSortNetworkSize];
-    std::vector<FragmentNode> large;  // pixels above the network's size; grows once per tile
-    const TileRect r = frame.tileRect(tile);
-    for (int y = r.y0; y <= r.y1; ++y)
-      for (int x = r.x0; x <= r.x1; ++x) {
-        const size_t p = static_cast<size_t>(y) * frame.width() + x;
-        const uint32_t n = stores.counts[p];
-        if (n == 0 && (!hybrid || stores.tails[p].count == 0)) continue;
-        const FragmentNode* sorted =
-            detail::sortNodes(stores.nodes.data() + alloc.offsets[p], n, small, large);
-        image.pixels[p] = hybrid ? compositeHybrid(sorted, n, stores.tails[p], background)
-                                 : compositeKBuffer(sorted, n, background);
-      }
-  });
-  return image;
+  return detail::resolveSortedNodes(
+      frame, method, stores, background,
+      [&](size_t p, uint32_t, std::vector<FragmentNode>&) -> const FragmentNode* {
+        return stores.nodes.data() + alloc.offsets[p];
+      });
 }
 
 }  // namespace
