@@ -118,14 +118,6 @@ struct PowerMomentPixel {
                                                 method_math::mboitPowerBias(Count),
                                                 kMboitOverestimation);
   }
-  void addColor(float depth, uint32_t rgba) {
-    const glm::vec4 c = unpackFragmentColor(rgba);
-    if (c.a <= 0.0f) return;
-    method_math::mboitAddColor(r, g, b, a, glm::vec3(c), transmittanceAt(depth) * c.a);
-  }
-  glm::vec3 composite(glm::vec3 background) const {
-    return method_math::mboitComposite(b0, glm::vec3(r, g, b), a, background);
-  }
 };
 static_assert(sizeof(PowerMomentPixel<6>) == 44 && sizeof(PowerMomentPixel<8>) == 52);
 
@@ -151,14 +143,6 @@ struct TrigMomentPixel {
     return method_math::mboitTransmittanceTrig(Count, b0, all, mboitWarpDepth(depth),
                                                method_math::mboitTrigBias(Count),
                                                kMboitOverestimation);
-  }
-  void addColor(float depth, uint32_t rgba) {
-    const glm::vec4 c = unpackFragmentColor(rgba);
-    if (c.a <= 0.0f) return;
-    method_math::mboitAddColor(r, g, b, a, glm::vec3(c), transmittanceAt(depth) * c.a);
-  }
-  glm::vec3 composite(glm::vec3 background) const {
-    return method_math::mboitComposite(b0, glm::vec3(r, g, b), a, background);
   }
 };
 static_assert(sizeof(TrigMomentPixel<3>) == 44 && sizeof(TrigMomentPixel<4>) == 52);
@@ -198,21 +182,15 @@ struct QuantizedMomentPixel {
     return method_math::mboitTransmittancePower(Count, b0, moments, mboitWarpDepth(depth), bias,
                                                 kMboitOverestimation);
   }
-  void addColor(float depth, uint32_t rgba) {
-    const glm::vec4 c = unpackFragmentColor(rgba);
-    if (c.a <= 0.0f) return;
-    method_math::mboitAddColor(r, g, b, a, glm::vec3(c), transmittanceAt(depth) * c.a);
-  }
-  glm::vec3 composite(glm::vec3 background) const {
-    return method_math::mboitComposite(b0, glm::vec3(r, g, b), a, background);
-  }
 };
 static_assert(sizeof(QuantizedMomentPixel<4, false>) == 28 &&
               sizeof(QuantizedMomentPixel<6, false>) == 32 &&
               sizeof(QuantizedMomentPixel<8, true>) == 36);
 
 /// The moments pass, then the capture weighting each fragment by its reconstructed transmittance:
-/// what every power-moment peer method does with its Pixel.
+/// what every moment peer method with a Pixel of b0, moments and the four sums (r, g, b, a) does
+/// (its addMoments and transmittanceAt are the moment set's own; the colour pass and the
+/// composite are shared).
 template <class Pixel>
 struct MomentPasses {
   using Slot = Pixel;
@@ -224,11 +202,15 @@ struct MomentPasses {
       px.slots->addMoments(depth, static_cast<float>(rgba >> 24) / 255.0f);
       return;
     }
-    px.slots->addColor(depth, rgba);
+    Pixel& p = *px.slots;
     ++px.count;
+    const glm::vec4 c = unpackFragmentColor(rgba);
+    if (c.a <= 0.0f) return;
+    method_math::mboitAddColor(p.r, p.g, p.b, p.a, glm::vec3(c), p.transmittanceAt(depth) * c.a);
   }
   static glm::vec3 composite(const Pixel* slots, uint32_t, glm::vec3 background) {
-    return slots->composite(background);
+    return method_math::mboitComposite(slots->b0, glm::vec3(slots->r, slots->g, slots->b), slots->a,
+                                       background);
   }
 };
 
