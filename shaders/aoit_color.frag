@@ -16,8 +16,10 @@ void main() {
   countInCapture(f);
   const float depth = fragmentDepth(f);
   const uint rgba = shade(f, base);
-  precise float a = float(rgba >> 24) * uInv255;
-  if (a <= 0.0) return;
+  precise float alpha = float(rgba >> 24) * uInv255;
+  // AoitPixel::addColor: an additive node adds its emission times vis(z); the word 0 adds nothing
+  const float a = (rgba >> 24) == kAdditiveNode ? 1.0 : alpha;
+  if (a <= 0.0 || rgba == 0u) return;
   const uint i = (kAoitNodeWords * uNodeCount + kAoitColorWords) * uint(f.pixel);
   const int n = int(uNodeCount);
   float d[kAoitMaxNodes + 1];

@@ -96,11 +96,11 @@ void insertNode(const uint p, const uint first, const uint k, const uint storeKi
   }
   if (toTail && uHybrid != 0u) {  // mfr::HybridTail::add (method_math.h's hybridTailAdd)
     const uint t = kTailWords * p;
-    precise float a = float(tailColor >> 24) * uInv255;
     float r = uintBitsToFloat(tails[t]), g = uintBitsToFloat(tails[t + 1u]),
           b = uintBitsToFloat(tails[t + 2u]), sumA = uintBitsToFloat(tails[t + 3u]);
     uint count = tails[t + 4u];
-    hybridTailAdd(r, g, b, sumA, count, a, srgb8ToLinear(tailColor & 0xffu),
+    precise float a = float(tailColor >> 24) * uInv255;
+    hybridTailAddNode(r, g, b, sumA, count, tailColor >> 24, a, srgb8ToLinear(tailColor & 0xffu),
                   srgb8ToLinear((tailColor >> 8) & 0xffu),
                   srgb8ToLinear((tailColor >> 16) & 0xffu));
     tails[t] = floatBitsToUint(r);

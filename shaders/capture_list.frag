@@ -58,10 +58,13 @@ void main() {
     pool[kListNodeWords * node + 2u] = next;
   } else if (uHybrid != 0u) {  // mfr::HybridTail::add's terms (method_math.h's hybridTailAdd)
     const uint t = kTailWords * f.pixel;
+    // hybridTailAddNode: an additive node (alpha byte 0) adds its emission and no alpha
+    const bool additive = (rgba >> 24) == kAdditiveNode;
     precise float a = float(rgba >> 24) * uInv255;
-    precise float ar = a * srgb8ToLinear(rgba & 0xffu);
-    precise float ag = a * srgb8ToLinear((rgba >> 8) & 0xffu);
-    precise float ab = a * srgb8ToLinear((rgba >> 16) & 0xffu);
+    const float w = additive ? 1.0 : a;
+    precise float ar = w * srgb8ToLinear(rgba & 0xffu);
+    precise float ag = w * srgb8ToLinear((rgba >> 8) & 0xffu);
+    precise float ab = w * srgb8ToLinear((rgba >> 16) & 0xffu);
     addToTail(t, ar);
     addToTail(t + 1u, ag);
     addToTail(t + 2u, ab);

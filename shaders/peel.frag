@@ -75,11 +75,11 @@ void peelAdd(uint w, uvec2 key) {
 // mfr::HybridTail::add (method_math.h's hybridTailAdd)
 void tailAdd(uint p, uint rgba) {
   const uint t = kTailWords * p;
-  precise float a = float(rgba >> 24) * uInv255;
   float r = uintBitsToFloat(tails[t]), g = uintBitsToFloat(tails[t + 1u]),
         b = uintBitsToFloat(tails[t + 2u]), sumA = uintBitsToFloat(tails[t + 3u]);
   uint count = tails[t + 4u];
-  hybridTailAdd(r, g, b, sumA, count, a, srgb8ToLinear(rgba & 0xffu),
+  precise float a = float(rgba >> 24) * uInv255;
+  hybridTailAddNode(r, g, b, sumA, count, rgba >> 24, a, srgb8ToLinear(rgba & 0xffu),
                 srgb8ToLinear((rgba >> 8) & 0xffu), srgb8ToLinear((rgba >> 16) & 0xffu));
   tails[t] = floatBitsToUint(r);
   tails[t + 1u] = floatBitsToUint(g);

@@ -29,16 +29,17 @@ float srgb8ToLinear(uint code) {
 
 // m "over" (front) or "under" (back) steps of the colour word rgba onto the four words at i
 void blendLayer(uint i, uint rgba, uint m, bool back) {
-  precise float a = float(rgba >> 24) * uInv255;
+  const uint a8 = rgba >> 24;
+  precise float a = float(a8) * uInv255;
   const float cr = srgb8ToLinear(rgba & 0xffu), cg = srgb8ToLinear((rgba >> 8) & 0xffu),
               cb = srgb8ToLinear((rgba >> 16) & 0xffu);
   float r = uintBitsToFloat(state[i]), g = uintBitsToFloat(state[i + 1u]),
         b = uintBitsToFloat(state[i + 2u]), T = uintBitsToFloat(state[i + 3u]);
   for (uint j = 0u; j < m; ++j) {
     if (back)
-      underStep(r, g, b, T, a, cr, cg, cb);
+      blendUnderStepScalar(r, g, b, T, a8, a, cr, cg, cb);
     else
-      overStep(r, g, b, T, a, cr, cg, cb);
+      blendStepScalar(r, g, b, T, a8, a, cr, cg, cb);
   }
   state[i] = floatBitsToUint(r);
   state[i + 1u] = floatBitsToUint(g);

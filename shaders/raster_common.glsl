@@ -133,6 +133,35 @@ uint packColor(vec3 rgb, float alpha) {
          (encodeSrgb8(clampUnit(rgb.b)) << 16) | (uint(int(scaledA)) << 24);
 }
 
+// overNodeWord: an over word's alpha byte 0 -> the word 0 (the additive node of no emission),
+// 1 -> 2 (1 is the multiply node's byte)
+uint overNodeWord(uint word) {
+  const uint a8 = word >> 24;
+  if (a8 == kAdditiveNode) return 0u;
+  if (a8 == kMultiplyNode) return (word & 0x00ffffffu) | (2u << 24);
+  return word;
+}
+
+// packBlendedColor: the node word of the material's blend mode (mfr::BlendMode)
+uint packBlended(uint mode, vec3 rgb, float alpha) {
+  const float a = clampUnit(alpha);
+  if (mode == kBlendPremultiplied) {
+    precise float scaledA = a * 255.0 + 0.5;
+    if (int(scaledA) == 0) return packColor(rgb, 0.0) & 0x00ffffffu;
+    precise vec3 straight = rgb / a;
+    return overNodeWord(packColor(straight, a));
+  }
+  if (mode == kBlendAdditive) {
+    precise vec3 emission = rgb * a;
+    return packColor(emission, 0.0) & 0x00ffffffu;
+  }
+  if (mode == kBlendMultiply) {
+    precise vec3 factor = (1.0 - a) + a * rgb;
+    return (packColor(factor, 0.0) & 0x00ffffffu) | (kMultiplyNode << 24);
+  }
+  return overNodeWord(packColor(rgb, alpha));
+}
+
 // headlight shading (RasterFrame::shade): the colour word, and the clamped n.v it used
 uint shadeWithCosine(FragmentData f, vec4 base, out float cosine) {
   const vec3 n = fragmentNormal(f);
@@ -147,7 +176,8 @@ uint shadeWithCosine(FragmentData f, vec4 base, out float cosine) {
   precise float light = uAmbient + uDiffuse * abs(ndotv);
   precise vec3 rgb = base.rgb * light;
   cosine = ndotv;
-  return packColor(rgb, base.a);
+  const uint flags = materials[fragmentMaterial() * kMaterialWords + kMaterialFlagsWord];
+  return packBlended((flags >> kMaterialBlendShift) & kMaterialBlendMask, rgb, base.a);
 }
 
 uint shade(FragmentData f, vec4 base) {

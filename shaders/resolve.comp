@@ -11,7 +11,7 @@
 // count works),
 // writes them back sorted, and composites them front to back in linear RGB over the
 // background with the CPU engine's kbuffer rule (mfr::compositeKBuffer), operation for operation,
-// or its hybrid rule (mfr::compositeHybrid) with the pixel's tail: method_math.h's overStep,
+// or its hybrid rule (mfr::compositeHybrid) with the pixel's tail: method_math.h's blendStep,
 // hybridBehind and overBackground, the functions the CPU engine calls.
 layout(local_size_x = kResolveGroupSize) in;
 
@@ -109,12 +109,12 @@ void main() {
       siftDown(first, 0u, end);
     }
   }
-  float r = 0.0f, g = 0.0f, b = 0.0f, T = 1.0f;
+  float r = 0.0f, g = 0.0f, b = 0.0f, tr = 1.0f, tg = 1.0f, tb = 1.0f;
   for (uint i = 0u; i < n; ++i) {
     const uint rgba = nodes[first + i].y;
-    precise float a = float(rgba >> 24) * uInv255;
-    overStep(r, g, b, T, a, srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
-             srgb8ToLinear((rgba >> 16) & 0xffu));
+    precise float alpha = float(rgba >> 24) * uInv255;
+    blendStep(r, g, b, tr, tg, tb, rgba >> 24, alpha, srgb8ToLinear(rgba & 0xffu),
+              srgb8ToLinear((rgba >> 8) & 0xffu), srgb8ToLinear((rgba >> 16) & 0xffu));
   }
   vec3 behind = uBackground;
   if (uHybrid != 0u) {
@@ -124,7 +124,7 @@ void main() {
     // (GLSL pow is exp2(y log2 x), not std::pow: last bits differ from the CPU engine)
     behind = hybridBehind(sum, uintBitsToFloat(tails[t + 3u]), tails[t + 4u], uBackground);
   }
-  const vec3 result = overBackground(vec3(r, g, b), T, behind);
+  const vec3 result = overBackground(vec3(r, g, b), vec3(tr, tg, tb), behind);
   image[3u * p + 0u] = result.r;
   image[3u * p + 1u] = result.g;
   image[3u * p + 2u] = result.b;

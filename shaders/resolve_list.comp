@@ -11,7 +11,7 @@
 // One invocation per pixel walks its list with a selection sort (the nearest remaining node's
 // contents swapped into the current node: nearest first by the FragmentNode key (depth bits,
 // colour word), no local array, so any length works) and composites each node as it is placed,
-// front to back, with the CPU engine's kbuffer or hybrid rule: method_math.h's overStep,
+// front to back, with the CPU engine's kbuffer or hybrid rule: method_math.h's blendStep,
 // hybridBehind and overBackground, as resolve.comp.
 layout(local_size_x = kResolveGroupSize) in;
 
@@ -51,7 +51,7 @@ void main() {
   const uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
   const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
   if (p >= uPixels) return;
-  float r = 0.0f, g = 0.0f, b = 0.0f, T = 1.0f;
+  float r = 0.0f, g = 0.0f, b = 0.0f, tr = 1.0f, tg = 1.0f, tb = 1.0f;
   uint n = 0u;
   for (uint a = heads[p]; a != kListEnd; a = pool[kListNodeWords * a + 2u]) {
     uint best = a;
@@ -72,8 +72,8 @@ void main() {
     }
     const uint rgba = bestKey.y;
     precise float alpha = float(rgba >> 24) * uInv255;
-    overStep(r, g, b, T, alpha, srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
-             srgb8ToLinear((rgba >> 16) & 0xffu));
+    blendStep(r, g, b, tr, tg, tb, rgba >> 24, alpha, srgb8ToLinear(rgba & 0xffu),
+              srgb8ToLinear((rgba >> 8) & 0xffu), srgb8ToLinear((rgba >> 16) & 0xffu));
     ++n;
   }
   lengths[p] = n;
@@ -84,7 +84,7 @@ void main() {
                           uintBitsToFloat(tails[t + 2u]));
     behind = hybridBehind(sum, uintBitsToFloat(tails[t + 3u]), tails[t + 4u], uBackground);
   }
-  const vec3 result = overBackground(vec3(r, g, b), T, behind);
+  const vec3 result = overBackground(vec3(r, g, b), vec3(tr, tg, tb), behind);
   image[3u * p + 0u] = result.r;
   image[3u * p + 1u] = result.g;
   image[3u * p + 2u] = result.b;

@@ -155,7 +155,7 @@ TEST(ProceduralRng, IsSplitMix64WithTheReferenceSequence) {
 
 TEST(ProceduralParameters, UnknownParameterIsAnErrorListingTheKnownOnes) {
   expectError("layers?foo=1",
-              {"procedural:layers: unknown parameter 'foo' (known: k, r, pd, alpha, seed)"});
+              {"procedural:layers: unknown parameter 'foo' (known: k, r, pd, alpha, seed, blend)"});
   expectError("hairball?k=1", {"'k'", "strands, segments, sides, radius, alpha, seed"});
   expectError("smoke?strands=1", {"'strands'", "count, size, alpha, seed"});
   expectError("bottles?detail=1", {"'detail'", "count, segments, alpha, spacing, seed"});

@@ -49,6 +49,12 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
                  "Back faces culled: auto (as the file says: glTF materials with doubleSided "
                  "false; OBJ, PLY, JSON and procedural scenes are double-sided), none or back "
                  "(every back face; front = counter-clockwise) (default auto)");
+  app.add_option("--blend", blend,
+                 "Blend mode of every material (MODE) or of the materials named MATERIAL "
+                 "(MATERIAL=MODE); repeatable, applied in order. MODE: over (default), "
+                 "premultiplied, additive or multiply (docs/METHODS.md, blend modes)")
+      ->expected(1)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_flag("--quiet,-q", quiet, "No progress or summary on the terminal");
   app.add_flag("--json", json, "Print machine-readable JSON on stdout");
   app.add_flag("--allow-outside-references", allowOutsideReferences,
@@ -111,6 +117,7 @@ SceneRequest SceneOptions::request() const {
   r.background = background;
   r.transmissionFloor = transmissionFloor;
   r.cull = cull;
+  r.blend = blend;
   if (gltfScene != -1) r.gltfScene = gltfScene;
   return r;
 }
@@ -131,7 +138,7 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
   auto loaded = loadScene(o.source, load);
   if (!loaded) return loaded.error();
   PreparedScene prepared{std::move(loaded.value()), {}, {}};
-  applyToScene(request, prepared.scene);
+  MFR_TRY(applyToScene(request, prepared.scene));
   auto views = sceneViews(prepared.scene, o.source, request);
   if (!views) return views.error();
   prepared.cameras = std::move(views->cameras);

@@ -38,7 +38,8 @@ struct SceneOptions {
   std::optional<double> alpha;
   std::vector<double> background;
   double transmissionFloor = 0.1;
-  std::string cull = "auto";  // --cull auto|none|back
+  std::string cull = "auto";       // --cull auto|none|back
+  std::vector<std::string> blend;  // --blend MODE | MATERIAL=MODE, repeatable
   bool quiet = false;
   bool json = false;
   bool allowOutsideReferences = false;  // files named in a scene may lie outside its folder

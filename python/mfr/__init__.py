@@ -119,8 +119,9 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
            view=None, orbit=0, orbit_view=None, zoom=1.0, composite=None, capture="tile",
            threads=0, seed=1, model=None, occupancy_d=None, importance=None, alpha=None,
            background=None, transmission_floor=0.1, shuffle_draw_order=None, gltf_scene=None,
-           cull=None, engine="cpu", gl_sync="auto", gl_raster="native", memory_limit=None,
-           allow_outside_references=False, depth_complexity=True, max_peels=None):
+           cull=None, blend=None, engine="cpu", gl_sync="auto", gl_raster="native",
+           memory_limit=None, allow_outside_references=False, depth_complexity=True,
+           max_peels=None):
     """Renders with one method, exactly as `mfr render` with the same options (the library checks
     both the same way: its errors name the Python argument where the CLI names its flag).
 
@@ -145,6 +146,9 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
         glTF file's scenes (`--scene N`; default the file's own). cull: the back faces culled,
         "auto" (as the file says: glTF materials with doubleSided false), "none" or "back" (every
         back face), as `mfr --cull`; None: the scene's own (Scene.cull, "auto" when loaded).
+    blend: the materials' blend mode, as `mfr --blend`: "MODE" (every material) or
+        "MATERIAL=MODE", or a list of them applied in order; MODE: "over", "premultiplied",
+        "additive" or "multiply" (docs/METHODS.md, blend modes).
     engine: "cpu" or "gl" (mfr.engine_names()); gl_sync: the GL k-buffer's "auto", "lock" or
         "interlock"; gl_raster: the GL geometry passes, "native" (GL's own pipeline) or "exact"
         (the CPU engine's raster emulated: bit-identical to engine="cpu").
@@ -169,8 +173,8 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
                    occupancy_d=occupancy_d, importance=importance, alpha=alpha,
                    background=background, transmission_floor=transmission_floor,
                    shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
-                   engine=engine, gl_sync=gl_sync, gl_raster=gl_raster, memory_limit=memory_limit,
-                   allow_outside_references=allow_outside_references,
+                   blend=blend, engine=engine, gl_sync=gl_sync, gl_raster=gl_raster,
+                   memory_limit=memory_limit, allow_outside_references=allow_outside_references,
                    depth_complexity=depth_complexity, max_peels=max_peels)
 
 
@@ -179,8 +183,8 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
             zoom=1.0,
             composite=None, capture="tile", threads=0, seed=1, model=None, ppd=FLIP_DEFAULT_PPD,
             alpha=None, background=None, transmission_floor=0.1, shuffle_draw_order=None,
-            gltf_scene=None, cull=None, engine="cpu", gl_sync="auto", gl_raster="native",
-            memory_limit=None, allow_outside_references=False) -> dict:
+            gltf_scene=None, cull=None, blend=None, engine="cpu", gl_sync="auto",
+            gl_raster="native", memory_limit=None, allow_outside_references=False) -> dict:
     """Writes the folder `mfr compare --out OUT` writes for the same options and returns its
     results.json as a dict.
 
@@ -194,7 +198,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
     OUT/frame_NNN, the flicker of each method along the path in results.json and report.html;
     orbit_step: degrees between frames, default 360/N); with orbit_view=I only view I of the N
     is compared. scene, camera, view, zoom, width, height, threads, seed, alpha, background,
-    transmission_floor, shuffle_draw_order, gltf_scene, cull, engine, gl_sync, gl_raster,
+    transmission_floor, shuffle_draw_order, gltf_scene, cull, blend, engine, gl_sync, gl_raster,
     memory_limit, allow_outside_references: as in mfr.render. A method that fails at a budget is
     recorded with its error; bad input raises mfr.Error.
     """
@@ -216,6 +220,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                                  ("transmission_floor", transmission_floor, 0.1),
                                  ("shuffle_draw_order", shuffle_draw_order, None),
                                  ("gltf_scene", gltf_scene, None), ("cull", cull, None),
+                                 ("blend", blend, None),
                                  ("engine", engine, "cpu"), ("gl_sync", gl_sync, "auto"),
                                  ("gl_raster", gl_raster, "native"),
                                  ("memory_limit", memory_limit, None),
@@ -231,8 +236,8 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                     threads=threads, seed=seed, model=model, ppd=ppd, alpha=alpha,
                     background=background, transmission_floor=transmission_floor,
                     shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
-                    engine=engine, gl_sync=gl_sync, gl_raster=gl_raster, memory_limit=memory_limit,
-                    allow_outside_references=allow_outside_references,
+                    blend=blend, engine=engine, gl_sync=gl_sync, gl_raster=gl_raster,
+                    memory_limit=memory_limit, allow_outside_references=allow_outside_references,
                     command_line="mfr.compare(" + ", ".join(call) + ")")
 
 

@@ -82,9 +82,10 @@ py::object compare(const py::object& sceneArg, const std::string& out,
                    uint64_t seed, const py::object& model, double ppd, const py::object& alpha,
                    const py::object& background, double transmissionFloor,
                    const py::object& shuffleDrawOrder, const py::object& gltfScene,
-                   const py::object& cull, const std::string& engineName, const std::string& glSync,
-                   const std::string& glRaster, const py::object& memoryLimitArg,
-                   bool allowOutsideReferences, const std::string& commandLine) {
+                   const py::object& cull, const py::object& blend, const std::string& engineName,
+                   const std::string& glSync, const std::string& glRaster,
+                   const py::object& memoryLimitArg, bool allowOutsideReferences,
+                   const std::string& commandLine) {
   if (out.empty()) throw LibraryError("out: an output folder is required");
   const bool temporal = orbit != 0 && orbitView.is_none();  // every view of the orbit
   if (temporal && orbit < 2)
@@ -136,7 +137,7 @@ py::object compare(const py::object& sceneArg, const std::string& out,
   options.capture = captureArgument(capture);
   const SceneRequest request =
       sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
-                           transmissionFloor, shuffleDrawOrder, gltfScene, cull);
+                           transmissionFloor, shuffleDrawOrder, gltfScene, cull, blend);
   unwrap(checkThreads(threads, "threads"));
   // checked and staged before any work; put in place as `out` once complete (as mfr compare)
   OutputFolder folder = unwrap(OutputFolder::begin(out));
@@ -210,9 +211,9 @@ flip_map (LDR-FLIP per pixel, float32 (h, w) in [0, 1]).)");
         py::arg("composite"), py::arg("capture"), py::arg("threads"), py::arg("seed"),
         py::arg("model"), py::arg("ppd"), py::arg("alpha"), py::arg("background"),
         py::arg("transmission_floor"), py::arg("shuffle_draw_order"), py::arg("gltf_scene"),
-        py::arg("cull"), py::arg("engine"), py::arg("gl_sync"), py::arg("gl_raster"),
-        py::arg("memory_limit"), py::arg("allow_outside_references"), py::arg("command_line"),
-        "mfr.compare's work (see python/mfr/__init__.py).");
+        py::arg("cull"), py::arg("blend"), py::arg("engine"), py::arg("gl_sync"),
+        py::arg("gl_raster"), py::arg("memory_limit"), py::arg("allow_outside_references"),
+        py::arg("command_line"), "mfr.compare's work (see python/mfr/__init__.py).");
 }
 
 }  // namespace mfr::python

@@ -119,13 +119,14 @@ py::object renderScene(
     const std::string& capture, int threads, uint64_t seed, const py::object& model,
     const py::object& occupancyD, const py::object& importance, const py::object& alpha,
     const py::object& background, double transmissionFloor, const py::object& shuffleDrawOrder,
-    const py::object& gltfScene, const py::object& cull, const std::string& engineName,
-    const std::string& glSync, const std::string& glRaster, const py::object& memoryLimitArg,
-    bool allowOutsideReferences, bool wantDepthComplexity, const py::object& maxPeels) {
+    const py::object& gltfScene, const py::object& cull, const py::object& blend,
+    const std::string& engineName, const std::string& glSync, const std::string& glRaster,
+    const py::object& memoryLimitArg, bool allowOutsideReferences, bool wantDepthComplexity,
+    const py::object& maxPeels) {
   const std::optional<uint64_t> memoryLimit = memoryLimitArgument(memoryLimitArg);
   const SceneRequest request =
       sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
-                           transmissionFloor, shuffleDrawOrder, gltfScene, cull);
+                           transmissionFloor, shuffleDrawOrder, gltfScene, cull, blend);
   unwrap(checkThreads(threads, "threads"));
   const MethodDesc m =
       buildMethod(method, k, composite, model, occupancyD, importance, seed, maxPeels);
@@ -348,10 +349,10 @@ lines are not rendered: Scene.primitives_skipped counts them.)");
         py::arg("importance") = py::none(), py::arg("alpha") = py::none(),
         py::arg("background") = py::none(), py::arg("transmission_floor") = 0.1,
         py::arg("shuffle_draw_order") = py::none(), py::arg("gltf_scene") = py::none(),
-        py::arg("cull") = py::none(), py::arg("engine") = "cpu", py::arg("gl_sync") = "auto",
-        py::arg("gl_raster") = "native", py::arg("memory_limit") = py::none(),
-        py::arg("allow_outside_references") = false, py::arg("depth_complexity") = true,
-        py::arg("max_peels") = py::none(),
+        py::arg("cull") = py::none(), py::arg("blend") = py::none(), py::arg("engine") = "cpu",
+        py::arg("gl_sync") = "auto", py::arg("gl_raster") = "native",
+        py::arg("memory_limit") = py::none(), py::arg("allow_outside_references") = false,
+        py::arg("depth_complexity") = true, py::arg("max_peels") = py::none(),
         R"(Renders a scene (an mfr.Scene, or a source string loaded with `seed`) with one method, as
 `mfr render` does with the same options, and returns an mfr.RenderResult (a list of them for an
 orbit of several views). See mfr.render's Python documentation (python/mfr/__init__.py) for the

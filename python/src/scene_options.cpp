@@ -92,7 +92,7 @@ SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const SceneR
     {
       py::gil_scoped_release release;
       *loaded = unwrap(loadScene(source, load));
-      applyToScene(request, *loaded);
+      unwrap(applyToScene(request, *loaded, Spelling::Python));
     }
     return {loaded, source};
   }
@@ -107,7 +107,7 @@ SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const SceneR
   auto loaded = scene.cast<std::shared_ptr<Scene>>();
   if (!request.changesScene()) return {loaded, loaded->name};
   auto changed = std::make_shared<Scene>(*loaded);  // the caller's scene stays as it is
-  applyToScene(request, *changed);
+  unwrap(applyToScene(request, *changed, Spelling::Python));
   return {changed, loaded->name};
 }
 
@@ -116,7 +116,7 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
                                   double zoom, const py::object& alpha,
                                   const py::object& background, double transmissionFloor,
                                   const py::object& shuffleDrawOrder, const py::object& gltfScene,
-                                  const py::object& cull) {
+                                  const py::object& cull, const py::object& blend) {
   SceneRequest r;
   r.width = width;
   r.height = height;
@@ -154,6 +154,16 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
   if (!shuffleDrawOrder.is_none())
     r.shuffleDrawOrder = castArgument<uint64_t>(shuffleDrawOrder, "shuffle_draw_order");
   if (!cull.is_none()) r.cull = castArgument<std::string>(cull, "cull");
+  if (py::isinstance<py::str>(blend)) {  // "MODE" or "MATERIAL=MODE", or a list of them
+    r.blend.push_back(blend.cast<std::string>());
+  } else if (!blend.is_none()) {
+    if (!py::isinstance<py::iterable>(blend))
+      throw py::type_error("blend: expected a str or a list of str, got " +
+                           std::string(py::str(blend.get_type().attr("__name__"))));
+    for (const py::handle item : blend)
+      r.blend.push_back(
+          castArgument<std::string>(item, "blend[" + std::to_string(r.blend.size()) + "]"));
+  }
   unwrap(checkSceneRequest(r, Spelling::Python));
   return r;
 }

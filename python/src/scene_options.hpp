@@ -46,7 +46,7 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
                                   double zoom, const py::object& alpha,
                                   const py::object& background, double transmissionFloor,
                                   const py::object& shuffleDrawOrder, const py::object& gltfScene,
-                                  const py::object& cull);
+                                  const py::object& cull, const py::object& blend);
 
 /// A budget: bytes as an int, a size ("20MB") or a share of the A-buffer ("25%").
 BudgetSpec budgetSpecArgument(const py::object& budget);

@@ -525,3 +525,21 @@ def test_hybrid_compositing_takes_budgets_down_to_the_per_pixel_words():
                     composite="hybrid")
     assert at.stats["bytes_used"] == floor and at.stats["fragments_captured"] == 0
     assert not at.k_map.any()
+
+
+def test_blend_argument():
+    # blend="additive": emission only, so over a black background the A-buffer's image is the sum of
+    # the layers' emission, the same whatever the submission order; wboit refuses it in one line
+    source = "procedural:particles?count=40&clouds=2"
+    lit = mfr.render(source, width=W, height=H, blend="additive", background=(0, 0, 0))
+    over = mfr.render(source, width=W, height=H, background=(0, 0, 0))
+    assert float(lit.image.sum()) > float(over.image.sum())
+    shuffled = mfr.render(source, width=W, height=H, blend=["additive"], background=(0, 0, 0),
+                          shuffle_draw_order=3)
+    assert (shuffled.image == lit.image).all()
+    with pytest.raises(mfr.Error, match=r"wboit: the scene has additive materials"):
+        mfr.render(source, width=W, height=H, method="wboit", blend="additive")
+    with pytest.raises(mfr.Error, match=r"^blend 'glow': expected MODE or MATERIAL=MODE"):
+        mfr.render(source, width=W, height=H, blend="glow")
+    with pytest.raises(mfr.Error, match=r"blend 'lens=additive': the scene has no material"):
+        mfr.render(source, width=W, height=H, blend="lens=additive")

@@ -179,6 +179,7 @@ std::vector<ShadeMaterial> resolveMaterials(const Scene& scene) {
     s.mode = m.alphaMode;
     s.cutoff = m.alphaCutoff;
     s.cullBack = scene.cullsBackFaces(static_cast<uint32_t>(out.size()));
+    s.blend = m.blend;
     if (scene.alphaOverride) {
       s.alphaOverridden = true;
       s.overrideAlpha = *scene.alphaOverride;

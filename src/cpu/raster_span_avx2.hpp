@@ -161,13 +161,20 @@ struct LaneShading {
     ndotv = _mm256_blendv_ps(one, clamped, _mm256_cmp_ps(nn, zero, _CMP_GT_OQ));
     const __m256 light =
         _mm256_add_ps(ambient, _mm256_mul_ps(diffuse, _mm256_and_ps(ndotv, absMask)));
-    return _mm256_or_si256(
+    const __m256i word = _mm256_or_si256(
         _mm256_or_si256(
             detail::encodeSrgb8x8(tables, _mm256_mul_ps(r, light)),
             _mm256_slli_epi32(detail::encodeSrgb8x8(tables, _mm256_mul_ps(g, light)), 8)),
         _mm256_or_si256(
             _mm256_slli_epi32(detail::encodeSrgb8x8(tables, _mm256_mul_ps(b, light)), 16),
             alphaWord));
+    // overNodeWord (the lanes take over materials only): alpha byte 0 -> the word 0, 1 -> 2
+    const __m256i alphaByte = _mm256_srli_epi32(alphaWord, 24);
+    const __m256i kept =
+        _mm256_andnot_si256(_mm256_cmpeq_epi32(alphaByte, _mm256_setzero_si256()), word);
+    return _mm256_add_epi32(kept,
+                            _mm256_and_si256(_mm256_cmpeq_epi32(alphaByte, _mm256_set1_epi32(1)),
+                                             _mm256_set1_epi32(1 << 24)));
   }
 };
 
@@ -536,7 +543,7 @@ MFR_TARGET_AVX2 void rasterizeTileAvx2(const RasterFrame& frame, const ShadingIn
   for (const uint32_t* it = frame.tileBegin(tile); it != frame.tileEnd(tile); ++it) {
     const TriangleSetup& t = frame.setups()[*it];
     const ShadeMaterial& m = (*in.materials)[t.material];
-    if (m.texture != nullptr || m.mode == AlphaMode::Mask) {
+    if (m.texture != nullptr || m.mode == AlphaMode::Mask || m.blend != BlendMode::Over) {
       frame.rasterizeTile<ShadeMode::Full>(tile, sink);  // no cull depths: all scalar
       return;
     }

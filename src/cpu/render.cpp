@@ -19,6 +19,7 @@
 #include "mfr/cpu/dkb_curve_pass.hpp"
 #include "mfr/cpu/optimal_oracle.hpp"
 #include "mfr/learn/model_file.hpp"
+#include "mfr/method/blend_support.hpp"
 #include "mfr/method/optimal_allocation.hpp"
 #include "mfr/method/pass_plan.hpp"
 #include "pipeline.hpp"
@@ -355,6 +356,7 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
                                          const RenderOptions& options, uint64_t memoryLimit) {
   auto planned = planPasses(method, options);
   if (!planned) return planned.error();
+  MFR_TRY(checkBlendSupport(method, frame.blendModes()));
   const PassPlan& plan = planned.value();
   RenderOutput out;
   PassTimer timer(out.stats.passes);

@@ -178,7 +178,8 @@ Result<void> GlEngine::State::uploadMaterials(const Scene& scene) {
         (scene.cullsBackFaces(index) ? kMaterialCullBack : 0u) |
             static_cast<uint32_t>(m.baseColorSampler.wrapS) << kMaterialWrapSShift |
             static_cast<uint32_t>(m.baseColorSampler.wrapT) << kMaterialWrapTShift |
-            (m.baseColorSampler.filter == TextureFilter::Nearest ? kMaterialNearest : 0u)};
+            (m.baseColorSampler.filter == TextureFilter::Nearest ? kMaterialNearest : 0u) |
+            static_cast<uint32_t>(m.blend) << kMaterialBlendShift};
     materialWords.insert(materialWords.end(), words, words + kMaterialWords);
   }
   for (const auto& [name, bytes] :

@@ -18,6 +18,7 @@
 #include "mfr/gl/gl_technique.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/allocation.hpp"
+#include "mfr/method/blend_support.hpp"
 #include "mfr/method/dkb_model.hpp"
 #include "mfr/method/importance.hpp"
 #include "mfr/method/memory_model.hpp"
@@ -394,6 +395,7 @@ class GlRenderEngine final : public Engine {
     context_.makeCurrent();  // (another GL engine on this thread may have made its own current)
     auto plan = planPasses(method, options);
     if (!plan) return plan.error();
+    MFR_TRY(checkBlendSupport(method, gv->view().scene->blendModes()));
     return GlFrame(*gv, method, plan.value(), options).run(interlock_);
   }
 

@@ -23,27 +23,40 @@ std::vector<double> errorCurve(const FragmentNode* sorted, uint32_t n, glm::vec3
   std::vector<double> err(n + 1 - firstK, 0.0);
   // prefix: core colour and transmittance; suffix: tail sums (the calling thread's scratch, reused
   // from pixel to pixel: the oracle calls this once per covered pixel)
-  thread_local std::vector<glm::dvec3> core, tailColor;
-  thread_local std::vector<double> T, tailAlpha;
+  thread_local std::vector<glm::dvec3> core, T, tailColor;
+  thread_local std::vector<double> tailAlpha;
   core.assign(n + 1, glm::dvec3(0.0));
-  T.assign(n + 1, 1.0);
+  T.assign(n + 1, glm::dvec3(1.0));
   tailColor.assign(n + 2, glm::dvec3(0.0));
   tailAlpha.assign(n + 2, 0.0);
+  // the node kinds of method_math.h blendStep / hybridTailAddNode (over, additive, multiply)
   for (uint32_t i = 0; i < n; ++i) {
-    const glm::dvec4 c(unpackFragmentColor(nodeColor(sorted[i])));
-    core[i + 1] = core[i] + glm::dvec3(c) * (c.a * T[i]);
-    T[i + 1] = T[i] * (1.0 - c.a);
+    const uint32_t rgba = nodeColor(sorted[i]);
+    const glm::dvec4 c(unpackFragmentColor(rgba));
+    if ((rgba >> 24) == kAdditiveAlphaByte) {
+      core[i + 1] = core[i] + glm::dvec3(c) * T[i];
+      T[i + 1] = T[i];
+    } else if ((rgba >> 24) == kMultiplyAlphaByte) {
+      core[i + 1] = core[i];
+      T[i + 1] = T[i] * glm::dvec3(c);
+    } else {
+      core[i + 1] = core[i] + glm::dvec3(c) * (c.a * T[i]);
+      T[i + 1] = T[i] * (1.0 - c.a);
+    }
   }
   for (uint32_t i = n; i-- > 0;) {
-    const glm::dvec4 c(unpackFragmentColor(nodeColor(sorted[i])));
-    tailColor[i] = tailColor[i + 1] + glm::dvec3(c) * c.a;
-    tailAlpha[i] = tailAlpha[i + 1] + c.a;
+    const uint32_t rgba = nodeColor(sorted[i]);
+    const glm::dvec4 c(unpackFragmentColor(rgba));
+    const double weight = (rgba >> 24) == kAdditiveAlphaByte ? 1.0 : c.a;
+    tailColor[i] = tailColor[i + 1] + glm::dvec3(c) * weight;
+    tailAlpha[i] = tailAlpha[i + 1] + ((rgba >> 24) == kAdditiveAlphaByte ? 0.0 : c.a);
   }
   const glm::dvec3 bg(background);
   auto hybrid = [&](uint32_t k) {
     const uint32_t t = n - k;
     if (compositing == Compositing::KBuffer) return core[k] + T[k] * bg;  // tail dropped
-    if (t == 0 || tailAlpha[k] <= 0.0) return core[k] + T[k] * bg;
+    if (t == 0) return core[k] + T[k] * bg;
+    if (tailAlpha[k] <= 0.0) return core[k] + T[k] * (bg + tailColor[k]);
     const glm::dvec3 colour = tailColor[k] / tailAlpha[k];
     const double alpha =
         1.0 - std::pow(std::max(0.0, 1.0 - tailAlpha[k] / t), static_cast<double>(t));

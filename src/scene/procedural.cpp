@@ -381,6 +381,7 @@ Result<Scene> makeProceduralScene(const std::string& spec, uint64_t seed, double
   const std::string prefix = "procedural:" + name;
   std::vector<std::string> known = def->keys;
   known.emplace_back("seed");
+  known.emplace_back("blend");
 
   ProceduralParams params;
   size_t pos = 0;
@@ -408,9 +409,19 @@ Result<Scene> makeProceduralScene(const std::string& spec, uint64_t seed, double
                        " (expected an integer in [0, 18446744073709551615])");
   }
 
+  // blend=MODE: every material of the scene (scene/blend_mode.hpp)
+  std::optional<BlendMode> blend;
+  if (const auto it = params.find("blend"); it != params.end()) {
+    auto mode = parseBlendMode(it->second, prefix + ": parameter 'blend'");
+    if (!mode) return mode.error();
+    blend = *mode;
+  }
+
   ParamReader reader(prefix, params, maxTriangles);
   Result<Scene> scene = def->build(reader, seed);
   if (!scene) return scene.error();
+  if (blend)
+    for (Material& m : scene->materials) m.blend = *blend;
   scene->name = "procedural:" + std::string(text);
   MFR_TRY(validateScene(*scene));
   return scene;

@@ -37,6 +37,7 @@ Result<void> checkSceneRequest(const SceneRequest& r, Spelling spelling) {
   if (!(r.transmissionFloor >= 0.0 && r.transmissionFloor <= 1.0))
     return makeError(flag("--transmission-floor") + ": must be in [0, 1]");
   if (!r.cull.empty()) MFR_TRY(parseCullMode(r.cull, flag("--cull")));
+  for (const std::string& b : r.blend) MFR_TRY(parseBlendOverride(b, flag("--blend")));
   if (r.view < -1) return makeError(flag("--view") + ": must be a camera index (0-based)");
   if (r.gltfScene && *r.gltfScene < 0)
     return makeError(spell(spelling, spelling == Spelling::Cli ? "--scene" : "gltf_scene") +
@@ -48,12 +49,33 @@ Result<void> checkSceneRequest(const SceneRequest& r, Spelling spelling) {
   return {};
 }
 
-void applyToScene(const SceneRequest& r, Scene& scene) {
+Result<void> applyToScene(const SceneRequest& r, Scene& scene, Spelling spelling) {
   if (r.shuffleDrawOrder) shuffleDrawOrder(scene, *r.shuffleDrawOrder);
   if (r.alpha) scene.alphaOverride = static_cast<float>(*r.alpha);
   if (r.background.size() == 3)
     scene.background = glm::vec3(r.background[0], r.background[1], r.background[2]);
   if (auto cull = parseCullMode(r.cull, "--cull"); cull && !r.cull.empty()) scene.cull = *cull;
+  for (const std::string& text : r.blend) {
+    const std::string name = spell(spelling, "--blend");
+    auto o = parseBlendOverride(text, name);
+    if (!o) return o.error();
+    bool named = false;
+    for (Material& m : scene.materials)
+      if (o->material.empty() || m.name == o->material) {
+        m.blend = o->mode;
+        named = true;
+      }
+    if (!named) {
+      std::string known;
+      for (const Material& m : scene.materials)
+        if (!m.name.empty() && known.size() < 200)
+          known += (known.empty() ? "" : ", ") + quoteInput(m.name, 40);
+      return makeError(name + " " + quoteInput(text) + ": the scene has no material named " +
+                       quoteInput(o->material) +
+                       (known.empty() ? "" : " (materials: " + known + ")"));
+    }
+  }
+  return {};
 }
 
 Result<SceneViews> sceneViews(const Scene& scene, const std::string& source, const SceneRequest& r,

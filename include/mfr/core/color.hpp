@@ -8,6 +8,8 @@
 #include <cstdint>
 
 #include <glm/glm.hpp>
+
+#include "mfr/core/blend_mode.hpp"
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -93,6 +95,52 @@ inline uint32_t packFragmentColor(const ColorTables& t, const glm::vec3& linearR
 }
 inline uint32_t packFragmentColor(const glm::vec3& linearRgb, float alpha) {
   return packFragmentColor(ColorTables::get(), linearRgb, alpha);
+}
+
+/// The node word of each blend mode (core/blend_mode.hpp). Its alpha byte says what it is:
+///   2..255  over: sRGB colour, linear alpha
+///   0       additive: the sRGB-encoded emission e = a c, added times the transmittance in front
+///   1       multiply: the sRGB-encoded factor t = 1 - a + a c, per channel, on all behind it
+/// An over fragment whose alpha byte would be 0 (it adds nothing and hides nothing) becomes the
+/// additive word 0, which adds nothing: every rule composites it as before. One whose alpha byte
+/// would be 1 keeps 2 (alpha 2/255 instead of 1/255). The stores, the sort and the node's order
+/// do not change: the kind rides in the byte every rule already reads (method_math.h blendStep).
+inline constexpr uint32_t kAdditiveAlphaByte = 0u;
+inline constexpr uint32_t kMultiplyAlphaByte = 1u;
+inline constexpr uint32_t kMinOverAlphaByte = 2u;
+
+/// An over word as a node word: alpha byte 0 -> the word 0, alpha byte 1 -> 2.
+inline uint32_t overNodeWord(uint32_t word) {
+  const uint32_t a8 = word >> 24;
+  if (a8 == kAdditiveAlphaByte) return 0u;
+  if (a8 == kMultiplyAlphaByte) return (word & 0x00ffffffu) | (kMinOverAlphaByte << 24);
+  return word;
+}
+
+/// The node word of a fragment of shaded linear colour `rgb` and alpha `alpha` in blend mode
+/// `mode`. Premultiplied: `rgb` is the premultiplied colour; with an alpha byte of 0 it is the
+/// additive word of emission rgb, else the over word of straight colour rgb / alpha (clamped to
+/// 1: a premultiplied colour above its alpha loses the excess).
+inline uint32_t packBlendedColor(const ColorTables& t, BlendMode mode, const glm::vec3& rgb,
+                                 float alpha) {
+  switch (mode) {
+    case BlendMode::Over:
+      break;
+    case BlendMode::Premultiplied: {
+      const float a = saturate(alpha);
+      if (static_cast<int32_t>(a * 255.0f + 0.5f) == 0)
+        return packFragmentColor(t, rgb, 0.0f) & 0x00ffffffu;
+      return overNodeWord(packFragmentColor(t, rgb / a, a));
+    }
+    case BlendMode::Additive:
+      return packFragmentColor(t, rgb * saturate(alpha), 0.0f) & 0x00ffffffu;
+    case BlendMode::Multiply: {
+      const float a = saturate(alpha);
+      const glm::vec3 factor = (1.0f - a) + a * rgb;
+      return (packFragmentColor(t, factor, 0.0f) & 0x00ffffffu) | (kMultiplyAlphaByte << 24);
+    }
+  }
+  return overNodeWord(packFragmentColor(t, rgb, alpha));
 }
 
 /// Unpacks a fragment colour word to linear RGB and alpha.

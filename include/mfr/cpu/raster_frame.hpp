@@ -49,7 +49,8 @@ struct ShadeMaterial {
   float cutoff = 0.5f;
   bool alphaOverridden = false;
   float overrideAlpha = 1.0f;
-  bool cullBack = false;  // Scene::cullsBackFaces: back faces dropped at set-up
+  bool cullBack = false;              // Scene::cullsBackFaces: back faces dropped at set-up
+  BlendMode blend = BlendMode::Over;  // the node word's kind (packBlendedColor)
 };
 
 /// Everything the inner loop needs of one (clipped) screen-space triangle.
@@ -129,6 +130,12 @@ class RasterFrame {
   const uint32_t* tileEnd(int tile) const { return binned_.data() + binOffsets_[tile + 1]; }
 
   const std::vector<TriangleSetup>& setups() const { return setups_; }
+  /// The blend modes of the scene's materials (Scene::blendModes).
+  uint32_t blendModes() const {
+    uint32_t modes = 0;
+    for (const ShadeMaterial& m : materials_) modes |= blendBit(m.blend);
+    return modes;
+  }
   /// The vertex colours / w of set-up `setupIndex` (meaningful when its hasColor is set; the
   /// frame keeps them only when the scene has colours).
   const TriangleColors& vertexColors(size_t setupIndex) const { return colors_[setupIndex]; }

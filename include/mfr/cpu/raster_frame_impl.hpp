@@ -157,7 +157,8 @@ template <ShadeMode Mode>
   const float ndotv =
       nn > 0.0f ? std::clamp((nz - nx * dx - ny * dy) / std::sqrt(nn), -1.0f, 1.0f) : 1.0f;
   const float light = kAmbient + (1.0f - kAmbient) * std::fabs(ndotv);
-  f.rgba = packFragmentColor(*colorTables_, glm::vec3(base) * light, base.a);
+  f.rgba = packBlendedColor(*colorTables_, materials_[t.material].blend, glm::vec3(base) * light,
+                            base.a);
   f.ndotv = ndotv;
 }
 

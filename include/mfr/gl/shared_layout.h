@@ -122,14 +122,20 @@ MFR_GL_CONST(uint, kBindAllocOffsets, 7u)       // exclusive prefix sum of k(p) 
 // first texel in the texel buffer (kNoTexture: none), its width, height; alpha mode
 // (mfr::AlphaMode); cutoff; alpha override flag, override value; flags (kMaterialCullBack, the
 // texture's sampler: wrap S and wrap T as method_math.h's kTextureWrap* in 2 bits each at
-// kMaterialWrapSShift and kMaterialWrapTShift, kMaterialNearest)
+// kMaterialWrapSShift and kMaterialWrapTShift, kMaterialNearest, the blend mode at
+// kMaterialBlendShift)
 MFR_GL_CONST(uint, kMaterialWords, 12u)
 MFR_GL_CONST(uint, kMaterialFlagsWord, 11u)
 MFR_GL_CONST(uint, kMaterialCullBack, 1u)    // flag: back faces culled (mfr::Scene::cullsBackFaces)
 MFR_GL_CONST(uint, kMaterialWrapSShift, 1u)  // mfr::TextureSampler::wrapS
 MFR_GL_CONST(uint, kMaterialWrapTShift, 3u)  // mfr::TextureSampler::wrapT
 MFR_GL_CONST(uint, kMaterialWrapMask, 3u)
-MFR_GL_CONST(uint, kMaterialNearest, 32u)  // flag: TextureFilter::Nearest (else bilinear)
+MFR_GL_CONST(uint, kMaterialNearest, 32u)    // flag: TextureFilter::Nearest (else bilinear)
+MFR_GL_CONST(uint, kMaterialBlendShift, 6u)  // mfr::BlendMode in 2 bits (packBlended)
+MFR_GL_CONST(uint, kMaterialBlendMask, 3u)
+MFR_GL_CONST(uint, kBlendPremultiplied, 1u)  // mfr::BlendMode values
+MFR_GL_CONST(uint, kBlendAdditive, 2u)
+MFR_GL_CONST(uint, kBlendMultiply, 3u)
 MFR_GL_CONST(uint, kNoTexture, 0xffffffffu)
 MFR_GL_CONST(uint, kAlphaOpaque, 0u)  // mfr::AlphaMode values
 MFR_GL_CONST(uint, kAlphaMask, 1u)

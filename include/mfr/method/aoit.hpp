@@ -85,8 +85,10 @@ struct AoitPixel {
   }
   void addColor(float depth, uint32_t rgba) {
     const glm::vec4 c = unpackFragmentColor(rgba);
-    if (c.a <= 0.0f) return;
-    method_math::aoitAddColor(r, g, b, glm::vec3(c), c.a, visibility(depth));
+    // an additive node (alpha byte 0) adds its emission times vis(z) and no visibility node
+    const float weight = (rgba >> 24) == kAdditiveAlphaByte ? 1.0f : c.a;
+    if (weight <= 0.0f || rgba == 0u) return;  // the word 0: an additive node adding nothing
+    method_math::aoitAddColor(r, g, b, glm::vec3(c), weight, visibility(depth));
   }
   /// nodes in use (depth below kAoitEmptyDepth)
   int used() const {
@@ -108,6 +110,8 @@ struct AoitPasses {
   static constexpr int kNodeCount = N;
   static constexpr bool kNodes = false;
   static constexpr std::array<const char*, 1> kExtraPasses{"visibility"};
+  /// Additive nodes add e vis(z) (no visibility node); multiply needs a per-channel visibility.
+  static constexpr uint32_t kBlendModes = kEveryBlendMode & ~blendBit(BlendMode::Multiply);
   template <class PeerPixel>
   static void add(PeerPixel px, int pass, float depth, uint32_t rgba) {
     if (pass == 0) {

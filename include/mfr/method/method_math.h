@@ -309,6 +309,94 @@ MFR_MATH_FN vec3 overBackground(vec3 color, float T, vec3 behind) {
   return result;
 }
 
+// ---- blend modes: the node's alpha byte says its kind (core/color.hpp packBlendedColor) -------
+MFR_MATH_CONST(uint, kAdditiveNode, 0u)  // rgb: the emission, added times T
+MFR_MATH_CONST(uint, kMultiplyNode, 1u)  // rgb: the factor, multiplied into T per channel
+
+/// One front-to-back step of a sorted node of any kind (alpha byte a8, its alpha a = a8 / 255 as
+/// the caller computes it, decoded linear colour c)
+/// onto the colour sum (r, g, b) and the per-channel transmittance (tr, tg, tb) in front of it:
+///   over (a8 >= 2, a = a8 / 255):  (r, g, b) += c a T,  T *= 1 - a   (overStep per channel)
+///   additive (a8 = 0):             (r, g, b) += c T
+///   multiply (a8 = 1):             T *= c
+/// With equal channels of T and over nodes only, every channel is overStep's operations.
+MFR_MATH_FN void blendStep(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(float) b,
+                           MFR_INOUT(float) tr, MFR_INOUT(float) tg, MFR_INOUT(float) tb, uint a8,
+                           float a, float cr, float cg, float cb) {
+  if (a8 == kAdditiveNode) {
+    MFR_PRECISE float nr = r + cr * tr;
+    MFR_PRECISE float ng = g + cg * tg;
+    MFR_PRECISE float nb = b + cb * tb;
+    r = nr;
+    g = ng;
+    b = nb;
+  } else if (a8 == kMultiplyNode) {
+    MFR_PRECISE float nr = tr * cr;
+    MFR_PRECISE float ng = tg * cg;
+    MFR_PRECISE float nb = tb * cb;
+    tr = nr;
+    tg = ng;
+    tb = nb;
+  } else {
+    MFR_PRECISE float wr = a * tr;
+    MFR_PRECISE float wg = a * tg;
+    MFR_PRECISE float wb = a * tb;
+    MFR_PRECISE float nr = r + cr * wr;
+    MFR_PRECISE float ng = g + cg * wg;
+    MFR_PRECISE float nb = b + cb * wb;
+    MFR_PRECISE float ntr = tr * (1.0f - a);
+    MFR_PRECISE float ntg = tg * (1.0f - a);
+    MFR_PRECISE float ntb = tb * (1.0f - a);
+    r = nr;
+    g = ng;
+    b = nb;
+    tr = ntr;
+    tg = ntg;
+    tb = ntb;
+  }
+}
+
+/// blendStep with one transmittance for the methods that keep one (depth peeling): over and
+/// additive nodes (a multiply node is not reached: those methods refuse multiply materials,
+/// method/blend_support.hpp).
+MFR_MATH_FN void blendStepScalar(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(float) b,
+                                 MFR_INOUT(float) T, uint a8, float a, float cr, float cg,
+                                 float cb) {
+  if (a8 == kAdditiveNode) {
+    MFR_PRECISE float nr = r + cr * T;
+    MFR_PRECISE float ng = g + cg * T;
+    MFR_PRECISE float nb = b + cb * T;
+    r = nr;
+    g = ng;
+    b = nb;
+  } else {
+    overStep(r, g, b, T, a, cr, cg, cb);
+  }
+}
+
+/// underStep (back to front) of a node of any kind but multiply: an additive node adds its
+/// emission in front of what lies behind, (r, g, b) += c, T unchanged.
+MFR_MATH_FN void blendUnderStepScalar(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(float) b,
+                                      MFR_INOUT(float) T, uint a8, float a, float cr, float cg,
+                                      float cb) {
+  if (a8 == kAdditiveNode) {
+    MFR_PRECISE float nr = cr + r;
+    MFR_PRECISE float ng = cg + g;
+    MFR_PRECISE float nb = cb + b;
+    r = nr;
+    g = ng;
+    b = nb;
+  } else {
+    underStep(r, g, b, T, a, cr, cg, cb);
+  }
+}
+
+/// overBackground with a per-channel transmittance.
+MFR_MATH_FN vec3 overBackground(vec3 color, vec3 T, vec3 behind) {
+  MFR_PRECISE vec3 result = color + T * behind;
+  return result;
+}
+
 /// mfr::HybridTail::add: a fragment (linear colour c, alpha a) not kept by the store joins the
 /// pixel's order-independent tail: sums of a c and a, and the count t.
 MFR_MATH_FN void hybridTailAdd(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(float) b,
@@ -325,12 +413,35 @@ MFR_MATH_FN void hybridTailAdd(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT
   count = count + 1u;
 }
 
+/// hybridTailAdd of a node of any kind but multiply (refused under hybrid compositing, method/
+/// blend_support.hpp): an additive node adds its emission to the colour sum and nothing to the
+/// alpha sum, so hybridBehind weights it like the tail's over fragments (alpha_tail / sum(a)).
+MFR_MATH_FN void hybridTailAddNode(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(float) b,
+                                   MFR_INOUT(float) alphaSum, MFR_INOUT(uint) count, uint a8,
+                                   float a, float cr, float cg, float cb) {
+  if (a8 == kAdditiveNode) {
+    MFR_PRECISE float nr = r + cr;
+    MFR_PRECISE float ng = g + cg;
+    MFR_PRECISE float nb = b + cb;
+    r = nr;
+    g = ng;
+    b = nb;
+    count = count + 1u;
+  } else {
+    hybridTailAdd(r, g, b, alphaSum, count, a, cr, cg, cb);
+  }
+}
+
 /// What lies behind the sorted core in the hybrid rule: the tail (C_tail = sum(a c) / sum(a),
 /// a_avg = sum(a) / t, alpha_tail = 1 - (1 - a_avg)^t) over the background; the background alone
 /// when the tail is empty. pow: std::pow on the host, GLSL's pow (exp2(y log2 x)) on the GPU, so
 /// the last bits of a non-empty tail may differ between the engines.
 MFR_MATH_FN vec3 hybridBehind(vec3 tailSum, float tailAlphaSum, uint tailCount, vec3 background) {
-  if (tailCount == 0u || tailAlphaSum <= 0.0f) return background;
+  if (tailCount == 0u) return background;
+  if (tailAlphaSum <= 0.0f) {  // additive nodes only (or invisible ones): their emission, in front
+    MFR_PRECISE vec3 lit = background + tailSum;
+    return lit;
+  }
   MFR_PRECISE vec3 tailColor = tailSum / tailAlphaSum;
   MFR_PRECISE float avgAlpha = tailAlphaSum / float(tailCount);
   MFR_PRECISE float tailAlpha = 1.0f - pow(max(0.0f, 1.0f - avgAlpha), float(tailCount));

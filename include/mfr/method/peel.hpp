@@ -63,16 +63,17 @@ struct PeelKey {
   }
 };
 
-/// One layer of multiplicity m composited front to back onto (r, g, b, T): m "over" steps, the
-/// A-buffer resolve's operations for m equal fragments.
+/// One layer of multiplicity m composited front to back onto (r, g, b, T): m steps of its kind
+/// (over or additive, method_math.h blendStepScalar), the A-buffer resolve's operations for m
+/// equal fragments.
 inline void peelOverLayer(float& r, float& g, float& b, float& T, FragmentNode key, uint32_t m) {
   const uint32_t rgba = nodeColor(key);
   const ColorTables& t = ColorTables::get();
   const float a = static_cast<float>(rgba >> 24) * (1.0f / 255.0f);
   for (uint32_t i = 0; i < m; ++i)
-    method_math::overStep(r, g, b, T, a, t.srgb8ToLinear[rgba & 0xffu],
-                          t.srgb8ToLinear[(rgba >> 8) & 0xffu],
-                          t.srgb8ToLinear[(rgba >> 16) & 0xffu]);
+    method_math::blendStepScalar(r, g, b, T, rgba >> 24, a, t.srgb8ToLinear[rgba & 0xffu],
+                                 t.srgb8ToLinear[(rgba >> 8) & 0xffu],
+                                 t.srgb8ToLinear[(rgba >> 16) & 0xffu]);
 }
 
 /// One layer of multiplicity m blended back to front in front of the back colour (r, g, b, T).
@@ -81,9 +82,9 @@ inline void peelUnderLayer(float& r, float& g, float& b, float& T, FragmentNode 
   const ColorTables& t = ColorTables::get();
   const float a = static_cast<float>(rgba >> 24) * (1.0f / 255.0f);
   for (uint32_t i = 0; i < m; ++i)
-    method_math::underStep(r, g, b, T, a, t.srgb8ToLinear[rgba & 0xffu],
-                           t.srgb8ToLinear[(rgba >> 8) & 0xffu],
-                           t.srgb8ToLinear[(rgba >> 16) & 0xffu]);
+    method_math::blendUnderStepScalar(r, g, b, T, rgba >> 24, a, t.srgb8ToLinear[rgba & 0xffu],
+                                      t.srgb8ToLinear[(rgba >> 8) & 0xffu],
+                                      t.srgb8ToLinear[(rgba >> 16) & 0xffu]);
 }
 
 /// Depth peeling's pixel: 36 bytes.
@@ -196,6 +197,8 @@ struct PeelPasses {
   static constexpr bool kNodes = false;
   static constexpr bool kRepeatsCapture = true;
   static constexpr std::array<const char*, 0> kExtraPasses{};
+  /// Over and additive layers (blendStepScalar); multiply needs a per-channel T in the pixel.
+  static constexpr uint32_t kBlendModes = kEveryBlendMode & ~blendBit(BlendMode::Multiply);
   /// A fragment of a peel pass; true when it is still to peel (counted frame-wide).
   template <class PeerPixel>
   static bool add(PeerPixel px, int /*pass*/, float depth, uint32_t rgba) {

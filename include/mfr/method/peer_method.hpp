@@ -70,6 +70,18 @@ using PeerMethods = PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Metho
                              MboitTrig3_16Method, MboitTrig4_16Method, MlabMethod, Aoit4Method,
                              Aoit8Method, Aoit16Method, PeelMethod, DualPeelMethod>;
 
+/// The blend modes a peer composites (core/blend_mode.hpp), as blendBit masks: its kBlendModes,
+/// else over and premultiplied (a premultiplied fragment reaches the rule as an over fragment of
+/// straight colour; its emission at alpha 0 is an additive node, which a rule weighting by alpha
+/// ignores, as its paper's premultiplied form does).
+template <class Peer>
+constexpr uint32_t peerBlendModes() {
+  if constexpr (requires { Peer::kBlendModes; })
+    return Peer::kBlendModes;
+  else
+    return blendBit(BlendMode::Over) | blendBit(BlendMode::Premultiplied);
+}
+
 /// Whether a peer's capture repeats (depth peeling's kRepeatsCapture); false when it does not say.
 template <class Peer>
 constexpr bool peerRepeatsCapture() {

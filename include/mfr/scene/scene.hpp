@@ -9,6 +9,7 @@
 
 #include <glm/glm.hpp>
 
+#include "mfr/core/blend_mode.hpp"
 #include "mfr/core/result.hpp"
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/cull_mode.hpp"
@@ -52,6 +53,9 @@ struct Material {
   /// glTF `doubleSided`: false lets CullMode::Auto cull the back faces. Formats without the notion
   /// (OBJ, PLY, JSON and procedural scenes) are double-sided.
   bool doubleSided = true;
+  /// How the material's fragments blend (scene/blend_mode.hpp): `--blend`, a procedural scene's
+  /// `blend=`; files do not say (glTF's BLEND is over).
+  BlendMode blend = BlendMode::Over;
 };
 
 struct Scene {
@@ -100,6 +104,13 @@ struct Scene {
     for (int c = 0; c < 3; ++c)
       if (colors[indices[triangle * 3 + c]] != glm::vec4(1.0f)) return true;
     return false;
+  }
+
+  /// The blend modes of the scene's materials, as blendBit masks.
+  uint32_t blendModes() const {
+    uint32_t modes = 0;
+    for (const Material& m : materials) modes |= blendBit(m.blend);
+    return modes;
   }
 
   size_t triangleCount() const { return indices.size() / 3; }

@@ -30,20 +30,24 @@ struct SceneRequest {
   double transmissionFloor = 0.1;            // --transmission-floor (glTF transmission glass)
   std::optional<int> gltfScene;              // --scene N: which of a glTF file's scenes
   std::string cull;  // --cull auto|none|back (Scene::cull); empty: the scene's as it is
+  /// --blend MODE or MATERIAL=MODE, repeatable, applied in order (scene/blend_mode.hpp)
+  std::vector<std::string> blend;
 
   bool hasCamera() const { return !camera.empty() || !cameraNumbers.empty(); }
   /// True when applyToScene changes a loaded scene.
   bool changesScene() const {
-    return shuffleDrawOrder || alpha || !background.empty() || !cull.empty();
+    return shuffleDrawOrder || alpha || !background.empty() || !cull.empty() || !blend.empty();
   }
 };
 
 /// The checks that need no scene: sizes, ranges, one camera source, --orbit-view within --orbit.
 Result<void> checkSceneRequest(const SceneRequest& request, Spelling spelling = Spelling::Cli);
 
-/// The draw order, alpha, background and cull overrides, applied to a loaded scene (a request
-/// that passed checkSceneRequest).
-void applyToScene(const SceneRequest& request, Scene& scene);
+/// The draw order, alpha, background, cull and blend overrides, applied to a loaded scene (a
+/// request that passed checkSceneRequest). The one error: a --blend MATERIAL=MODE naming no
+/// material of the scene.
+Result<void> applyToScene(const SceneRequest& request, Scene& scene,
+                          Spelling spelling = Spelling::Cli);
 
 /// The views to render and, with --orbit-view I > 0, view I - 1 of the orbit (the frame before
 /// the rendered one: its nearest |n.v| feeds the variable k-buffer's Fresnel term).
