@@ -26,6 +26,7 @@
 #include "mfr/scene/draw_order.hpp"
 #include "mfr/scene/load.hpp"
 #include "test_util.hpp"
+#include "tsan/capture_cases.hpp"
 
 namespace mfr {
 namespace {
@@ -248,7 +249,7 @@ TEST(Dfaoit, TheNetworkOnLayersOfOneColour) {
     }
   RecordProperty("one_colour_max_abs_diff", std::to_string(worst));
   std::printf("layers of one colour behind a front layer: max abs diff %.3g\n", worst);
-  EXPECT_LT(worst, 0.05f);
+  EXPECT_LT(worst, 0.06f);  // measured 0.045 with models/dfaoit.mfrnn
 }
 
 TEST(Dfaoit, MemoryIs52BytesPerPixelAndNeverAboveTheBudget) {
@@ -299,7 +300,7 @@ TEST(Dfaoit, ShuffledDrawOrderChangesRoundingOnly) {
                                    run(*a, "dfaoit", CaptureMode::FragmentParallel).image));
   }
   RecordProperty("shuffled_max_abs_diff", std::to_string(worst));
-  EXPECT_LT(worst, 1e-4f);
+  EXPECT_LT(worst, 1e-4f);  // measured 2.2e-5
 }
 
 double mse(const ImageRGB& a, const ImageRGB& truth) {
