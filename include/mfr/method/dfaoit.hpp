@@ -25,10 +25,11 @@
 //               the paper accumulates its own feature set (not reproduced here: the stored copy of
 //               the paper available to this work gave its abstract and introduction only, and the
 //               authors' shader code was not found in the stored repositories), so this set is
-//               mfr's, chosen to be scale-free (every input O(1), no image-level statistic) and
-//               exact for one layer.
+//               mfr's, chosen to be scale-free (every input O(1), no image-level statistic).
 //   network     12 -> 32 -> 32 -> 3, ReLU, ReLU, sigmoid (learn::Mlp, the project's trainer
-//               `mfr train`); 1,571 parameters. The output is y' = sum_{i >= 1} a_i T_i c_i /
+//               `mfr train`); 1,571 parameters. The size is mfr's (the paper's layer sizes were
+//               not available to this work either), kept small so the per-pixel resolve stays
+//               cheap on both engines. The output is y' = sum_{i >= 1} a_i T_i c_i /
 //               ((1 - a0) - T) (T_i the transmittance in front of fragment i), in [0, 1], so one
 //               network serves any background and an empty pixel is the background exactly. With
 //               at most two fragments y' is known exactly (the rest is one fragment: y' = its
@@ -37,7 +38,7 @@
 //   colour      linear RGB throughout (inputs and target), like every method of mfr (which space
 //               the paper's network works in was not checked: see above).
 //   training    `mfr dataset --target dfaoit` on the procedural corpus only (the A-buffer's sorted
-//               composite gives y per pixel), `mfr train` (mean squared error, SGD with momentum),
+//               composite gives y' per pixel), `mfr train` (mean squared error, SGD with momentum),
 //               scripts/train-dfaoit.sh; the model ships as models/dfaoit.mfrnn, compiled into the
 //               library like the deep k-buffer's, reproducible bit for bit (the tiny reference
 //               models/test/dfaoit-tiny.mfrnn, tests/dfaoit_repro_test.sh).
@@ -45,7 +46,8 @@
 // Order independence: the sums are float sums in arrival order (the CPU engine's tile-owned
 // capture: primitive order; fragment-parallel and GL: any), so another draw order changes their
 // last bits only; the nearest node, the farthest depth and the count do not depend on the order.
-// The image is therefore draw-order independent up to float rounding of the sums (tested).
+// The image is therefore draw-order independent up to float rounding of the sums (measured: 2.2e-5
+// at most on shuffled hairball and smoke scenes, Dfaoit.ShuffledDrawOrderChangesRoundingOnly).
 // Memory: 52 B per pixel (plus the lock word of the fragment-parallel capture, and on GL).
 #pragma once
 
