@@ -10,6 +10,7 @@
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/method/budget_spec.hpp"
+#include "mfr/method/dfaoit.hpp"
 
 namespace mfr::cli {
 namespace {
@@ -22,7 +23,8 @@ struct DatasetArgs {
   std::vector<std::string> budgets;  // relative shares ("25%"), instead of the steps
   double sample = 0.2;
   std::string composite = "hybrid";
-  std::string curveOut;  // also dkb-curve's dataset of the same samples
+  std::string curveOut;        // also dkb-curve's dataset of the same samples
+  std::string target = "dkb";  // dkb: the deep k-buffer's samples; dfaoit: DFAOIT's
   const CLI::App* command = nullptr;
 };
 
@@ -31,6 +33,14 @@ int runDataset(DatasetArgs& a) {
     return fail("--budget-steps " + std::to_string(a.budgetSteps) + ": must be in [1, 64]");
   if (!(a.sample > 0.0 && a.sample <= 1.0)) return fail("--sample: must be in (0, 1]");
   if (a.out.empty()) return fail("--out: empty path");
+  if (a.target != "dkb" && a.target != "dfaoit")
+    return fail("--target " + quoteInput(a.target) + ": expected dkb or dfaoit");
+  const bool dfaoit = a.target == "dfaoit";
+  if (dfaoit && (!a.budgets.empty() || a.command->count("--budget-steps") > 0 ||
+                 a.command->count("--composite") > 0 || !a.curveOut.empty()))
+    return fail(
+        "--target dfaoit: --budget, --budget-steps, --composite and --curve-out do not "
+        "apply (DFAOIT keeps no nodes)");
   learn::Dataset data;
   learn::ViewSamplingOptions sampling;
   sampling.budgetSteps = a.budgetSteps;
@@ -73,6 +83,12 @@ int runDataset(DatasetArgs& a) {
       ro.threads = options.threads;
       auto frame = RasterFrame::build(prepared->scene, prepared->cameras[v], ro);
       if (!frame) return fail(echoPath(source) + ": " + frame.error().message);
+      if (dfaoit) {
+        const auto samples =
+            learn::sampleDfaoitView(frame.value(), sceneIndex, static_cast<uint32_t>(v), sampling);
+        data.samples.insert(data.samples.end(), samples.begin(), samples.end());
+        continue;
+      }
       auto samples =
           learn::sampleView(frame.value(), sceneIndex, static_cast<uint32_t>(v), sampling);
       if (!samples) return fail(echoPath(source) + ": " + samples.error().message);
@@ -82,18 +98,26 @@ int runDataset(DatasetArgs& a) {
         {{"scene", source}, {"views", views}, {"samples", data.samples.size() - before}});
   }
   progress.clear();
-  nlohmann::json metadata = nlohmann::json{
-      {"generator", "mfr dataset"},
-      {"features", kDkbFeatureSet},
-      {"target", learn::kDkbTargetScaling},
-      {"composite", toString(sampling.compositing)},
-      {"width", a.scene.width},
-      {"height", a.scene.height},
-      {"orbit", a.scene.orbit},
-      {"budget_steps", a.budgets.empty() ? a.budgetSteps : static_cast<int>(a.budgets.size())},
-      {"sample_fraction", a.sample},
-      {"seed", a.scene.seed},
-      {"scenes", perScene}};
+  nlohmann::json metadata =
+      dfaoit
+          ? nlohmann::json{{"generator", "mfr dataset"},    {"method", "dfaoit"},
+                           {"features", kDfaoitFeatureSet}, {"target", kDfaoitTarget},
+                           {"width", a.scene.width},        {"height", a.scene.height},
+                           {"orbit", a.scene.orbit},        {"sample_fraction", a.sample},
+                           {"seed", a.scene.seed},          {"scenes", perScene}}
+          : nlohmann::json{{"generator", "mfr dataset"},
+                           {"features", kDkbFeatureSet},
+                           {"target", learn::kDkbTargetScaling},
+                           {"composite", toString(sampling.compositing)},
+                           {"width", a.scene.width},
+                           {"height", a.scene.height},
+                           {"orbit", a.scene.orbit},
+                           {"budget_steps",
+                            a.budgets.empty() ? a.budgetSteps : static_cast<int>(a.budgets.size())},
+                           {"sample_fraction", a.sample},
+                           {"seed", a.scene.seed},
+                           {"scenes", perScene}};
+  if (dfaoit) data.targetCount = learn::kDfaoitTargetCount;
   // shares only when given: a dataset made with --budget-steps keeps its bytes
   if (!sampling.budgetPercents.empty()) metadata["budget_percents"] = sampling.budgetPercents;
   data.metadata = metadata.dump();
@@ -149,6 +173,10 @@ Runner addDatasetCommand(CLI::App& app) {
   cmd->add_option("--curve-out", args->curveOut,
                   "Also write dkb-curve's dataset: the same samples with each pixel's error curve "
                   "(8 drops and a tail) as targets");
+  cmd->add_option("--target", args->target,
+                  "Which network's samples: dkb (default; the deep k-buffer's features and "
+                  "optimal targets) or dfaoit (DFAOIT's features and each pixel's A-buffer "
+                  "colour; no budgets)");
   args->command = cmd;
   return [args] { return runDataset(*args); };
 }

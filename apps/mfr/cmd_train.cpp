@@ -21,6 +21,7 @@
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/learn/model_file.hpp"
+#include "mfr/method/dfaoit.hpp"
 
 namespace mfr::cli {
 namespace {
@@ -39,7 +40,7 @@ struct TrainArgs {
 struct Split {
   Eigen::MatrixXf trainX, trainY, validX, validY;
   Compositing rule = Compositing::Hybrid;  // of every dataset's targets
-  uint32_t targetCount = 1;                // 1: importance, kCurveOutputs: dkb-curve
+  uint32_t targetCount = 1;  // 1: importance, kCurveOutputs: dkb-curve, kDfaoitTargetCount: dfaoit
   std::vector<std::string> trainScenes, validScenes;
   // per dataset, in order: its file name (not the folder, so the model's bytes do not depend on
   // where it was trained) and the FNV-1a 64 of its bytes
@@ -118,13 +119,16 @@ Result<Split> loadSplit(const TrainArgs& a) {
       for (int c = 0; c < kDkbFeatureCount; ++c) x(c, i) = s.features[c];
       if (outputs == 1)
         y(0, i) = s.target;
+      else if (split.targetCount == learn::kDfaoitTargetCount)
+        for (Eigen::Index t = 0; t < outputs; ++t) y(t, i) = s.colour[static_cast<size_t>(t)];
       else
         for (Eigen::Index t = 0; t < outputs; ++t) y(t, i) = s.curve[static_cast<size_t>(t)];
     }
   return split;
 }
 
-Result<void> writeLossCurve(const std::string& path, const std::vector<learn::EpochLog>& logs) {
+Result<void> writeLossCurve(const std::string& path, const std::vector<learn::EpochLog>& logs,
+                            const std::string& title) {
   PlotSeries train{"training MSE", {}, {}, glm::vec3(0.12f, 0.47f, 0.71f)};
   PlotSeries valid{"validation MSE (held-out scenes)", {}, {}, glm::vec3(0.85f, 0.37f, 0.0f)};
   for (const learn::EpochLog& e : logs) {
@@ -134,7 +138,7 @@ Result<void> writeLossCurve(const std::string& path, const std::vector<learn::Ep
     valid.y.push_back(e.validationLoss);
   }
   PlotOptions options;
-  options.title = "deep k-buffer training loss";
+  options.title = title;
   options.xLabel = "epoch";
   options.yLabel = "mean squared error";
   options.logY = true;
@@ -160,8 +164,11 @@ int runTrain(TrainArgs& a) {
 
   auto split = loadSplit(a);
   if (!split) return fail(split.error().message);
-  const bool curve = split->targetCount != 1;
-  const std::vector<int>& layers = curve ? kDkbCurveLayers : learn::kDkbLayers;
+  const bool dfaoit = split->targetCount == learn::kDfaoitTargetCount;
+  const bool curve = split->targetCount != 1 && !dfaoit;
+  const std::vector<int>& layers = dfaoit  ? kDfaoitLayers
+                                   : curve ? kDkbCurveLayers
+                                           : learn::kDkbLayers;
   learn::Mlp net = learn::makeMlp(layers, o.seed);
   // the log is written (atomically, like every output) when training ends; its folder is checked
   // now so that a bad --log fails before the training, not after it
@@ -209,9 +216,19 @@ int runTrain(TrainArgs& a) {
                            {"final_validation_mse", std::isfinite(last.validationLoss)
                                                         ? nlohmann::json(last.validationLoss)
                                                         : nlohmann::json(nullptr)}}}};
+  if (dfaoit) {  // DFAOIT's network (mfr/method/dfaoit.hpp): no compositing rule of its own
+    meta.erase("composite");
+    meta["method"] = "dfaoit";
+    meta["features"] = kDfaoitFeatureSet;
+    meta["feature_normalisation"] = "include/mfr/method/method_math.h (dfaoitFeatures)";
+    meta["target"] = kDfaoitTarget;
+  }
   auto written = learn::writeModel(a.out, learn::Model{net, meta.dump(2)});
   if (!written) return fail(written.error().message);
-  if (auto curve = writeLossCurve(a.lossCurve, logs); !curve) return fail(curve.error().message);
+  if (auto curve = writeLossCurve(a.lossCurve, logs,
+                                  dfaoit ? "dfaoit training loss" : "deep k-buffer training loss");
+      !curve)
+    return fail(curve.error().message);
   if (!a.quiet)
     std::printf("%s: %d epochs, %lld training / %lld validation samples, MSE %.5g / %.5g\n",
                 a.out.c_str(), last.epoch, static_cast<long long>(split->trainX.cols()),
@@ -224,7 +241,9 @@ int runTrain(TrainArgs& a) {
 Runner addTrainCommand(CLI::App& app) {
   auto args = std::make_shared<TrainArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "train", "Train the deep k-buffer's network on datasets from mfr dataset (deterministic)");
+      "train",
+      "Train the deep k-buffer's (or, on --target dfaoit datasets, DFAOIT's) network on "
+      "datasets from mfr dataset (deterministic)");
   cmd->add_option("datasets", args->datasets, "Datasets (.mfrds)")->required();
   cmd->add_option("--out,-o", args->out, "Output model (.mfrnn)")->required();
   cmd->add_option("--log", args->log, "Per-epoch CSV log (default: OUT.log.csv)");

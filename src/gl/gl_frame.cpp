@@ -14,6 +14,7 @@
 #include "mfr/gl/gl_technique.hpp"
 #include "mfr/gl/shared_layout.h"
 #include "mfr/method/aoit.hpp"
+#include "mfr/method/dfaoit.hpp"
 #include "mfr/method/mboit.hpp"
 #include "mfr/method/pass_plan.hpp"
 
@@ -33,6 +34,7 @@ bool countPassFirst(GlTechnique t) {
     case GlTechnique::Aoit:
     case GlTechnique::LinkedList:
     case GlTechnique::Peel:
+    case GlTechnique::Dfaoit:
       return false;
   }
   return false;
@@ -50,6 +52,7 @@ bool fragmentNodes(GlTechnique t) {
     case GlTechnique::Aoit:        // (aoit's are visibility steps)
     case GlTechnique::LinkedList:  // (read by walking the lists: readLists)
     case GlTechnique::Peel:
+    case GlTechnique::Dfaoit:
       return false;
   }
   return false;
@@ -95,6 +98,8 @@ uint64_t largestPerPixelBytes(const RenderPlan& p) {
       return std::max<uint64_t>(12, p.hybrid ? kTailWords * 4 : 0);
     case GlTechnique::Peel:
       return std::max<uint64_t>({12, peelWords(p.method) * 4, p.hybrid ? kTailWords * 4 : 0});
+    case GlTechnique::Dfaoit:
+      return std::max<uint64_t>(12, kDfaoitWords * 4);
   }
   return 12;
 }
@@ -173,6 +178,52 @@ struct GlEngine::State::FrameRun {
                         GL_BUFFER_UPDATE_BARRIER_BIT);
       });
     }
+  }
+
+  // dfaoit: the per-pixel sums (dfaoit.frag)
+  void captureDfaoit() {
+    const uint32_t pixels = plan.pixels;
+    accum = fb.make("accumulators", uint64_t{pixels} * kDfaoitWords * 4);
+    {  // T = 1 and the nearest node empty (kFarDepthBits); the rest 0
+      static_assert(kDfaoitWords == 13);
+      std::vector<uint32_t> init(uint64_t{pixels} * kDfaoitWords, 0u);
+      for (uint32_t p = 0; p < pixels; ++p) {
+        init[uint64_t{p} * kDfaoitWords + 8] = std::bit_cast<uint32_t>(1.0f);
+        init[uint64_t{p} * kDfaoitWords + 11] = kFarDepthBits;
+      }
+      glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
+    }
+    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+    clearUint(locks, kLockFree);
+    pass("capture", [&] {
+      const GLuint p = s.program(ProgramId::Dfaoit);
+      useCapture(p);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+      fb.bindImage(locks, kBindLocks);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    });
+  }
+
+  // dfaoit: features, the network and the composite per pixel (dfaoit_resolve.comp)
+  Result<void> resolveDfaoit() {
+    const std::vector<float>& weights = builtinDfaoitWeights();
+    if (weights.size() != kDfaoitWeightCount)
+      return makeError("--engine gl: " + plan.method.name + ": " +
+                       builtinDfaoitModel().error().message);
+    const GLuint net = fb.make("network", weights.size() * 4, weights.data());
+    image = fb.make("image", uint64_t{plan.pixels} * 12);
+    pass("resolve", [&] {
+      const GLuint p = s.program(ProgramId::DfaoitResolve);
+      useResolve(p);
+      glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindDfaoitWeights, net);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
+      dispatchPixels();
+    });
+    return {};
   }
 
   // wboit, mboit, aoit: the per-pixel accumulators (mboit: its moments first; aoit: its nodes)
@@ -701,6 +752,7 @@ Result<RenderPlan> GlEngine::State::planRender(const MethodDesc& method,
     case GlTechnique::Wboit:
     case GlTechnique::Mboit:
     case GlTechnique::Aoit:
+    case GlTechnique::Dfaoit:
       break;
     case GlTechnique::LinkedList:
       plan.allocSlots = options.poolNodes;
@@ -783,6 +835,10 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       case GlTechnique::Peel:
         frame.capturePeel();
         frame.resolvePeel();
+        break;
+      case GlTechnique::Dfaoit:
+        frame.captureDfaoit();
+        MFR_TRY(frame.resolveDfaoit());
         break;
     }
     MFR_TRY(frame.checkErrors());

@@ -92,6 +92,8 @@ constexpr ProgramRow kPrograms[] = {
     {ProgramId::NearestCosine, "nearest_cosine.frag", Stages::Raster, Prelude::None},
     {ProgramId::Wboit, "wboit.frag", Stages::Raster, Prelude::None},
     {ProgramId::WboitResolve, "wboit_resolve.comp", Stages::Compute, Prelude::None},
+    {ProgramId::Dfaoit, "dfaoit.frag", Stages::Raster, Prelude::None},
+    {ProgramId::DfaoitResolve, "dfaoit_resolve.comp", Stages::Compute, Prelude::None},
     {ProgramId::MboitMoments, "mboit_moments.frag", Stages::Raster, Prelude::None},
     {ProgramId::MboitColor, "mboit_color.frag", Stages::Raster, Prelude::None},
     {ProgramId::MboitResolve, "mboit_resolve.comp", Stages::Compute, Prelude::None},

@@ -28,6 +28,8 @@ enum class ProgramId : uint8_t {
   NearestCosine,    // nearest_cosine.frag (vkb: the nearest fragment's |n.v|)
   Wboit,            // wboit.frag
   WboitResolve,     // wboit_resolve.comp
+  Dfaoit,           // dfaoit.frag
+  DfaoitResolve,    // dfaoit_resolve.comp
   MboitMoments,     // mboit_moments.frag
   MboitColor,       // mboit_color.frag
   MboitResolve,     // mboit_resolve.comp

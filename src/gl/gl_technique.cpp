@@ -46,6 +46,11 @@ constexpr GlTechniqueInfo kTechniques[] = {
      "[tail pass] -> resolve",
      "peel.frag (+ peel_step.comp)", "peel_resolve.comp",
      "state 36 B (peel) or 72 B (dual-peel) + lock 4 B [+ tail 20 B]", "peel, dual-peel"},
+    {GlTechnique::Dfaoit, "dfaoit",
+     "capture (accumulate the sums under the lock) -> resolve (features, 12-32-32-3 network, "
+     "composite)",
+     "dfaoit.frag", "dfaoit_resolve.comp",
+     "accumulators 52 B + lock 4 B; per image: the network's 1,571 weights", "dfaoit"},
 };
 
 constexpr bool rowsInEnumOrder() {
@@ -129,6 +134,11 @@ std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
           m.occupancyWords != 0)
         return std::nullopt;
       return GlTechnique::Aoit;
+    case Compositing::DeepApproximate:
+      if (m.allocation != AllocationPolicy::NoNodes || m.store != StoreChoice::None ||
+          m.occupancyWords != 0)
+        return std::nullopt;
+      return GlTechnique::Dfaoit;
     case Compositing::Peel:
     case Compositing::DualPeel:
       if (m.allocation != AllocationPolicy::NoNodes || m.store != StoreChoice::None ||
@@ -161,7 +171,7 @@ Result<GlTechnique> classifyGl(const MethodDesc& method) {
         " is not in the GL engine (it runs the A-buffer; the k-buffer family with a "
         "fixed k or a per-pixel k(p), max-array or max-heap stores, occupancy culling "
         "and kbuffer or hybrid compositing; wboit; mboit; mlab; aoit; linked-list; peel, "
-        "dual-peel)");
+        "dual-peel; dfaoit)");
   return *t;
 }
 

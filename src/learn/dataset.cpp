@@ -18,6 +18,7 @@
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/optimal_oracle.hpp"
 #include "mfr/method/budget_spec.hpp"
+#include "mfr/method/dfaoit.hpp"
 #include "mfr/method/optimal_allocation.hpp"
 
 namespace mfr::learn {
@@ -156,6 +157,47 @@ Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t
   return samples;
 }
 
+std::vector<DatasetSample> sampleDfaoitView(const RasterFrame& frame, uint32_t scene, uint32_t view,
+                                            const ViewSamplingOptions& options) {
+  const size_t pixels = frame.pixelCount();
+  std::vector<DfaoitPixel> sums(pixels);
+  std::vector<std::vector<FragmentNode>> nodes(pixels);
+  // tile-owned: a pixel's fragments in primitive order on one worker, as the CPU engine's capture
+  frame.forEachTile([&](int tile) {
+    frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
+                                           sums[f.pixel].add(f.depth, f.rgba);
+                                           nodes[f.pixel].push_back(makeNode(f.depth, f.rgba));
+                                         }});
+  });
+  std::vector<DatasetSample> samples;
+  for (uint32_t p = 0; p < pixels; ++p) {
+    if (sums[p].n < 3) continue;  // (one or two fragments: the resolve needs no network)
+    if (sampleUniform(options.seed, scene, view, 0, p) >= options.sampleFraction) continue;
+    std::vector<FragmentNode>& px = nodes[p];
+    std::sort(px.begin(), px.end());  // the A-buffer's order
+    float r = 0.0f, g = 0.0f, b = 0.0f, T = 1.0f;
+    for (const FragmentNode node : px) {
+      const glm::vec4 c = unpackFragmentColor(nodeColor(node));
+      method_math::overStep(r, g, b, T, c.a, c.r, c.g, c.b);
+    }
+    // y': the colour behind the nearest fragment (the A-buffer's first) over its coverage share
+    const glm::vec4 near = unpackFragmentColor(sums[p].nearColour);
+    const float share = (1.0f - near.a) - T;
+    if (!(share > 1e-4f)) continue;  // (what lies behind is invisible: y' does not matter)
+    DatasetSample sample;
+    sample.scene = scene;
+    sample.view = view;
+    sample.pixel = p;
+    const DfaoitInputs x = sums[p].features();
+    std::copy(x.begin(), x.end(), sample.features.begin());
+    const float rest[3] = {r - near.a * near.r, g - near.a * near.g, b - near.a * near.b};
+    for (int i = 0; i < 3; ++i)
+      sample.colour[static_cast<size_t>(i)] = std::clamp(rest[i] / share, 0.0f, 1.0f);
+    samples.push_back(sample);
+  }
+  return samples;
+}
+
 Result<void> writeDataset(const std::string& path, const Dataset& data) {
   std::string out;
   out.reserve(64 + data.samples.size() * sampleBytes(data.targetCount));
@@ -179,6 +221,8 @@ Result<void> writeDataset(const std::string& path, const Dataset& data) {
     for (float f : s.features) put(out, f);
     if (data.targetCount == 1)
       put(out, s.target);
+    else if (data.targetCount == kDfaoitTargetCount)
+      for (float t : s.colour) put(out, t);
     else
       for (uint32_t t = 0; t < data.targetCount; ++t) put(out, s.curve[t]);
   }
@@ -208,9 +252,9 @@ Result<Dataset> readDataset(const std::string& path) {
     return in.error("truncated header");
   if (features != kDkbFeatureCount)
     return in.error(std::to_string(features) + " features per sample, expected 12");
-  if (targets != 1 && targets != kCurveOutputs)
-    return in.error(std::to_string(targets) + " targets per sample, expected 1 or " +
-                    std::to_string(kCurveOutputs));
+  if (targets != 1 && targets != kCurveOutputs && targets != kDfaoitTargetCount)
+    return in.error(std::to_string(targets) + " targets per sample, expected 1, " +
+                    std::to_string(kDfaoitTargetCount) + " or " + std::to_string(kCurveOutputs));
   if (sceneCount == 0 || sceneCount > kMaxScenes) return in.error("bad scene count");
   Dataset data;
   data.fileHash = fnv1a64(bytes);
@@ -240,11 +284,14 @@ Result<Dataset> readDataset(const std::string& path) {
     for (float& f : s.features) (void)in.get(f);
     if (targets == 1)
       (void)in.get(s.target);
+    else if (targets == kDfaoitTargetCount)
+      for (float& t : s.colour) (void)in.get(t);
     else
       for (uint32_t t = 0; t < targets; ++t) (void)in.get(s.curve[t]);
     if (s.scene >= sceneCount) return in.error("sample " + std::to_string(i) + ": bad scene");
     bool finite = std::isfinite(s.target) && s.target >= 0.0f && s.target <= 1.0f;
     for (float t : s.curve) finite = finite && std::isfinite(t) && t >= 0.0f && t <= 1.0f;
+    for (float t : s.colour) finite = finite && std::isfinite(t) && t >= 0.0f && t <= 1.0f;
     for (float f : s.features) finite = finite && std::isfinite(f);
     if (!finite)
       return in.error("sample " + std::to_string(i) + ": non-finite or out-of-range value");
@@ -267,9 +314,12 @@ Result<Compositing> datasetRule(const Dataset& data, const std::string& path) {
 Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& path) {
   const auto meta = nlohmann::json::parse(data.metadata, nullptr, false);
   if (!meta.is_object()) return {};
+  const bool dfaoit = data.targetCount == kDfaoitTargetCount;
   const std::pair<const char*, const char*> expected[] = {
-      {"features", kDkbFeatureSet},
-      {"target", data.targetCount == 1 ? kDkbTargetScaling : kDkbCurveTargetScaling}};
+      {"features", dfaoit ? kDfaoitFeatureSet : kDkbFeatureSet},
+      {"target", dfaoit                  ? kDfaoitTarget
+                 : data.targetCount == 1 ? kDkbTargetScaling
+                                         : kDkbCurveTargetScaling}};
   for (const auto& [key, value] : expected) {
     const auto it = meta.find(key);
     if (it == meta.end()) continue;

@@ -34,7 +34,8 @@ GlTechnique expectedTechnique(const std::string& preset) {
                                                            {"aoit16", GlTechnique::Aoit},
                                                            {"linked-list", GlTechnique::LinkedList},
                                                            {"peel", GlTechnique::Peel},
-                                                           {"dual-peel", GlTechnique::Peel}};
+                                                           {"dual-peel", GlTechnique::Peel},
+                                                           {"dfaoit", GlTechnique::Dfaoit}};
   const auto it = peers.find(preset);
   return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
 }
@@ -54,7 +55,7 @@ TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
     EXPECT_EQ(*tc, GlTechnique::KBuffer) << name << "+occupancy";
     ++occupancyForms;
   }
-  EXPECT_EQ(presets, 32);  // 13 of the k-buffer family, the A-buffer, linked-list, 17 peers
+  EXPECT_EQ(presets, 33);  // 13 of the k-buffer family, the A-buffer, linked-list, 18 peers
   EXPECT_EQ(occupancyForms, 13);
 }
 
@@ -72,7 +73,7 @@ TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
 
 TEST(GlTechnique, TableRowsFollowTheEnum) {
   const auto rows = glTechniques();
-  ASSERT_EQ(rows.size(), 8u);
+  ASSERT_EQ(rows.size(), 9u);
   for (size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(static_cast<size_t>(rows[i].technique), i);
     EXPECT_EQ(&techniqueInfo(rows[i].technique), &rows[i]);

@@ -29,8 +29,9 @@ enum class GlTechnique : uint8_t {
   Mlab,     // multi-layer alpha blending: merge capture of k nodes, front-to-back resolve
   Aoit,     // adaptive transparency: visibility pass (N nodes), colour pass, composite
   LinkedList,  // per-pixel linked lists: pool counter + head exchange capture, walk-sort resolve
-  Peel,  // depth peeling and dual depth peeling: peel passes (geometry + per-pixel step) until
-         // none remains or --max-peels, [tail pass], composite
+  Peel,    // depth peeling and dual depth peeling: peel passes (geometry + per-pixel step) until
+           // none remains or --max-peels, [tail pass], composite
+  Dfaoit,  // deep and fast approximate OIT: one accumulation pass, the network in the resolve
 };
 
 /// One row of the technique table.

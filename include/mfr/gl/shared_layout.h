@@ -75,6 +75,11 @@ MFR_GL_CONST(uint, kMboitWordsBase, 5u)
 // (mfr::AoitPixel<N>): kAoitNodeWords N + kAoitColorWords words, N = 4, 8 or 16
 MFR_GL_CONST(uint, kAoitNodeWords, 2u)
 MFR_GL_CONST(uint, kAoitColorWords, 3u)
+// deep and fast approximate OIT: per pixel sum a c (r, g, b), sum a, sum a z, sum a c z (r, g, b),
+// T, n, farthest depth, nearest depth bits, nearest RGBA8 (mfr::DfaoitPixel); the resolve's
+// network weights (mfr::dfaoitWeights)
+MFR_GL_CONST(uint, kDfaoitWords, 13u)
+MFR_GL_CONST(uint, kBindDfaoitWeights, 1u)
 // multi-layer alpha blending: per node depth, premultiplied r, g, b, transmittance (mfr::MlabNode)
 MFR_GL_CONST(uint, kMlabWords, 5u)
 // depth peeling: per pixel bound, candidate key, multiplicity, front r, g, b, T (mfr::PeelPixel);
@@ -165,6 +170,7 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //   nearest_cosine.frag: kBindNearest kBindLocks(image)
 //   occupancy_fill.frag: kBindOccupancy kBindOccBits
 //   wboit.frag: kBindAccum kBindLocks(image)
+//   dfaoit.frag: kBindAccum kBindLocks(image)
 //   peel.frag: kBindAccum kBindCaptureStats kBindTails kBindLocks(image)
 //   alloc_histogram.comp: kBindAllocCounts kBindAllocSummary
 //   alloc_k.comp: kBindAllocCounts kBindAllocSummary kBindAllocK kBindAllocReserved kBindImportance
@@ -183,6 +189,7 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //       kBindAllocation(texture)
 //   swap_node_words.comp: kBindNodes
 //   wboit_resolve.comp: kBindAccum kBindImage
+//   dfaoit_resolve.comp: kBindAccum kBindDfaoitWeights kBindImage kBindColorTables
 //   peel_step.comp: kBindAccum kBindCaptureStats kBindOffsets kBindColorTables
 //   peel_resolve.comp: kBindAccum kBindResolveTails kBindImage
 //   raster_common.glsl: kBindMaterials kBindColorTables kBindTexels kBindCounts(image)

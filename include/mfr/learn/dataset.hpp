@@ -12,14 +12,15 @@
 //   0       8      magic "MFRDS\0\0\0"
 //   8       4      u32 version (kDatasetVersion)
 //   12      4      u32 feature count (12)
-//   16      4      u32 T, targets per sample: 1 (the importance t(p)) or 9 (dkb-curve's curve,
-//                  mfr/method/dkb_curve.hpp)
+//   16      4      u32 T, targets per sample: 1 (the importance t(p)), 9 (dkb-curve's curve,
+//                  mfr/method/dkb_curve.hpp) or 3 (DFAOIT's colour, mfr/method/dfaoit.hpp)
 //   20      4      u32 S, number of scenes (1..65536)
 //   ...            S x { u32 length (1..4096), UTF-8 name }
 //   ...     4      u32 metadata length m (<= 1 MiB), then m bytes of JSON (how it was generated)
 //   ...     8      u64 N, number of samples (<= 2^32)
 //   ...            N x (64 + 4 T)-byte samples: u32 scene, u32 view, u32 budget step, u32 pixel,
-//                  f32 features[12] (dkb_features.hpp), f32 targets[T] (t(p), or the curve)
+//                  f32 features[12] (dkb_features.hpp, or dfaoit.hpp's for T = 3), f32
+//                  targets[T] (t(p), the curve, or DFAOIT's colour)
 //   end            (no trailing bytes)
 #pragma once
 
@@ -52,13 +53,19 @@ struct DatasetSample {
   uint32_t budgetStep = 0;  // 0 = one fragment per covered pixel ... steps - 1 = all fragments
   uint32_t pixel = 0;       // y * width + x
   PixelFeatures features{};
-  float target = 0.0f;   // the importance target t(p) (Dataset::targetCount 1)
-  CurveTargets curve{};  // dkb-curve's targets (Dataset::targetCount 9)
+  float target = 0.0f;            // the importance target t(p) (Dataset::targetCount 1)
+  CurveTargets curve{};           // dkb-curve's targets (Dataset::targetCount 9)
+  std::array<float, 3> colour{};  // DFAOIT's target (Dataset::targetCount 3), features then
+                                  // DfaoitPixel::features()
 };
+
+/// Targets per sample of a DFAOIT dataset (the colour y, mfr/method/dfaoit.hpp).
+inline constexpr uint32_t kDfaoitTargetCount = 3;
 
 struct Dataset {
   std::vector<std::string> scenes;
-  uint32_t targetCount = 1;  // 1: DatasetSample::target, kCurveOutputs: DatasetSample::curve
+  uint32_t targetCount = 1;  // 1: DatasetSample::target, kCurveOutputs: DatasetSample::curve,
+                             // kDfaoitTargetCount: DatasetSample::colour
   std::string metadata;      // JSON
   std::vector<DatasetSample> samples;
   uint64_t fileHash = 0;  // fnv1a64 of the file's bytes: set by readDataset, ignored when writing
@@ -81,8 +88,8 @@ Result<Dataset> readDataset(const std::string& path);
 
 /// Checks that a dataset's metadata, where it declares a feature set ("features") or a target
 /// ("target"), declares kDkbFeatureSet and kDkbTargetScaling (kDkbCurveTargetScaling for curve
-/// datasets): a dataset written by an older `mfr dataset` is refused rather than trained on.
-/// `path` names it in the message.
+/// datasets; kDfaoitFeatureSet and kDfaoitTarget for DFAOIT's): a dataset written by an older `mfr
+/// dataset` is refused rather than trained on. `path` names it in the message.
 Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& path);
 
 /// The compositing rule a dataset's targets were computed for: its metadata's "composite"
@@ -109,6 +116,14 @@ struct ViewSamplingOptions {
   /// Memory pre-flight of the exact A-buffer and error curves (frameErrorCurves); none: default.
   std::optional<uint64_t> memoryLimitBytes;
 };
+
+/// DFAOIT's samples of one rendered view (mfr/method/dfaoit.hpp): for a sampled pixel of at least
+/// three fragments of positive alpha (fewer need no network) whose fragments behind the nearest
+/// are visible ((1 - a0) - T > 1e-4) (options.sampleFraction, options.seed; budget step 0) its
+/// inputs DfaoitPixel::features() and its target y', from the A-buffer's sorted composite C:
+/// (C - a0 c0) / ((1 - a0) - T), clamped to [0, 1]. Budgets do not apply (no nodes).
+std::vector<DatasetSample> sampleDfaoitView(const RasterFrame& frame, uint32_t scene, uint32_t view,
+                                            const ViewSamplingOptions& options);
 
 /// Features and optimal targets of one rendered view, for every budget step, sampled.
 Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t scene,

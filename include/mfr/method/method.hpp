@@ -77,6 +77,8 @@ enum class Compositing : uint8_t {
   Adaptive16,           // aoit16: the same with 16 nodes
   Peel,                 // peel: depth peeling, one nearest layer per geometry pass (Everitt 2001)
   DualPeel,             // dual-peel: nearest and farthest layer per pass (Bavoil & Myers 2008)
+  DeepApproximate,      // dfaoit: per-pixel sums, a network predicts the colour (Tsopouridis
+                        // 2024), dfaoit.hpp
 };
 
 /// True for kbuffer and hybrid, the rules `--composite` chooses between (the k-buffer family).

@@ -21,6 +21,9 @@
 //     HPG 2018 (4 power moments, bias 5e-7, overestimation 0.25); see mboit.hpp;
 //   AOIT: Salvi, Montgomery, Lefohn, "Adaptive Transparency", HPG 2011 (the visibility function's
 //     insertion and area-based compression, the colour pass's weight); see aoit.hpp;
+//   DFAOIT: Tsopouridis, Vasilakis, Fudos, "Deep and Fast Approximate Order Independent
+//     Transparency", CGF 2024 (the accumulated sums, the network's inputs, the composite); see
+//     dfaoit.hpp;
 //   importance: Vasilakis, Vardis, Papaioannou, Moustakas, "Variable k-buffer using Importance
 //     Maps", sec. 3.2, Eqs. 3-6 (../shared/papers/variable-k-buffer-importance-maps.md); see
 //     importance.hpp;
@@ -1057,6 +1060,125 @@ MFR_MATH_FN void aoitAddColor(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(
 /// background.
 MFR_MATH_FN vec3 aoitComposite(vec3 sum, float total, vec3 background) {
   MFR_PRECISE vec3 result = sum + total * background;
+  return result;
+}
+
+// ---- deep and fast approximate OIT (DFAOIT) ---------------------------------------------------
+// Tsopouridis, Vasilakis, Fudos, "Deep and Fast Approximate Order Independent Transparency", CGF
+// 2024 (dfaoit.hpp): one pass of order-independent sums per pixel, the 12 network inputs built
+// from them, the composite of the nearest fragment over the predicted colour behind it. The
+// network itself (12-32-32-3) is dfaoit.hpp's dfaoitForward and dfaoit_resolve.comp's loop (its
+// weights are a buffer on GL).
+MFR_MATH_CONST(int, kDfaoitInputs, 12)
+MFR_MATH_CONST(int, kDfaoitHidden, 32)
+MFR_MATH_CONST(int, kDfaoitOutputs, 3)
+
+/// One fragment (linear colour c, alpha a, window depth z) into the sums: (r, g, b) += a c,
+/// alphaSum += a, alphaDepth += a z, (rz, gz, bz) += a c z, T *= 1 - a.
+MFR_MATH_FN void dfaoitAccumulate(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(float) b,
+                                  MFR_INOUT(float) alphaSum, MFR_INOUT(float) alphaDepth,
+                                  MFR_INOUT(float) rz, MFR_INOUT(float) gz, MFR_INOUT(float) bz,
+                                  MFR_INOUT(float) T, vec3 c, float a, float z) {
+  MFR_PRECISE float pr = a * c.r;
+  MFR_PRECISE float pg = a * c.g;
+  MFR_PRECISE float pb = a * c.b;
+  MFR_PRECISE float nr = r + pr;
+  MFR_PRECISE float ng = g + pg;
+  MFR_PRECISE float nb = b + pb;
+  MFR_PRECISE float na = alphaSum + a;
+  MFR_PRECISE float az = a * z;
+  MFR_PRECISE float nad = alphaDepth + az;
+  MFR_PRECISE float prz = pr * z;
+  MFR_PRECISE float pgz = pg * z;
+  MFR_PRECISE float pbz = pb * z;
+  MFR_PRECISE float nrz = rz + prz;
+  MFR_PRECISE float ngz = gz + pgz;
+  MFR_PRECISE float nbz = bz + pbz;
+  MFR_PRECISE float nT = T * (1.0f - a);
+  r = nr;
+  g = ng;
+  b = nb;
+  alphaSum = na;
+  alphaDepth = nad;
+  rz = nrz;
+  gz = ngz;
+  bz = nbz;
+  T = nT;
+}
+
+/// Where a channel's colour sits in depth against the alpha: (sum a c z / sum a c - zbar) / range,
+/// clamped to [-1, 1]; 0 without colour or range.
+MFR_MATH_FN float dfaoitSkew(float colourDepth, float colour, float zbar, float range) {
+  if (!(colour > 0.0f) || !(range > 0.0f)) return 0.0f;
+  MFR_PRECISE float zc = exactDivide(colourDepth, colour);
+  MFR_PRECISE float skew = zc - zbar;
+  return clamp(exactDivide(skew, range), -1.0f, 1.0f);
+}
+
+/// The 12 network inputs of a pixel with n >= 1 fragments of positive alpha. They describe the
+/// fragments behind the nearest one (the "rest": the sums less the nearest fragment's own terms,
+/// a0 c0, a0, a0 z0, a0 c0 z0, computed as dfaoitAccumulate computes them), whose
+/// visibility-weighted mean colour the network predicts (dfaoitComposite):
+///   x0-2   the rest's alpha-weighted mean colour sum' a c / sum' a   (0 when sum' a <= 0)
+///   x3-5   per channel, where the rest's colour sits in depth against its alpha: dfaoitSkew of
+///          sum' a c z, sum' a c, zbar' = sum' a z / sum' a, range = z_far - z_near
+///   x6     (zbar' - z_near) / range, clamped to [0, 1] (0 without range)
+///   x7     the rest's opacity 1 - T / (1 - a0)   (0 when a0 = 1)
+///   x8     the rest's mean alpha sum' a / (n - 1)   (0 when n = 1)
+///   x9     1 / (n - 1)                              (0 when n = 1)
+///   x10    the pixel's opacity 1 - T
+///   x11    the nearest fragment's alpha a0
+/// Divisions are exactDivide (correctly rounded on both sides).
+MFR_MATH_FN void dfaoitFeatures(vec3 sum, float alphaSum, float alphaDepth, vec3 colourDepth,
+                                float T, uint n, float nearDepth, vec3 nearColour, float nearAlpha,
+                                float farDepth, MFR_INOUT_ARRAY(float, x, kDfaoitInputs)) {
+  MFR_PRECISE float pr = nearAlpha * nearColour.r;
+  MFR_PRECISE float pg = nearAlpha * nearColour.g;
+  MFR_PRECISE float pb = nearAlpha * nearColour.b;
+  MFR_PRECISE float restR = sum.r - pr;
+  MFR_PRECISE float restG = sum.g - pg;
+  MFR_PRECISE float restB = sum.b - pb;
+  MFR_PRECISE float restA = alphaSum - nearAlpha;
+  MFR_PRECISE float az = nearAlpha * nearDepth;
+  MFR_PRECISE float restAz = alphaDepth - az;
+  MFR_PRECISE float prz = pr * nearDepth;
+  MFR_PRECISE float pgz = pg * nearDepth;
+  MFR_PRECISE float pbz = pb * nearDepth;
+  MFR_PRECISE float restRz = colourDepth.r - prz;
+  MFR_PRECISE float restGz = colourDepth.g - pgz;
+  MFR_PRECISE float restBz = colourDepth.b - pbz;
+  MFR_PRECISE float range = farDepth - nearDepth;
+  for (int i = 0; i < kDfaoitInputs; ++i) x[i] = 0.0f;
+  if (n > 1u && restA > 0.0f) {
+    x[0] = clamp(exactDivide(restR, restA), 0.0f, 1.0f);
+    x[1] = clamp(exactDivide(restG, restA), 0.0f, 1.0f);
+    x[2] = clamp(exactDivide(restB, restA), 0.0f, 1.0f);
+    MFR_PRECISE float zbar = exactDivide(restAz, restA);
+    x[3] = dfaoitSkew(restRz, restR, zbar, range);
+    x[4] = dfaoitSkew(restGz, restG, zbar, range);
+    x[5] = dfaoitSkew(restBz, restB, zbar, range);
+    if (range > 0.0f) {
+      MFR_PRECISE float front = zbar - nearDepth;
+      x[6] = clamp(exactDivide(front, range), 0.0f, 1.0f);
+    }
+    MFR_PRECISE float behind = 1.0f - nearAlpha;
+    if (behind > 0.0f) x[7] = clamp(1.0f - exactDivide(T, behind), 0.0f, 1.0f);
+    MFR_PRECISE float rest = float(n - 1u);
+    x[8] = exactDivide(restA, rest);
+    x[9] = exactDivide(1.0f, rest);
+  }
+  x[10] = 1.0f - T;
+  x[11] = nearAlpha;
+}
+
+/// The composite: the nearest fragment over the rest, whose colour is the predicted
+/// visibility-weighted mean y of the fragments behind it times their share of the coverage,
+/// (1 - a0) - T, over the background by the exact transmittance:
+///   a0 c0 + max(0, (1 - a0) - T) y + T background.
+MFR_MATH_FN vec3 dfaoitComposite(vec3 y, float T, vec3 nearColour, float nearAlpha,
+                                 vec3 background) {
+  MFR_PRECISE float share = max(0.0f, (1.0f - nearAlpha) - T);
+  MFR_PRECISE vec3 result = nearAlpha * nearColour + share * y + T * background;
   return result;
 }
 
