@@ -192,15 +192,6 @@ RenderOutput run(const RasterFrame& frame, const std::string& preset,
   return std::move(out.value());
 }
 
-float maxAbs(const ImageRGB& a, const ImageRGB& b) {
-  float worst = 0.0f;
-  for (size_t p = 0; p < a.pixels.size(); ++p) {
-    const glm::vec3 d = glm::abs(a.pixels[p] - b.pixels[p]);
-    worst = std::max({worst, d.r, d.g, d.b});
-  }
-  return worst;
-}
-
 TEST(Dfaoit, OneLayerIsExactAndAnEmptyPixelIsTheBackground) {
   // columns 0..9 covered, 10..15 empty
   const RasterFrame frame = frameOf({{-1.0f, {0.8f, 0.3f, 0.1f, 0.6f}}}, 16, 10);
@@ -213,7 +204,7 @@ TEST(Dfaoit, OneLayerIsExactAndAnEmptyPixelIsTheBackground) {
     }
   }
   EXPECT_GT(empty, 0u);
-  EXPECT_LT(maxAbs(d.image, a.image), 2e-6f);
+  EXPECT_LT(test::largestDifference(d.image, a.image), 2e-6f);
 }
 
 TEST(Dfaoit, TwoLayersAndAnOpaqueFrontLayerAreExact) {
@@ -230,7 +221,7 @@ TEST(Dfaoit, TwoLayersAndAnOpaqueFrontLayerAreExact) {
   for (size_t k = 0; k < cases.size(); ++k) {
     const RasterFrame frame = frameOf(cases[k], 8, 9);
     const RenderOutput d = run(frame, "dfaoit"), a = run(frame, "abuffer");
-    EXPECT_LT(maxAbs(d.image, a.image), 2e-6f) << "case " << k;
+    EXPECT_LT(test::largestDifference(d.image, a.image), 2e-6f) << "case " << k;
   }
 }
 
@@ -245,7 +236,8 @@ TEST(Dfaoit, TheNetworkOnLayersOfOneColour) {
       std::vector<std::pair<float, glm::vec4>> layers{{-0.3f, front}};
       for (int i = 0; i < n; ++i) layers.push_back({-0.6f - 0.3f * static_cast<float>(i), behind});
       const RasterFrame frame = frameOf(layers, 8, 9);
-      worst = std::max(worst, maxAbs(run(frame, "dfaoit").image, run(frame, "abuffer").image));
+      worst = std::max(
+          worst, test::largestDifference(run(frame, "dfaoit").image, run(frame, "abuffer").image));
     }
   RecordProperty("one_colour_max_abs_diff", std::to_string(worst));
   std::printf("layers of one colour behind a front layer: max abs diff %.3g\n", worst);
@@ -294,10 +286,12 @@ TEST(Dfaoit, ShuffledDrawOrderChangesRoundingOnly) {
     const auto a = test::buildFrame(scene, *scene.defaultCamera, 40, 40, 2);
     const auto b = test::buildFrame(shuffled, *scene.defaultCamera, 40, 40, 2);
     ASSERT_TRUE(a && b);
-    worst = std::max(worst, maxAbs(run(*a, "dfaoit").image, run(*b, "dfaoit").image));
+    worst =
+        std::max(worst, test::largestDifference(run(*a, "dfaoit").image, run(*b, "dfaoit").image));
     // and fragment-parallel capture (any interleaving) against tile-owned
-    worst = std::max(worst, maxAbs(run(*a, "dfaoit").image,
-                                   run(*a, "dfaoit", CaptureMode::FragmentParallel).image));
+    worst = std::max(
+        worst, test::largestDifference(run(*a, "dfaoit").image,
+                                       run(*a, "dfaoit", CaptureMode::FragmentParallel).image));
   }
   RecordProperty("shuffled_max_abs_diff", std::to_string(worst));
   EXPECT_LT(worst, 1e-4f);  // measured 1.7e-5

@@ -71,15 +71,6 @@ RenderOutput abuffer(const RasterFrame& frame) {
   return run(frame, methodPreset("abuffer").value());
 }
 
-float worstDifference(const ImageRGB& a, const ImageRGB& b) {
-  float worst = 0.0f;
-  for (size_t i = 0; i < a.pixels.size(); ++i) {
-    const glm::vec3 d = glm::abs(a.pixels[i] - b.pixels[i]);
-    worst = std::max({worst, d.r, d.g, d.b});
-  }
-  return worst;
-}
-
 // the most distinct keys (depth, colour) of a pixel, from the A-buffer's nodes
 uint32_t maxDistinctKeys(const RenderOutput& ab) {
   uint32_t most = 0;
@@ -111,7 +102,7 @@ void expectEqualsTheABuffer(const RasterFrame& frame, const std::string& what) {
   EXPECT_EQ(peel.stats.fragmentsGenerated, ab.stats.fragmentsGenerated) << what;
   EXPECT_EQ(peel.stats.peelPasses, layers) << what;
   const RenderOutput dual = run(frame, peelMethod("dual-peel"));
-  EXPECT_LT(worstDifference(dual.image, ab.image), 2e-6f) << what;
+  EXPECT_LT(test::largestDifference(dual.image, ab.image), 2e-6f) << what;
   EXPECT_EQ(dual.stats.lost, 0u) << what;
   EXPECT_EQ(dual.stats.peelPasses, (layers + 1) / 2) << what;
   // one timed entry per pass, in order
@@ -396,7 +387,8 @@ TEST(Peeling, DrawOrderAndCaptureModeDoNotChangeTheImage) {
         const RenderOutput z = run(*a, m, CaptureMode::FragmentParallel);
         EXPECT_EQ(x.image.pixels, z.image.pixels) << what << " parallel";
         const MethodDesc h = peelMethod(preset, P ? P : 1, true);
-        EXPECT_LT(worstDifference(run(*a, h).image, run(*b, h).image), 1e-5f) << what << " tail";
+        EXPECT_LT(test::largestDifference(run(*a, h).image, run(*b, h).image), 1e-5f)
+            << what << " tail";
       }
   }
 }

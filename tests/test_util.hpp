@@ -1,11 +1,13 @@
 // Helpers shared by the tests: hand-made scenes in screen-space terms.
 #pragma once
 
+#include <algorithm>
 #include <string>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "mfr/core/image.hpp"
 #include "mfr/scene/scene.hpp"
 
 namespace mfr::test {
@@ -62,6 +64,16 @@ inline std::vector<TestTriangle> screenRect(double x0, double y0, double x1, dou
   const glm::vec3 p00 = screenPoint(x0, y0, size, z), p10 = screenPoint(x1, y0, size, z);
   const glm::vec3 p01 = screenPoint(x0, y1, size, z), p11 = screenPoint(x1, y1, size, z);
   return {{p00, p10, p11, color}, {p00, p11, p01, color}};
+}
+
+/// The largest absolute difference of one colour channel over two images of the same size.
+inline float largestDifference(const ImageRGB& a, const ImageRGB& b) {
+  float worst = 0.0f;
+  for (size_t i = 0; i < a.pixels.size(); ++i) {
+    const glm::vec3 d = glm::abs(a.pixels[i] - b.pixels[i]);
+    worst = std::max({worst, d.r, d.g, d.b});
+  }
+  return worst;
 }
 
 }  // namespace mfr::test

@@ -29,6 +29,7 @@
 #include <string>
 #include <vector>
 
+#include "../test_util.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/mboit.hpp"
@@ -283,16 +284,6 @@ Sameness expectedSameness(const Config& c) {
   }
 }
 
-/// Largest absolute difference of a colour channel over the image.
-float largestDifference(const ImageRGB& a, const ImageRGB& b) {
-  float worst = 0.0f;
-  for (size_t i = 0; i < a.pixels.size(); ++i) {
-    const glm::vec3 d = glm::abs(a.pixels[i] - b.pixels[i]);
-    worst = std::max({worst, d.r, d.g, d.b});
-  }
-  return worst;
-}
-
 void expectSameOutput(const Config& c, const RenderOutput& a, const RenderOutput& b) {
   const Sameness same = expectedSameness(c);
   const RenderStats &sa = a.stats, &sb = b.stats;
@@ -313,9 +304,9 @@ void expectSameOutput(const Config& c, const RenderOutput& a, const RenderOutput
                           a.image.pixels.size() * sizeof(glm::vec3)),
               0)
         << c.describe << ": images differ (largest difference "
-        << largestDifference(a.image, b.image) << ")";
+        << test::largestDifference(a.image, b.image) << ")";
   } else {
-    const float worst = largestDifference(a.image, b.image);
+    const float worst = test::largestDifference(a.image, b.image);
     std::fprintf(stderr, "  summation-order difference %g\n", worst);
     // every moment-based rule (mboit, mboit6, mboit8) reconstructs from its moments
     // (the trigonometric ones more: measured 2.5e-2 under a shuffled draw order, test_peer_methods)

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <string>
 
+#include "../test_util.hpp"
 #include "gl_engine_or_skip.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/method/blend_support.hpp"
@@ -19,15 +20,6 @@ namespace mfr::gl {
 namespace {
 
 const glm::vec3 kBg(0.2f, 0.4f, 0.6f);
-
-float worstDifference(const ImageRGB& a, const ImageRGB& b) {
-  float worst = 0.0f;
-  for (size_t i = 0; i < a.pixels.size(); ++i) {
-    const glm::vec3 d = glm::abs(a.pixels[i] - b.pixels[i]);
-    worst = std::max({worst, d.r, d.g, d.b});
-  }
-  return worst;
-}
 
 TEST(GlBlend, SameImagesAsTheCpuEngine) {
   MFR_GL_ENGINE_OR_SKIP(gl, "auto", "exact");
@@ -76,7 +68,9 @@ TEST(GlBlend, SameImagesAsTheCpuEngine) {
         const bool orderDependent = (p.composite && std::string(p.composite) == "hybrid") ||
                                     std::string(p.name) == "aoit8" ||
                                     std::string(p.name) == "wboit";
-        EXPECT_LT(worstDifference(g->image, r->image), orderDependent ? 2e-5f : 2e-6f) << what;
+        EXPECT_LT(::mfr::test::largestDifference(g->image, r->image),
+                  orderDependent ? 2e-5f : 2e-6f)
+            << what;
         ++compared;
       }
     }

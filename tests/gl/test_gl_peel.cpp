@@ -14,6 +14,7 @@
 #include <string>
 
 #include "../shared_scenes.hpp"
+#include "../test_util.hpp"
 #include "gl_engine_or_skip.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/method/make_method.hpp"
@@ -30,15 +31,6 @@ MethodDesc peelMethod(const std::string& preset, std::optional<int64_t> maxPeels
   o.maxPeels = maxPeels;
   if (hybrid) o.composite = "hybrid";
   return makeMethod(preset, o).value();
-}
-
-float worstDifference(const ImageRGB& a, const ImageRGB& b) {
-  float worst = 0.0f;
-  for (size_t i = 0; i < a.pixels.size(); ++i) {
-    const glm::vec3 d = glm::abs(a.pixels[i] - b.pixels[i]);
-    worst = std::max({worst, d.r, d.g, d.b});
-  }
-  return worst;
 }
 
 Camera cameraOf(const Scene& scene) {
@@ -90,7 +82,7 @@ TEST(GlPeel, EqualsTheGlABufferOnEveryRealScene) {
       ASSERT_TRUE(out.ok()) << out.error().message;
       // peel: the A-buffer resolve's "over" steps in the same order (float rounding at most);
       // dual-peel: its back layers blended back to front
-      EXPECT_LT(worstDifference(out->image, ab->image), 2e-6f);
+      EXPECT_LT(::mfr::test::largestDifference(out->image, ab->image), 2e-6f);
       EXPECT_EQ(out->stats.fragmentsGenerated, ab->stats.fragmentsGenerated);
       EXPECT_EQ(out->stats.captured, ab->stats.fragmentsGenerated);
       EXPECT_EQ(out->stats.lost, 0u);
@@ -149,7 +141,7 @@ TEST_P(GlPeelSeam, SameStatisticsAndImageAsTheCpuEngine) {
     if (t.name.rfind("peel", 0) == 0) cpuNames.push_back(t.name);
   EXPECT_EQ(names, cpuNames);
   const float tolerance = c.hybrid ? 1e-5f : 1e-6f;
-  EXPECT_LT(worstDifference(g->image, r->image), tolerance);
+  EXPECT_LT(::mfr::test::largestDifference(g->image, r->image), tolerance);
 }
 
 INSTANTIATE_TEST_SUITE_P(
