@@ -8,6 +8,9 @@
 #include <filesystem>
 #include <limits>
 #include <numeric>
+#include <tuple>
+
+#include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
 #include "mfr/cpu/dkb_curve_pass.hpp"
@@ -220,8 +223,36 @@ TEST(DkbCurve, CurveDatasetTrainRenderOnTheCommandLine) {
   ASSERT_TRUE(importance);
   EXPECT_EQ(importance->targetCount, 1u);
   ASSERT_EQ(importance->samples.size(), read->samples.size());
-  for (size_t i = 0; i < read->samples.size(); ++i)
-    ASSERT_EQ(importance->samples[i].features, read->samples[i].features) << "the same samples";
+  // the same samples; under hybrid compositing (the default) with dkb-curve's own inputs
+  for (size_t i = 0; i < read->samples.size(); ++i) {
+    const learn::DatasetSample &a = importance->samples[i], &b = read->samples[i];
+    ASSERT_EQ(std::tie(a.scene, a.view, a.budgetStep, a.pixel),
+              std::tie(b.scene, b.view, b.budgetStep, b.pixel));
+    const float n = std::exp2(4.0f * b.features[0]);  // feature 0 is log2(n(p)) / 4
+    ASSERT_GE(n, 1.0f);
+    ASSERT_NEAR(n, std::round(n), 1e-3f) << "a whole fragment count";
+  }
+  const auto declared = [](const learn::Dataset& d, const char* key) {
+    return nlohmann::json::parse(d.metadata).at(key).get<std::string>();
+  };
+  EXPECT_EQ(declared(*read, "features"), kDkbCurveFeatureSet);
+  EXPECT_EQ(declared(*read, "target"), kDkbCurveTailOnlyTargetScaling);
+  EXPECT_EQ(declared(*importance, "features"), kDkbFeatureSet);
+  // under kbuffer compositing the curve samples keep the deep k-buffer's inputs
+  const std::string kbufferData = (dir / "curve-kbuffer.mfrds").string();
+  r =
+      run("dataset 'procedural:city?rows=2&columns=3' --width 32 --height 32 --composite kbuffer "
+          "--quiet -o " +
+          (dir / "importance-kbuffer.mfrds").string() + " --curve-out " + kbufferData);
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  auto kbuffer = learn::readDataset(kbufferData);
+  auto kbufferImportance = learn::readDataset((dir / "importance-kbuffer.mfrds").string());
+  ASSERT_TRUE(kbuffer && kbufferImportance);
+  ASSERT_EQ(kbuffer->samples.size(), kbufferImportance->samples.size());
+  for (size_t i = 0; i < kbuffer->samples.size(); ++i)
+    ASSERT_EQ(kbuffer->samples[i].features, kbufferImportance->samples[i].features);
+  EXPECT_EQ(declared(*kbuffer, "features"), kDkbFeatureSet);
+  EXPECT_EQ(declared(*kbuffer, "target"), kDkbCurveTargetScaling);
   r = run("train " + data + " " + (dir / "importance.mfrds").string() + " --epochs 1 --quiet -o " +
           model);
   EXPECT_EQ(r.exitCode, 1) << "importance and curve datasets mixed";

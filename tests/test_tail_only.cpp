@@ -405,18 +405,22 @@ TEST(TailOnly, FillVariantsGiveAPixelAtMostNMinusOneSlotsUnderHybrid) {
 }
 
 TEST(TailOnly, PredictedCurvesMayLeaveAPixelWithoutASlotUnderHybrid) {
-  // two pixels of 3 fragments: drops 0.5, 0.1 (pixel 0) and 0.2, 0.1 (pixel 1), as sqrt targets
+  // two pixels of 3 fragments, curves from k = 0 (the hybrid model's, on its log scale): drops
+  // 0.5, 0.1 (pixel 0) and 0.2, 0.1 (pixel 1); err(2) = err(3) = 0
   std::vector<float> predictions(2 * kCurveOutputs, 0.0f);
-  predictions[0] = std::sqrt(0.5f);
-  predictions[1] = std::sqrt(0.1f);
-  predictions[kCurveOutputs] = std::sqrt(0.2f);
-  predictions[kCurveOutputs + 1] = std::sqrt(0.1f);
+  predictions[0] = curveLogUnit(0.5);
+  predictions[1] = curveLogUnit(0.1);
+  predictions[kCurveOutputs] = curveLogUnit(0.2);
+  predictions[kCurveOutputs + 1] = curveLogUnit(0.1);
   const std::vector<uint32_t> n = {3, 3};
   EXPECT_EQ(allocateByPredictedCurves(predictions, n, 0, 0), (std::vector<uint32_t>{0, 0}));
-  // err(0) is extended by the first drop: pixel 0 gains 0.5 from its first slot, pixel 1 0.2
+  // the tail-only error is predicted: pixel 0 gains 0.5 from its first slot, pixel 1 0.2
   EXPECT_EQ(allocateByPredictedCurves(predictions, n, 1, 0), (std::vector<uint32_t>{1, 0}));
-  // from k = 1 (kbuffer's floor) both keep a slot
-  EXPECT_EQ(allocateByPredictedCurves(predictions, n, 2, 1), (std::vector<uint32_t>{1, 1}));
+  EXPECT_EQ(allocateByPredictedCurves(predictions, n, 2, 0), (std::vector<uint32_t>{1, 1}));
+  // a third fragment's slot gains nothing (a tail of one fragment is exact): 4 slots serve both
+  // pixels' gains, and slots beyond them fill up to n(p)
+  EXPECT_EQ(allocateByPredictedCurves(predictions, n, 4, 0), (std::vector<uint32_t>{2, 2}));
+  EXPECT_EQ(allocateByPredictedCurves(predictions, n, 6, 0), (std::vector<uint32_t>{3, 3}));
 }
 
 }  // namespace

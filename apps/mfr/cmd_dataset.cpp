@@ -125,7 +125,9 @@ int runDataset(DatasetArgs& a) {
   if (!written) return fail(written.error().message);
   if (!a.curveOut.empty()) {  // the same samples with dkb-curve's targets
     auto meta = nlohmann::json::parse(data.metadata);
-    meta["target"] = kDkbCurveTargetScaling;
+    meta["target"] = dkbCurveTarget(sampling.compositing);
+    meta["features"] = dkbCurveFeatureSet(sampling.compositing);
+    for (learn::DatasetSample& s : data.samples) s.features = s.curveFeatures;
     data.metadata = meta.dump();
     data.targetCount = kCurveOutputs;
     written = learn::writeDataset(a.curveOut, data);

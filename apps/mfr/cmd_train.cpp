@@ -193,9 +193,9 @@ int runTrain(TrainArgs& a) {
   if (logs.empty() || !std::isfinite(logs.back().trainLoss))
     return fail("training diverged (non-finite loss); lower --learning-rate or --momentum");
   const learn::EpochLog& last = logs.back();
-  nlohmann::json meta = {{"features", kDkbFeatureSet},
+  nlohmann::json meta = {{"features", curve ? dkbCurveFeatureSet(split->rule) : kDkbFeatureSet},
                          {"feature_normalisation", "include/mfr/method/dkb_features.hpp"},
-                         {"target", curve ? kDkbCurveTargetScaling : learn::kDkbTargetScaling},
+                         {"target", curve ? dkbCurveTarget(split->rule) : learn::kDkbTargetScaling},
                          {"composite", toString(split->rule)},
                          {"layers", layers},
                          {"activations", "relu, relu, sigmoid"},

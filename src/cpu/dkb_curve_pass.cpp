@@ -27,14 +27,16 @@ Result<CurveChoice> predictedCurveK(const RasterFrame& frame, const MethodDesc& 
     out.n[p] = pixels[p].n;
     if (pixels[p].n > 0) covered.push_back(p);
   }
-  // under hybrid compositing a pixel may keep no slot (its tail alone); else allocate() reports
-  // a budget below one slot per covered pixel
-  const uint32_t firstK = allowsTailOnlyPixels(method) ? 0 : 1;
+  // under hybrid compositing a pixel may keep no slot (its tail alone) and the model's curves
+  // start at k = 0; else allocate() reports a budget below one slot per covered pixel
+  const uint32_t firstK = curveFirstK(method.compositing);
+  MFR_CHECK_EQ(firstK, allowsTailOnlyPixels(method) ? 0u : 1u);
   if (firstK == 1 && slots < covered.size()) return out;
-  // the network over the covered pixels (rows of 12 features)
+  // the network over the covered pixels (rows of 12 features: the hybrid model's own)
   std::vector<float> rows(covered.size() * kDkbFeatureCount);
   for (size_t i = 0; i < covered.size(); ++i) {
-    const PixelFeatures f = pixelFeatures(pixels[covered[i]], image, slots);
+    const PixelFeatures f = firstK == 0 ? curvePixelFeatures(pixels[covered[i]])
+                                        : pixelFeatures(pixels[covered[i]], image, slots);
     std::copy(f.begin(), f.end(), rows.begin() + static_cast<ptrdiff_t>(i * kDkbFeatureCount));
   }
   std::vector<float> predicted(covered.size() * kCurveOutputs);

@@ -103,10 +103,22 @@ uint64_t budgetStepSlots(uint64_t coveredPixels, uint64_t fragments, int step, i
 
 Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t scene,
                                               uint32_t view, const ViewSamplingOptions& options) {
-  auto oracle =
-      frameErrorCurves(frame, options.background, options.compositing, options.memoryLimitBytes);
+  // curve targets start at the rule's first k (0, the tail alone, under hybrid compositing); the
+  // importance targets always come from the curves from k = 1 (the paper's optimal k-buffer)
+  const uint32_t firstK = options.curveTargets ? curveFirstK(options.compositing) : 1;
+  auto oracle = frameErrorCurves(frame, options.background, options.compositing,
+                                 options.memoryLimitBytes, firstK);
   if (!oracle) return oracle.error();
-  const double scale = options.curveTargets ? curveScale(oracle->curves) : 1.0;
+  std::vector<CurveTargets> curves;
+  if (options.curveTargets) {
+    const double scale = firstK == 0 ? 1.0 : curveScale(oracle->curves);
+    curves.resize(oracle->curves.size());
+    for (size_t p = 0; p < curves.size(); ++p)
+      if (!oracle->curves[p].empty()) curves[p] = curveTargets(oracle->curves[p], scale, firstK);
+    if (firstK == 0)  // err(k) for k >= 1 are the same values as curves from k = 1
+      for (std::vector<double>& c : oracle->curves)
+        if (!c.empty()) c.erase(c.begin());
+  }
   const std::vector<FeatureAccumulator> pixels = accumulateFeatures(frame);
   const ImageFeatureStats image = imageFeatureStats(pixels);
   std::vector<DatasetSample> samples;
@@ -150,7 +162,10 @@ Result<std::vector<DatasetSample>> sampleView(const RasterFrame& frame, uint32_t
       sample.pixel = p;
       sample.features = pixelFeatures(pixels[p], image, slots);
       sample.target = static_cast<float>(k[p]) / static_cast<float>(kMax);
-      if (options.curveTargets) sample.curve = curveTargets(oracle->curves[p], scale);
+      if (options.curveTargets) {
+        sample.curve = curves[p];
+        sample.curveFeatures = firstK == 0 ? curvePixelFeatures(pixels[p]) : sample.features;
+      }
       samples.push_back(sample);
     }
   }
@@ -315,11 +330,15 @@ Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& pat
   const auto meta = nlohmann::json::parse(data.metadata, nullptr, false);
   if (!meta.is_object()) return {};
   const bool dfaoit = data.targetCount == kDfaoitTargetCount;
+  auto rule = datasetRule(data, path);
+  if (!rule) return rule.error();
   const std::pair<const char*, const char*> expected[] = {
-      {"features", dfaoit ? kDfaoitFeatureSet : kDkbFeatureSet},
+      {"features", dfaoit                  ? kDfaoitFeatureSet
+                   : data.targetCount == 1 ? kDkbFeatureSet
+                                           : dkbCurveFeatureSet(rule.value())},
       {"target", dfaoit                  ? kDfaoitTarget
                  : data.targetCount == 1 ? kDkbTargetScaling
-                                         : kDkbCurveTargetScaling}};
+                                         : dkbCurveTarget(rule.value())}};
   for (const auto& [key, value] : expected) {
     const auto it = meta.find(key);
     if (it == meta.end()) continue;

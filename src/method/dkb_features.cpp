@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "mfr/core/color.hpp"
+#include "mfr/method/dkb_curve.hpp"
 
 namespace mfr {
 namespace {
@@ -23,7 +24,12 @@ void FeatureAccumulator::add(float depth, uint32_t rgba) {
   ++n;
   nearest = std::min(nearest, makeNode(depth, rgba));
   farthest = std::max(farthest, depth);
-  premultipliedSum += premultiplied(rgba);
+  const glm::vec3 c = premultiplied(rgba);
+  premultipliedSum += c;
+  premultipliedSquares += glm::dot(c, c);
+  const float alpha = static_cast<float>(rgba >> 24) / 255.0f;
+  alphaSum += alpha;
+  transmittance *= 1.0f - alpha;
 }
 
 void ImageFeatureStats::add(const FeatureAccumulator& a) {
@@ -62,6 +68,45 @@ PixelFeatures pixelFeatures(const FeatureAccumulator& pixel, const ImageFeatureS
   f[9] = static_cast<float>(std::min(1.0, static_cast<double>(slots) / image.fragments));
   f[10] = image.nearest;
   f[11] = image.farthest;
+  return f;
+}
+
+PixelFeatures curvePixelFeatures(const FeatureAccumulator& pixel) {
+  PixelFeatures f{};
+  if (pixel.n == 0) return f;
+  const float n = static_cast<float>(pixel.n);
+  // the spread of `count` colours of sum `sum` and squared norms `squares`
+  const auto spread = [](glm::vec3 sum, float squares, float count) {
+    const glm::vec3 mean = sum / count;
+    return std::sqrt(std::max(0.0f, squares / count - glm::dot(mean, mean)));
+  };
+  const uint32_t nearestColour = nodeColor(pixel.nearest);
+  const glm::vec3 nearest = premultiplied(nearestColour);
+  const glm::vec3 mean = pixel.premultipliedSum / n;
+  f[0] = std::log2(n) / 4.0f;
+  f[1] = static_cast<float>(nearestColour >> 24) / 255.0f;
+  f[2] = pixel.alphaSum / n;
+  for (int c = 0; c < 3; ++c) {
+    f[3 + c] = nearest[c];
+    f[6 + c] = mean[c];
+  }
+  // the tail-only error of two groups, the nearest fragment and the rest as one fragment of
+  // their tail's colour (hybrid transparency's tail: weighted mean colour, opacity
+  // 1 - (1 - mean alpha)^count): exact for two fragments of equal opacity
+  const auto tailColour = [](glm::vec3 sum, float alphaSum, float count) {
+    if (!(alphaSum > 1e-6f)) return sum;
+    return sum / alphaSum * (1.0f - std::pow(std::max(0.0f, 1.0f - alphaSum / count), count));
+  };
+  const float a1 = f[1];
+  const glm::vec3 rest =
+      tailColour(pixel.premultipliedSum - nearest, pixel.alphaSum - a1, n - 1.0f);
+  const glm::vec3 d =
+      nearest + (1.0f - a1) * rest - tailColour(pixel.premultipliedSum, pixel.alphaSum, n);
+  f[9] = curveLogUnit(glm::dot(d, d));
+  if (pixel.n > 1)
+    f[10] = spread(pixel.premultipliedSum - nearest,
+                   pixel.premultipliedSquares - glm::dot(nearest, nearest), n - 1.0f);
+  f[11] = pixel.transmittance;
   return f;
 }
 

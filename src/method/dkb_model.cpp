@@ -29,10 +29,15 @@ struct ModelKind {
   const char* method;  // for messages
   int outputs;
   const char* target;
+  const char* features;
 };
 
-constexpr ModelKind kImportanceKind{"the deep k-buffer", 1, learn::kDkbTargetScaling};
-constexpr ModelKind kCurveKind{"dkb-curve", kCurveOutputs, kDkbCurveTargetScaling};
+constexpr ModelKind kImportanceKind{"the deep k-buffer", 1, learn::kDkbTargetScaling,
+                                    kDkbFeatureSet};
+/// dkb-curve's: its target and inputs depend on the rule (curves from k = 0 under hybrid).
+constexpr ModelKind curveKind(Compositing rule) {
+  return {"dkb-curve", kCurveOutputs, dkbCurveTarget(rule), dkbCurveFeatureSet(rule)};
+}
 
 // checkDkbModel / checkDkbCurveModel; `requireTarget`: the metadata must declare the target (the
 // built-in models).
@@ -51,10 +56,10 @@ Result<void> checkModelFits(const learn::Model& model, const std::string& name,
   const std::string features = declared("features"), target = declared("target");
   if (features.empty())
     return makeError("model " + name + ": its metadata does not declare the feature set \"" +
-                     std::string(kDkbFeatureSet) + "\" (was it written by mfr train?)");
-  if (features != kDkbFeatureSet)
+                     kind.features + "\" (was it written by mfr train?)");
+  if (features != kind.features)
     return makeError("model " + name + ": trained on the feature set \"" + oneLine(features, 80) +
-                     "\", this build computes \"" + kDkbFeatureSet + "\" (retrain it)");
+                     "\", this build computes \"" + kind.features + "\" (retrain it)");
   if (target.empty() && requireTarget)
     return makeError("model " + name + ": its metadata does not declare the target \"" +
                      kind.target + "\" (retrain it)");
@@ -99,7 +104,9 @@ Result<void> checkDkbModel(const learn::Model& model, const std::string& name) {
 }
 
 Result<void> checkDkbCurveModel(const learn::Model& model, const std::string& name) {
-  return checkModelFits(model, name, kCurveKind, false);
+  auto rule = dkbModelRule(model, name);
+  if (!rule) return rule.error();
+  return checkModelFits(model, name, curveKind(rule.value()), false);
 }
 
 Result<Compositing> dkbModelRule(const learn::Model& model, const std::string& name) {
@@ -144,12 +151,12 @@ Result<std::shared_ptr<const learn::Model>> builtinDkbCurveModel(Compositing rul
   if (rule == Compositing::KBuffer) {
     static const CachedModel kbuffer =
         decodeBuiltin(kMfrCurveKBufferModel, kMfrCurveKBufferModelSize,
-                      "models/dkb-curve-kbuffer.mfrnn", kCurveKind, rule);
+                      "models/dkb-curve-kbuffer.mfrnn", curveKind(rule), rule);
     return kbuffer;
   }
   if (rule == Compositing::Hybrid) {
-    static const CachedModel hybrid = decodeBuiltin(kMfrCurveModel, kMfrCurveModelSize,
-                                                    "models/dkb-curve.mfrnn", kCurveKind, rule);
+    static const CachedModel hybrid = decodeBuiltin(
+        kMfrCurveModel, kMfrCurveModelSize, "models/dkb-curve.mfrnn", curveKind(rule), rule);
     return hybrid;
   }
   return noBuiltin(rule);

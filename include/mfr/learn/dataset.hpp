@@ -55,6 +55,7 @@ struct DatasetSample {
   PixelFeatures features{};
   float target = 0.0f;            // the importance target t(p) (Dataset::targetCount 1)
   CurveTargets curve{};           // dkb-curve's targets (Dataset::targetCount 9)
+  PixelFeatures curveFeatures{};  // and its inputs (dkbCurveFeatureSet; what a curve file holds)
   std::array<float, 3> colour{};  // DFAOIT's target (Dataset::targetCount 3), features then
                                   // DfaoitPixel::features()
 };

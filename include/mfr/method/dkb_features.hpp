@@ -13,6 +13,30 @@
 //   10     image nearest depth D_n = min d_n(p)   window depth in [0, 1]
 //   11     image farthest depth D_f = max d_f(p)  window depth in [0, 1]
 //
+// dkb-curve's hybrid model has its own 12 inputs (curvePixelFeatures, kDkbCurveFeatureSet; issue
+// 28): what the hybrid tail's error depends on, the fragments' colours and opacities, rather than
+// the image's depth range and the budget (a curve does not depend on the budget):
+//
+//   #      feature                                value fed to the network
+//   0      the pixel's fragment count             log2(n(p)) / 4 (the curve's length is absolute)
+//   1      opacity of the nearest fragment        alpha
+//   2      mean opacity                           mean alpha
+//   3-5    colour of the nearest fragment         linear RGB x alpha (as above)
+//   6-8    average colour of the fragments        mean of linear RGB x alpha (as above)
+//   9      the tail-only error of two groups      curveLogUnit(|C2 - tail(all)|^2), below
+//   10     colour spread behind the nearest       sqrt(mean |a c|^2 - |mean a c|^2) over the
+//                                                 fragments but the nearest
+//   11     the pixel's transmittance              T = prod (1 - alpha)
+//
+// Feature 9 is err(0) of the pixel seen as two fragments, the nearest (a1 c1) and the rest as one
+// fragment of the rest's own tail colour, with hybrid transparency's tail (Maule et al. 2013, as
+// method_math.h's hybridBehind): tail(S, A, m) = S / A * (1 - (1 - A / m)^m) for m fragments of
+// premultiplied sum S and alpha sum A. C2 = a1 c1 + (1 - a1) tail(rest), against tail(all); the
+// background's share is left out (it cancels when the opacities are equal). It is exact for two
+// fragments of equal opacity, the commonest pixel of a closed mesh at one alpha, and on the same
+// log scale as the targets, so the network's first output starts from it. Behind the nearest, the
+// rest's spread, 10, is what the first slot leaves in the tail.
+//
 // Depths are window depths (gl_FragCoord.z). Colours are premultiplied by the fragment's opacity
 // because a fragment's share of the final colour (and so of the error of dropping it) scales with
 // it; the paper's fully transparent scenes had one opacity, ours do not. Uncovered pixels have no
@@ -35,6 +59,8 @@ inline constexpr int kDkbFeatureCount = 12;
 /// records in datasets, `mfr train` in models, and checkDkbModel requires of a model ("features").
 /// Change it whenever pixelFeatures changes, and retrain (scripts/train-model.sh).
 inline constexpr const char* kDkbFeatureSet = "mfr-dkb-features-v1";
+/// The same for curvePixelFeatures (dkb-curve's hybrid model).
+inline constexpr const char* kDkbCurveFeatureSet = "mfr-dkb-curve-features-v1";
 using PixelFeatures = std::array<float, kDkbFeatureCount>;
 
 /// What the feature pass accumulates for one pixel (order-independent: min, max, sums; ties of the
@@ -44,6 +70,10 @@ struct FeatureAccumulator {
   FragmentNode nearest = kFarNode;
   float farthest = 0.0f;
   glm::vec3 premultipliedSum{0.0f};
+  // (dkb-curve's hybrid inputs, curvePixelFeatures)
+  float premultipliedSquares = 0.0f;  // sum of |linear RGB x alpha|^2
+  float alphaSum = 0.0f;
+  float transmittance = 1.0f;  // prod (1 - alpha)
   void add(float depth, uint32_t rgba);
 };
 
@@ -60,6 +90,10 @@ struct ImageFeatureStats {
 /// The 12 inputs of a covered pixel; `slots` = F(M).
 PixelFeatures pixelFeatures(const FeatureAccumulator& pixel, const ImageFeatureStats& image,
                             uint64_t slots);
+
+/// dkb-curve's 12 hybrid inputs of a covered pixel (the second table above); zeros when
+/// uncovered.
+PixelFeatures curvePixelFeatures(const FeatureAccumulator& pixel);
 
 /// Image statistics of a feature pass.
 ImageFeatureStats imageFeatureStats(const std::vector<FeatureAccumulator>& pixels);
