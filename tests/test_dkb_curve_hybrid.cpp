@@ -128,29 +128,40 @@ TEST(DkbCurveHybrid, InputsOfATwoFragmentPixel) {
   const double err0 = twoFragmentTailOnlyError(a, c);
   ASSERT_GT(err0, 1e-3);
   EXPECT_NEAR(f[9], curveLogUnit(err0), 1e-5);
+  // err(1) of two fragments is 0 (a tail of one fragment is exact), up to float rounding
+  EXPECT_LE(f[10], curveLogUnit(1e-12));
   // one fragment behind the nearest has no spread (up to float cancellation under the root)
-  EXPECT_NEAR(f[10], 0.0f, 1e-3f);
-  EXPECT_NEAR(f[11], (1.0 - a[0]) * (1.0 - a[1]), 1e-6);
+  EXPECT_NEAR(f[11], 0.0f, 1e-3f);
   EXPECT_EQ(curvePixelFeatures(FeatureAccumulator{}), PixelFeatures{}) << "uncovered";
 }
 
-TEST(DkbCurveHybrid, TwoGroupErrorIsTheOraclesForTwoFragmentsOfOneOpacity) {
-  const uint32_t front = rgba(230, 30, 60, 128), back = rgba(40, 200, 90, 128);
-  FeatureAccumulator pixel;
-  pixel.add(0.3f, front);
-  pixel.add(0.6f, back);
+TEST(DkbCurveHybrid, EstimatesAreTheOraclesForThreeFragmentsOfOneOpacity) {
+  const uint32_t colours[3] = {rgba(230, 30, 60, 128), rgba(40, 200, 90, 128),
+                               rgba(250, 240, 20, 128)};
+  const float depths[3] = {0.3f, 0.6f, 0.8f};
+  for (int order : {0, 1, 2}) {  // arrival order does not matter
+    SCOPED_TRACE(order);
+    FeatureAccumulator pixel;
+    for (int i = 0; i < 3; ++i) pixel.add(depths[(i + order) % 3], colours[(i + order) % 3]);
+    // the oracle's curve from the tail alone over a background (its share cancels here)
+    FragmentNode sorted[3];
+    for (int i = 0; i < 3; ++i) sorted[i] = makeNode(depths[i], colours[i]);
+    const std::vector<double> curve =
+        errorCurve(sorted, 3, glm::vec3(0.2f, 0.5f, 0.9f), Compositing::Hybrid, 0);
+    ASSERT_EQ(curve.size(), 4u);
+    ASSERT_GT(curve[1], 1e-4);
+    const PixelFeatures f = curvePixelFeatures(pixel);
+    EXPECT_NEAR(f[9], curveLogUnit(curve[0]), 1e-5);
+    EXPECT_NEAR(f[10], curveLogUnit(curve[1]), 1e-5);
+  }
+  // two fragments: err(0) by the formula, written out independently
+  FeatureAccumulator two;
+  two.add(0.3f, colours[0]);
+  two.add(0.6f, colours[1]);
   const double a[2] = {128 / 255.0, 128 / 255.0};
   const double c[2][3] = {{srgbToLinear(230), srgbToLinear(30), srgbToLinear(60)},
                           {srgbToLinear(40), srgbToLinear(200), srgbToLinear(90)}};
-  const double err0 = twoFragmentTailOnlyError(a, c);
-  // the oracle's curve from the tail alone over a background (its share cancels here)
-  FragmentNode sorted[2] = {makeNode(0.3f, front), makeNode(0.6f, back)};
-  const std::vector<double> curve =
-      errorCurve(sorted, 2, glm::vec3(0.2f, 0.5f, 0.9f), Compositing::Hybrid, 0);
-  ASSERT_EQ(curve.size(), 3u);
-  EXPECT_NEAR(curve[0], err0, 1e-5 * err0) << "(the oracle decodes colours in float)";
-  EXPECT_NEAR(curve[1], 0.0, 1e-12) << "a tail of one fragment is exact";
-  EXPECT_NEAR(curvePixelFeatures(pixel)[9], curveLogUnit(curve[0]), 1e-5);
+  EXPECT_NEAR(curvePixelFeatures(two)[9], curveLogUnit(twoFragmentTailOnlyError(a, c)), 1e-5);
 }
 
 TEST(DkbCurveHybrid, SpreadBehindTheNearestOfThreeFragments) {
@@ -160,9 +171,9 @@ TEST(DkbCurveHybrid, SpreadBehindTheNearestOfThreeFragments) {
   pixel.add(0.6f, rgba(0, 0, 255, 255));
   const PixelFeatures f = curvePixelFeatures(pixel);
   // two colours (1, 0, 0) and (0, 0, 1): mean (0.5, 0, 0.5), mean |c|^2 = 1, spread sqrt(0.5)
-  EXPECT_NEAR(f[10], std::sqrt(0.5f), 1e-6f);
+  EXPECT_NEAR(f[11], std::sqrt(0.5f), 1e-6f);
   EXPECT_NEAR(f[0], std::log2(3.0f) / 4.0f, 1e-6f);
-  EXPECT_FLOAT_EQ(f[11], 0.0f) << "an opaque fragment";
+  EXPECT_NEAR(f[2], (127 / 255.0f + 2.0f) / 3.0f, 1e-6f);
 }
 
 TEST(DkbCurveHybrid, HybridModelsDeclareTheTailOnlyDefinition) {

@@ -22,14 +22,19 @@ glm::vec3 premultiplied(uint32_t rgba) {
 
 void FeatureAccumulator::add(float depth, uint32_t rgba) {
   ++n;
-  nearest = std::min(nearest, makeNode(depth, rgba));
+  const FragmentNode node = makeNode(depth, rgba);
+  if (node < nearest) {
+    second = nearest;
+    nearest = node;
+  } else {
+    second = std::min(second, node);
+  }
   farthest = std::max(farthest, depth);
   const glm::vec3 c = premultiplied(rgba);
   premultipliedSum += c;
   premultipliedSquares += glm::dot(c, c);
   const float alpha = static_cast<float>(rgba >> 24) / 255.0f;
   alphaSum += alpha;
-  transmittance *= 1.0f - alpha;
 }
 
 void ImageFeatureStats::add(const FeatureAccumulator& a) {
@@ -75,11 +80,6 @@ PixelFeatures curvePixelFeatures(const FeatureAccumulator& pixel) {
   PixelFeatures f{};
   if (pixel.n == 0) return f;
   const float n = static_cast<float>(pixel.n);
-  // the spread of `count` colours of sum `sum` and squared norms `squares`
-  const auto spread = [](glm::vec3 sum, float squares, float count) {
-    const glm::vec3 mean = sum / count;
-    return std::sqrt(std::max(0.0f, squares / count - glm::dot(mean, mean)));
-  };
   const uint32_t nearestColour = nodeColor(pixel.nearest);
   const glm::vec3 nearest = premultiplied(nearestColour);
   const glm::vec3 mean = pixel.premultipliedSum / n;
@@ -90,23 +90,36 @@ PixelFeatures curvePixelFeatures(const FeatureAccumulator& pixel) {
     f[3 + c] = nearest[c];
     f[6 + c] = mean[c];
   }
-  // the tail-only error of two groups, the nearest fragment and the rest as one fragment of
-  // their tail's colour (hybrid transparency's tail: weighted mean colour, opacity
-  // 1 - (1 - mean alpha)^count): exact for two fragments of equal opacity
+  // the tail-only error err(0) and err(1) of the pixel seen as its two nearest fragments and the
+  // rest as one fragment of the rest's tail colour (hybrid transparency's tail: weighted mean
+  // colour, opacity 1 - (1 - mean alpha)^count): exact for three fragments of equal opacity
   const auto tailColour = [](glm::vec3 sum, float alphaSum, float count) {
-    if (!(alphaSum > 1e-6f)) return sum;
+    if (!(alphaSum > 1e-6f) || !(count > 0.0f)) return sum;
     return sum / alphaSum * (1.0f - std::pow(std::max(0.0f, 1.0f - alphaSum / count), count));
   };
   const float a1 = f[1];
-  const glm::vec3 rest =
-      tailColour(pixel.premultipliedSum - nearest, pixel.alphaSum - a1, n - 1.0f);
-  const glm::vec3 d =
-      nearest + (1.0f - a1) * rest - tailColour(pixel.premultipliedSum, pixel.alphaSum, n);
-  f[9] = curveLogUnit(glm::dot(d, d));
-  if (pixel.n > 1)
-    f[10] = spread(pixel.premultipliedSum - nearest,
-                   pixel.premultipliedSquares - glm::dot(nearest, nearest), n - 1.0f);
-  f[11] = pixel.transmittance;
+  glm::vec3 second(0.0f);
+  float a2 = 0.0f;
+  if (pixel.n > 1) {
+    a2 = static_cast<float>(nodeColor(pixel.second) >> 24) / 255.0f;
+    second = premultiplied(nodeColor(pixel.second));
+  }
+  const glm::vec3 behindFirst = pixel.premultipliedSum - nearest;
+  const float behindFirstAlpha = pixel.alphaSum - a1;
+  const glm::vec3 behindSecond =
+      tailColour(behindFirst - second, behindFirstAlpha - a2, std::max(0.0f, n - 2.0f));
+  const glm::vec3 fromSecond = second + (1.0f - a2) * behindSecond;  // the estimate behind 1
+  const glm::vec3 d0 =
+      nearest + (1.0f - a1) * fromSecond - tailColour(pixel.premultipliedSum, pixel.alphaSum, n);
+  const glm::vec3 d1 =
+      (1.0f - a1) * (fromSecond - tailColour(behindFirst, behindFirstAlpha, n - 1.0f));
+  f[9] = curveLogUnit(glm::dot(d0, d0));
+  f[10] = curveLogUnit(glm::dot(d1, d1));
+  if (pixel.n > 1) {  // the spread of the colours behind the nearest
+    const glm::vec3 mean = behindFirst / (n - 1.0f);
+    const float squares = pixel.premultipliedSquares - glm::dot(nearest, nearest);
+    f[11] = std::sqrt(std::max(0.0f, squares / (n - 1.0f) - glm::dot(mean, mean)));
+  }
   return f;
 }
 

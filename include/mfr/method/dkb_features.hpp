@@ -23,19 +23,21 @@
 //   2      mean opacity                           mean alpha
 //   3-5    colour of the nearest fragment         linear RGB x alpha (as above)
 //   6-8    average colour of the fragments        mean of linear RGB x alpha (as above)
-//   9      the tail-only error of two groups      curveLogUnit(|C2 - tail(all)|^2), below
-//   10     colour spread behind the nearest       sqrt(mean |a c|^2 - |mean a c|^2) over the
+//   9      estimate of err(0), the tail alone     curveLogUnit(|C3 - tail(all)|^2), below
+//   10     estimate of err(1)                     curveLogUnit((1 - a1)^2 |C3' - tail(behind 1)|^2)
+//   11     colour spread behind the nearest       sqrt(mean |a c|^2 - |mean a c|^2) over the
 //                                                 fragments but the nearest
-//   11     the pixel's transmittance              T = prod (1 - alpha)
 //
-// Feature 9 is err(0) of the pixel seen as two fragments, the nearest (a1 c1) and the rest as one
-// fragment of the rest's own tail colour, with hybrid transparency's tail (Maule et al. 2013, as
-// method_math.h's hybridBehind): tail(S, A, m) = S / A * (1 - (1 - A / m)^m) for m fragments of
-// premultiplied sum S and alpha sum A. C2 = a1 c1 + (1 - a1) tail(rest), against tail(all); the
-// background's share is left out (it cancels when the opacities are equal). It is exact for two
-// fragments of equal opacity, the commonest pixel of a closed mesh at one alpha, and on the same
-// log scale as the targets, so the network's first output starts from it. Behind the nearest, the
-// rest's spread, 10, is what the first slot leaves in the tail.
+// Features 9 and 10 see the pixel as three fragments: its two nearest (a1 c1, a2 c2; the feature
+// pass keeps both) and the rest as one fragment of the rest's own tail colour, with hybrid
+// transparency's tail (Maule et al. 2013, as method_math.h's hybridBehind): tail(S, A, m) =
+// S / A * (1 - (1 - A / m)^m) for m fragments of premultiplied sum S and alpha sum A. Behind the
+// nearest that is C3' = a2 c2 + (1 - a2) tail(behind 2), and in all C3 = a1 c1 + (1 - a1) C3';
+// err(0) compares C3 with the tail of every fragment, err(1) C3' with the tail of the fragments
+// behind the nearest, seen through the nearest. The background's share is left out (it cancels
+// when the opacities are equal). Both are exact for up to three fragments of one opacity (most
+// pixels of a closed mesh at one alpha) and are on the targets' log scale, so for such pixels the
+// first two drops follow from them; 11 tells how far the rest is from one colour.
 //
 // Depths are window depths (gl_FragCoord.z). Colours are premultiplied by the fragment's opacity
 // because a fragment's share of the final colour (and so of the error of dropping it) scales with
@@ -68,12 +70,12 @@ using PixelFeatures = std::array<float, kDkbFeatureCount>;
 struct FeatureAccumulator {
   uint32_t n = 0;
   FragmentNode nearest = kFarNode;
+  FragmentNode second = kFarNode;  // the second nearest (dkb-curve's hybrid inputs)
   float farthest = 0.0f;
   glm::vec3 premultipliedSum{0.0f};
   // (dkb-curve's hybrid inputs, curvePixelFeatures)
   float premultipliedSquares = 0.0f;  // sum of |linear RGB x alpha|^2
   float alphaSum = 0.0f;
-  float transmittance = 1.0f;  // prod (1 - alpha)
   void add(float depth, uint32_t rgba);
 };
 
