@@ -174,7 +174,8 @@ Runner addDatasetCommand(CLI::App& app) {
                   "one model per rule");
   cmd->add_option("--curve-out", args->curveOut,
                   "Also write dkb-curve's dataset: the same samples with each pixel's error curve "
-                  "(8 drops and a tail) as targets");
+                  "(8 drops and a tail) as targets; under hybrid compositing the curve from k = 0 "
+                  "and dkb-curve's own inputs");
   cmd->add_option("--target", args->target,
                   "Which network's samples: dkb (default; the deep k-buffer's features and "
                   "optimal targets) or dfaoit (DFAOIT's features and each pixel's A-buffer "
