@@ -78,16 +78,25 @@ TEST(DkbCurve, TargetsRoundTripTheCurvesTheRepresentationHolds) {
 
 TEST(DkbCurve, RebuiltCurvesDecreaseToZeroWhateverThePrediction) {
   procedural::Rng rng(6);
-  for (int trial = 0; trial < 200; ++trial) {
-    float p[kCurveOutputs];
-    for (float& v : p) v = rng.uniform(-0.5f, 1.5f);
-    if (trial % 7 == 0) p[rng.below(kCurveOutputs)] = std::numeric_limits<float>::quiet_NaN();
-    const uint32_t n = 1 + rng.below(30);
-    const std::vector<double> err = curveFromPrediction(p, n);
-    ASSERT_EQ(err.size(), n);
-    EXPECT_EQ(err.back(), 0.0);
-    for (uint32_t k = 1; k < n; ++k) EXPECT_GE(err[k - 1], err[k]) << "non-increasing";
-    EXPECT_LE(err.front(), kCurveOutputs + 1e-12) << "each value at most 1 (squared)";
+  // from k = 1 (kbuffer; sqrt scale, values at most 1) and from k = 0 (hybrid; log scale, values
+  // at most 3, and err(n - 1) = 0: a tail of one fragment is exact)
+  for (uint32_t firstK : {1u, 0u}) {
+    SCOPED_TRACE(firstK);
+    for (int trial = 0; trial < 200; ++trial) {
+      float p[kCurveOutputs];
+      for (float& v : p) v = rng.uniform(-0.5f, 1.5f);
+      if (trial % 7 == 0) p[rng.below(kCurveOutputs)] = std::numeric_limits<float>::quiet_NaN();
+      const uint32_t n = 1 + rng.below(30);
+      const std::vector<double> err = curveFromPrediction(p, n, firstK);
+      ASSERT_EQ(err.size(), n + 1 - firstK);
+      EXPECT_EQ(err.back(), 0.0);
+      if (firstK == 0) {
+        EXPECT_EQ(err[n - 1], 0.0) << "a tail of one fragment is exact";
+      }
+      for (size_t k = 1; k < err.size(); ++k) EXPECT_GE(err[k - 1], err[k]) << "non-increasing";
+      const double top = firstK == 0 ? kCurveLogTop : 1.0;
+      EXPECT_LE(err.front(), kCurveOutputs * top + 1e-12) << "each value at most " << top;
+    }
   }
   EXPECT_TRUE(curveFromPrediction(nullptr, 0).empty());
 }
