@@ -97,8 +97,9 @@ TEST(DkbCurveHybrid, InputsOfATwoFragmentPixel) {
   const float farDepth = 0.75f, nearDepth = 0.25f;
   const uint32_t back = rgba(40, 200, 90, 102), front = rgba(230, 30, 60, 179);  // a 0.4, 0.7
   FeatureAccumulator pixel;
-  pixel.add(farDepth, back);  // arrival order does not matter: the nearest is found by depth
-  pixel.add(nearDepth, front);
+  pixel.addWithCurveInputs(farDepth,
+                           back);  // arrival order does not matter: the nearest is found by depth
+  pixel.addWithCurveInputs(nearDepth, front);
   const double a[2] = {179 / 255.0, 102 / 255.0};
   const double c[2][3] = {{srgbToLinear(230), srgbToLinear(30), srgbToLinear(60)},
                           {srgbToLinear(40), srgbToLinear(200), srgbToLinear(90)}};
@@ -127,7 +128,8 @@ TEST(DkbCurveHybrid, EstimatesAreTheOraclesForThreeFragmentsOfOneOpacity) {
   for (int order : {0, 1, 2}) {  // arrival order does not matter
     SCOPED_TRACE(order);
     FeatureAccumulator pixel;
-    for (int i = 0; i < 3; ++i) pixel.add(depths[(i + order) % 3], colours[(i + order) % 3]);
+    for (int i = 0; i < 3; ++i)
+      pixel.addWithCurveInputs(depths[(i + order) % 3], colours[(i + order) % 3]);
     // the oracle's curve from the tail alone over a background (its share cancels here)
     FragmentNode sorted[3];
     for (int i = 0; i < 3; ++i) sorted[i] = makeNode(depths[i], colours[i]);
@@ -141,8 +143,8 @@ TEST(DkbCurveHybrid, EstimatesAreTheOraclesForThreeFragmentsOfOneOpacity) {
   }
   // two fragments: err(0) by the formula, written out independently
   FeatureAccumulator two;
-  two.add(0.3f, colours[0]);
-  two.add(0.6f, colours[1]);
+  two.addWithCurveInputs(0.3f, colours[0]);
+  two.addWithCurveInputs(0.6f, colours[1]);
   const double a[2] = {128 / 255.0, 128 / 255.0};
   const double c[2][3] = {{srgbToLinear(230), srgbToLinear(30), srgbToLinear(60)},
                           {srgbToLinear(40), srgbToLinear(200), srgbToLinear(90)}};
@@ -151,14 +153,35 @@ TEST(DkbCurveHybrid, EstimatesAreTheOraclesForThreeFragmentsOfOneOpacity) {
 
 TEST(DkbCurveHybrid, SpreadBehindTheNearestOfThreeFragments) {
   FeatureAccumulator pixel;
-  pixel.add(0.2f, rgba(255, 255, 255, 255 / 2));
-  pixel.add(0.5f, rgba(255, 0, 0, 255));  // behind: premultiplied (1, 0, 0) and (0, 0, 1)
-  pixel.add(0.6f, rgba(0, 0, 255, 255));
+  pixel.addWithCurveInputs(0.2f, rgba(255, 255, 255, 255 / 2));
+  pixel.addWithCurveInputs(0.5f,
+                           rgba(255, 0, 0, 255));  // behind: premultiplied (1, 0, 0) and (0, 0, 1)
+  pixel.addWithCurveInputs(0.6f, rgba(0, 0, 255, 255));
   const PixelFeatures f = curvePixelFeatures(pixel);
   // two colours (1, 0, 0) and (0, 0, 1): mean (0.5, 0, 0.5), mean |c|^2 = 1, spread sqrt(0.5)
   EXPECT_NEAR(f[11], std::sqrt(0.5f), 1e-6f);
   EXPECT_NEAR(f[0], std::log2(3.0f) / 4.0f, 1e-6f);
   EXPECT_NEAR(f[2], (127 / 255.0f + 2.0f) / 3.0f, 1e-6f);
+}
+
+TEST(DkbCurveHybrid, CurveInputsLeaveTheDeepKBuffersInputsAsTheyAre) {
+  // the paper's feature pass adds without the curve inputs: the same accumulator otherwise
+  procedural::Rng rng(30);
+  FeatureAccumulator plain, withCurve;
+  for (int i = 0; i < 50; ++i) {
+    const float depth = rng.uniform();
+    const uint32_t colour =
+        rgba(static_cast<uint8_t>(rng.below(256)), static_cast<uint8_t>(rng.below(256)),
+             static_cast<uint8_t>(rng.below(256)), static_cast<uint8_t>(2 + rng.below(254)));
+    plain.add(depth, colour);
+    withCurve.addWithCurveInputs(depth, colour);
+  }
+  EXPECT_EQ(plain.n, withCurve.n);
+  EXPECT_EQ(plain.nearest, withCurve.nearest);
+  EXPECT_EQ(plain.farthest, withCurve.farthest);
+  EXPECT_EQ(plain.premultipliedSum, withCurve.premultipliedSum);
+  EXPECT_EQ(plain.second, kFarNode) << "kept by addWithCurveInputs only";
+  EXPECT_LT(withCurve.nearest, withCurve.second);
 }
 
 TEST(DkbCurveHybrid, HybridModelsDeclareTheTailOnlyDefinition) {

@@ -101,8 +101,9 @@ std::vector<float> predictImportance(const RasterFrame& frame, const learn::Mode
 std::vector<FeatureAccumulator> accumulateFeatures(const RasterFrame& frame) {
   std::vector<FeatureAccumulator> pixels(frame.pixelCount());
   frame.forEachTile([&](int tile) {
-    frame.rasterizeTile<ShadeMode::Full>(
-        tile, EmitAll{[&](const Fragment& f) { pixels[f.pixel].add(f.depth, f.rgba); }});
+    frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
+                                           pixels[f.pixel].addWithCurveInputs(f.depth, f.rgba);
+                                         }});
   });
   return pixels;
 }

@@ -10,31 +10,37 @@
 namespace mfr {
 namespace {
 
+float alphaOf(uint32_t rgba) {
+  return static_cast<float>(rgba >> 24) / 255.0f;
+}
+
 glm::vec3 premultiplied(uint32_t rgba) {
   const ColorTables& t = ColorTables::get();
-  const float alpha = static_cast<float>(rgba >> 24) / 255.0f;
   return glm::vec3(t.srgb8ToLinear[rgba & 0xff], t.srgb8ToLinear[(rgba >> 8) & 0xff],
                    t.srgb8ToLinear[(rgba >> 16) & 0xff]) *
-         alpha;
+         alphaOf(rgba);
 }
 
 }  // namespace
 
-void FeatureAccumulator::add(float depth, uint32_t rgba) {
+void FeatureAccumulator::add(FragmentNode node, float depth, glm::vec3 premultipliedColour) {
   ++n;
-  const FragmentNode node = makeNode(depth, rgba);
-  if (node < nearest) {
-    second = nearest;
-    nearest = node;
-  } else {
-    second = std::min(second, node);
-  }
+  nearest = std::min(nearest, node);
   farthest = std::max(farthest, depth);
+  premultipliedSum += premultipliedColour;
+}
+
+void FeatureAccumulator::add(float depth, uint32_t rgba) {
+  add(makeNode(depth, rgba), depth, premultiplied(rgba));
+}
+
+void FeatureAccumulator::addWithCurveInputs(float depth, uint32_t rgba) {
+  const FragmentNode node = makeNode(depth, rgba);
+  second = node < nearest ? nearest : std::min(second, node);
   const glm::vec3 c = premultiplied(rgba);
-  premultipliedSum += c;
+  add(node, depth, c);
   premultipliedSquares += glm::dot(c, c);
-  const float alpha = static_cast<float>(rgba >> 24) / 255.0f;
-  alphaSum += alpha;
+  alphaSum += alphaOf(rgba);
 }
 
 void ImageFeatureStats::add(const FeatureAccumulator& a) {
@@ -84,7 +90,7 @@ PixelFeatures curvePixelFeatures(const FeatureAccumulator& pixel) {
   const glm::vec3 nearest = premultiplied(nearestColour);
   const glm::vec3 mean = pixel.premultipliedSum / n;
   f[0] = std::log2(n) / 4.0f;
-  f[1] = static_cast<float>(nearestColour >> 24) / 255.0f;
+  f[1] = alphaOf(nearestColour);
   f[2] = pixel.alphaSum / n;
   for (int c = 0; c < 3; ++c) {
     f[3 + c] = nearest[c];
@@ -101,7 +107,7 @@ PixelFeatures curvePixelFeatures(const FeatureAccumulator& pixel) {
   glm::vec3 second(0.0f);
   float a2 = 0.0f;
   if (pixel.n > 1) {
-    a2 = static_cast<float>(nodeColor(pixel.second) >> 24) / 255.0f;
+    a2 = alphaOf(nodeColor(pixel.second));
     second = premultiplied(nodeColor(pixel.second));
   }
   const glm::vec3 behindFirst = pixel.premultipliedSum - nearest;
@@ -116,9 +122,9 @@ PixelFeatures curvePixelFeatures(const FeatureAccumulator& pixel) {
   f[9] = curveLogUnit(glm::dot(d0, d0));
   f[10] = curveLogUnit(glm::dot(d1, d1));
   if (pixel.n > 1) {  // the spread of the colours behind the nearest
-    const glm::vec3 mean = behindFirst / (n - 1.0f);
+    const glm::vec3 behindMean = behindFirst / (n - 1.0f);
     const float squares = pixel.premultipliedSquares - glm::dot(nearest, nearest);
-    f[11] = std::sqrt(std::max(0.0f, squares / (n - 1.0f) - glm::dot(mean, mean)));
+    f[11] = std::sqrt(std::max(0.0f, squares / (n - 1.0f) - glm::dot(behindMean, behindMean)));
   }
   return f;
 }

@@ -41,7 +41,8 @@ std::vector<float> predictImportance(const RasterFrame& frame, const learn::Mode
                                      const ImageFeatureStats& image, uint64_t slots,
                                      double* featureMs = nullptr, double* inferenceMs = nullptr);
 
-/// The whole-frame feature pass (tile-parallel, deterministic): one accumulator per pixel.
+/// The whole-frame feature pass (tile-parallel, deterministic): one accumulator per pixel, with
+/// dkb-curve's hybrid inputs (FeatureAccumulator::addWithCurveInputs).
 std::vector<FeatureAccumulator> accumulateFeatures(const RasterFrame& frame);
 
 }  // namespace mfr

@@ -70,13 +70,20 @@ using PixelFeatures = std::array<float, kDkbFeatureCount>;
 struct FeatureAccumulator {
   uint32_t n = 0;
   FragmentNode nearest = kFarNode;
-  FragmentNode second = kFarNode;  // the second nearest (dkb-curve's hybrid inputs)
   float farthest = 0.0f;
   glm::vec3 premultipliedSum{0.0f};
-  // (dkb-curve's hybrid inputs, curvePixelFeatures)
+  // dkb-curve's hybrid inputs (curvePixelFeatures), kept by addWithCurveInputs only
+  FragmentNode second = kFarNode;     // the second nearest
   float premultipliedSquares = 0.0f;  // sum of |linear RGB x alpha|^2
   float alphaSum = 0.0f;
+  /// The deep k-buffer's inputs (pixelFeatures).
   void add(float depth, uint32_t rgba);
+  /// The same and dkb-curve's hybrid inputs (accumulateFeatures; the paper's feature pass,
+  /// predictImportance, needs add alone).
+  void addWithCurveInputs(float depth, uint32_t rgba);
+
+ private:
+  void add(FragmentNode node, float depth, glm::vec3 premultipliedColour);
 };
 
 /// Image-level quantities of the frame (over covered pixels).
