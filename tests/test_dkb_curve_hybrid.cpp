@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -41,6 +42,11 @@ TEST(DkbCurveHybrid, LogScaleSpansSixteenDecadesBelowThree) {
   EXPECT_FLOAT_EQ(curveLogUnit(0.0), 0.0f);
   EXPECT_FLOAT_EQ(curveLogUnit(-1.0), 0.0f);
   EXPECT_FLOAT_EQ(curveLogUnit(std::nan("")), 0.0f);
+  // the definition datasets and models record names this scale
+  const std::string scale = "1 + log10(v / " + std::to_string(static_cast<int>(kCurveLogTop)) +
+                            ") / " + std::to_string(static_cast<int>(kCurveLogDecades)) + " ";
+  EXPECT_EQ(std::string(kDkbCurveTailOnlyTargetScaling).rfind(scale, 0), 0u)
+      << kDkbCurveTailOnlyTargetScaling;
 }
 
 /// A hybrid curve err(k), k = 0..n: err(n - 1) = err(n) = 0, drops of 1e-9..1 before, and beyond

@@ -15,7 +15,7 @@
 //   k0 = 1: t = sqrt(v / S), S a per-view scale, max_p err_p(1), so that t stays in [0, 1]: the
 //         hull allocation only compares drops between pixels of one image, so any per-image factor
 //         is free, as for the importance; the square root spreads the small drops.
-//   k0 = 0: t = 1 + log10(v / 3) / 9 clamped to [0, 1] (0 for v <= 0): absolute, 9 decades below
+//   k0 = 0: t = 1 + log10(v / 3) / 16 clamped to [0, 1] (0 for v <= 0): absolute, 16 decades below
 //         the largest squared linear-RGB error, 3. A per-view S is a statistic of the whole image
 //         the network cannot see (one bright pixel rescales every target), and the allocation at
 //         a large budget ranks drops many decades below the largest, which a square root squeezes
@@ -54,11 +54,11 @@ inline constexpr const char* kDkbCurveTargetScaling =
     "sqrt(err(j) - err(j+1)) j=1..8, sqrt(err(9)), over max_p err_p(1) per view "
     "(include/mfr/method/dkb_curve.hpp)";
 inline constexpr const char* kDkbCurveTailOnlyTargetScaling =
-    "1 + log10(v / 3) / 9 of v = err(j) - err(j+1) j=0..7 and err(8), err(0) the tail alone, "
+    "1 + log10(v / 3) / 16 of v = err(j) - err(j+1) j=0..7 and err(8), err(0) the tail alone, "
     "err(n-1) = 0 (include/mfr/method/dkb_curve.hpp)";
 
-/// The log scale of curves from k = 0: values from 3 (the largest squared linear-RGB error) down 9
-/// decades map to [1, 0].
+/// The log scale of curves from k = 0: values from 3 (the largest squared linear-RGB error) down
+/// 16 decades map to [1, 0]. kDkbCurveTailOnlyTargetScaling names both numbers: change it with them.
 inline constexpr double kCurveLogTop = 3.0;
 inline constexpr double kCurveLogDecades = 16.0;
 
