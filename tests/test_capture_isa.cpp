@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -12,7 +13,9 @@
 
 #include "cpu/max_heap_replace.hpp"
 #include "mfr/core/isa.hpp"
+#include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/fragment_stores.hpp"
+#include "mfr/cpu/render.hpp"
 #include "mfr/method/stats_json.hpp"
 #include "mfr/scene/procedural.hpp"
 #include "tsan/capture_cases.hpp"
@@ -61,8 +64,8 @@ Scene proceduralScene(const std::string& spec) {
   return scene.ok() ? std::move(scene.value()) : Scene{};
 }
 
-// An opaque, a blended, an alpha-masked and a textured material in one scene: the wide path takes
-// the first two and hands the others to the scalar loop on the same tile.
+// An opaque, a blended, an alpha-masked and a textured material in one scene (all on the wide
+// path), and one blending additively: the tiles it reaches run the scalar loop on the same sink.
 Scene mixedMaterialScene(int size) {
   std::vector<test::TestTriangle> tris;
   for (int i = 0; i < 12; ++i) {
@@ -81,6 +84,7 @@ Scene mixedMaterialScene(int size) {
   checker.rgba = {255, 0, 0, 255, 0, 255, 0, 40, 0, 0, 255, 200, 255, 255, 255, 90};
   s.textures.push_back(checker);
   s.materials[8].baseColorTexture = 0;
+  s.materials[10].blend = BlendMode::Additive;
   s.uvs.assign(s.positions.size(), glm::vec2(0.0f));
   for (size_t v = 0; v < s.uvs.size(); ++v)
     s.uvs[v] = glm::vec2(static_cast<float>(v % 3) * 0.7f, static_cast<float>(v % 2) * 1.3f);
@@ -88,17 +92,65 @@ Scene mixedMaterialScene(int size) {
 }
 
 // The mixed scene with vertex colours on every other rectangle (some corners white, alpha below 1
-// on some), its masked and textured materials made plain blended ones: every tile takes the wide
-// path, coloured triangles (blended and opaque) included.
+// on some), its masked, textured and additive materials made plain blended ones: every tile takes
+// the wide path, coloured triangles (blended and opaque) included.
 Scene vertexColorScene(int size) {
   Scene s = mixedMaterialScene(size);
   s.materials[5].alphaMode = AlphaMode::Blend;
   s.materials[8].baseColorTexture = -1;
+  s.materials[10].blend = BlendMode::Over;
   s.colors.assign(s.positions.size(), glm::vec4(1.0f));
   for (size_t v = 0; v < s.colors.size(); ++v)
     if ((v / 6) % 2 == 1)  // two triangles of 3 vertices per rectangle
       s.colors[v] = glm::vec4(0.2f + 0.1f * static_cast<float>(v % 7), 1.0f - 0.05f * (v % 11),
                               static_cast<float>(v % 3) * 0.4f, v % 4 == 0 ? 1.0f : 0.6f);
+  return s;
+}
+
+// Textured materials of every sampler (bilinear and nearest; repeat, clamp to edge, mirrored
+// repeat per axis), non-power-of-two textures with texel alpha, uv ranges far outside [0, 1]
+// (the scalar wrap per lane), one beyond 1e9 (texelIndex's fmod) and one NaN, opaque, masked and
+// alpha-overridden materials, vertex colours on some: every tile takes the wide path, with the
+// texture sampled and the alpha test run on the lanes.
+Scene texturedScene(int size) {
+  Scene s = vertexColorScene(size);
+  auto texture = [](int w, int h, int seed) {
+    Texture t;
+    t.width = w;
+    t.height = h;
+    for (int i = 0; i < w * h * 4; ++i)
+      t.rgba.push_back(static_cast<uint8_t>((i * 37 + seed * 91 + (i / 4) * (i % 4) * 13) % 256));
+    return t;
+  };
+  s.textures = {texture(2, 2, 1), texture(5, 3, 2), texture(7, 4, 3), texture(64, 33, 4)};
+  const TextureWrap r = TextureWrap::Repeat, c = TextureWrap::ClampToEdge,
+                    m = TextureWrap::MirroredRepeat;
+  const TextureFilter lin = TextureFilter::Linear, nea = TextureFilter::Nearest;
+  const struct {
+    int material, texture;
+    TextureSampler sampler;
+  } textured[] = {{0, 3, {r, r, lin}}, {1, 0, {r, c, lin}}, {3, 1, {c, c, nea}},
+                  {4, 2, {m, r, lin}}, {6, 3, {m, m, nea}}, {7, 1, {c, m, lin}},
+                  {8, 0, {r, r, nea}}, {9, 2, {c, r, lin}}, {11, 3, {r, m, lin}}};
+  for (const auto& t : textured) {
+    s.materials[t.material].baseColorTexture = t.texture;
+    s.materials[t.material].baseColorSampler = t.sampler;
+  }
+  s.materials[4].alphaMode = AlphaMode::Opaque;
+  // alpha-masked: textured (texel alpha against the cutoff), textured and vertex-coloured, and
+  // plain (material alpha and vertex colours)
+  s.materials[3].alphaMode = s.materials[7].alphaMode = s.materials[10].alphaMode = AlphaMode::Mask;
+  s.materials[3].alphaCutoff = 0.4f;
+  s.materials[7].alphaCutoff = 0.25f;
+  s.materials[10].alphaCutoff = 0.3f;
+  s.uvs.assign(s.positions.size(), glm::vec2(0.0f));
+  for (size_t v = 0; v < s.uvs.size(); ++v) {
+    const float rect = static_cast<float>(v / 6);  // two triangles of 3 vertices per rectangle
+    s.uvs[v] = glm::vec2(static_cast<float>(v % 3) * (0.4f + 0.3f * rect) - 0.2f * rect,
+                         static_cast<float>(v % 2) * (1.1f - 0.07f * rect) + 0.05f * rect - 0.3f);
+  }
+  s.uvs[6 * 9] = glm::vec2(3e9f, -2e9f);  // rectangle 9: texelIndex's fmod
+  s.uvs[6 * 11 + 4] = glm::vec2(std::numeric_limits<float>::quiet_NaN(), 0.5f);
   return s;
 }
 
@@ -116,6 +168,10 @@ TEST(CaptureIsa, WidePathCapturesWhatTheScalarPathCaptures) {
   cases.push_back({"mixed materials", mixedMaterialScene(70), 70, 70});
   cases.push_back({"vertex colours", vertexColorScene(70), 70, 70});
   cases.push_back({"hot pixels", test::hotPixelScene(24, 400, 7), 24, 24});
+  cases.push_back({"textured", texturedScene(70), 70, 70});
+  Scene overridden = texturedScene(70);
+  overridden.alphaOverride = 0.45f;
+  cases.push_back({"textured, alpha override", std::move(overridden), 70, 70});
   for (const Case& c : cases) {
     const Camera camera = c.scene.defaultCamera ? *c.scene.defaultCamera : test::screenCamera();
     const auto frame = test::buildFrame(c.scene, camera, c.width, c.height, 2);
@@ -137,6 +193,54 @@ TEST(CaptureIsa, WidePathCapturesWhatTheScalarPathCaptures) {
                           c.name + " " + method.name + " " + toString(rule));
       }
     }
+  }
+}
+
+// The passes that shade every fragment (shaded_fragments.hpp: the deep k-buffer's features, the
+// previous-frame cosines, the optimal oracle's pre-pass) give the same per-pixel results on the
+// lanes as on the scalar loop, textured, masked and vertex-coloured triangles included.
+TEST(CaptureIsa, ShadedPassesGiveWhatTheScalarPathGives) {
+  if (detectedIsa() == Isa::Scalar) GTEST_SKIP() << "no AVX2 on this CPU: only the scalar path";
+  const IsaGuard guard;
+  Scene overridden = texturedScene(70);
+  overridden.alphaOverride = 0.45f;
+  const std::vector<std::pair<std::string, Scene>> scenes = {
+      {"textured", texturedScene(70)},
+      {"textured, alpha override", std::move(overridden)},
+      {"hairball", proceduralScene("hairball?strands=250")}};
+  for (const auto& [name, scene] : scenes) {
+    const Camera camera = scene.defaultCamera ? *scene.defaultCamera : test::screenCamera();
+    const auto frame = test::buildFrame(scene, camera, 70, 70, 2);
+    ASSERT_TRUE(frame) << name;
+    setActiveIsa(Isa::Scalar);
+    const std::vector<FeatureAccumulator> scalarFeatures = accumulateFeatures(*frame);
+    const std::vector<float> scalarCosine = nearestCosine(*frame);
+    setActiveIsa(detectedIsa());
+    const std::vector<FeatureAccumulator> wideFeatures = accumulateFeatures(*frame);
+    const std::vector<float> wideCosine = nearestCosine(*frame);
+    ASSERT_EQ(scalarFeatures.size(), wideFeatures.size());
+    uint64_t covered = 0;
+    ImageFeatureStats image;
+    for (const FeatureAccumulator& a : scalarFeatures) image.add(a);
+    for (size_t p = 0; p < scalarFeatures.size(); ++p) {
+      const FeatureAccumulator &a = scalarFeatures[p], &b = wideFeatures[p];
+      ASSERT_EQ(a.n, b.n) << name << " pixel " << p;
+      if (a.n == 0) continue;
+      ++covered;
+      EXPECT_EQ(a.nearest, b.nearest) << name << " pixel " << p;
+      EXPECT_EQ(a.second, b.second) << name << " pixel " << p;
+      EXPECT_EQ(a.farthest, b.farthest) << name << " pixel " << p;
+      EXPECT_TRUE(a.premultipliedSum == b.premultipliedSum) << name << " pixel " << p;
+      EXPECT_EQ(a.premultipliedSquares, b.premultipliedSquares) << name << " pixel " << p;
+      EXPECT_EQ(a.alphaSum, b.alphaSum) << name << " pixel " << p;
+      EXPECT_TRUE(pixelFeatures(a, image, 1000) == pixelFeatures(b, image, 1000)) << name;
+    }
+    EXPECT_GT(covered, 100u) << name;
+    EXPECT_TRUE(scalarCosine == wideCosine) << name << ": previous-frame cosines differ";
+    // the oracle's curves through k(p), then the (already compared) capture
+    const MethodDesc optimal = test::presetWithK("optimal", std::nullopt, Compositing::Hybrid);
+    const uint64_t budget = 70 * 70 * 60;
+    expectSameCapture(*frame, optimal, budget, name + " optimal");
   }
 }
 

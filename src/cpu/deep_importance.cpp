@@ -12,6 +12,7 @@
 #include "mfr/core/quote.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/learn/model_file.hpp"
+#include "shaded_fragments.hpp"
 
 namespace mfr {
 namespace {
@@ -60,15 +61,14 @@ std::vector<float> predictImportance(const RasterFrame& frame, const learn::Mode
     thread_local std::vector<int> covered;
     thread_local Eigen::MatrixXf inputs;
     local.assign(static_cast<size_t>(w) * h, FeatureAccumulator{});
-    frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
-                                           // row and column in the tile without an integer
-                                           // division: (d + 0.5) / width is exact enough
-                                           const uint32_t d = f.pixel - origin;
-                                           const uint32_t y =
-                                               static_cast<uint32_t>((d + 0.5) * inverseWidth);
-                                           const uint32_t x = d - y * frame.width();
-                                           local[y * w + x].add(f.depth, f.rgba);
-                                         }});
+    detail::forEachShadedFragment(frame, tile, [&](const Fragment& f) {
+      // row and column in the tile without an integer division: (d + 0.5) / width is exact
+      // enough
+      const uint32_t d = f.pixel - origin;
+      const uint32_t y = static_cast<uint32_t>((d + 0.5) * inverseWidth);
+      const uint32_t x = d - y * frame.width();
+      local[y * w + x].add(f.depth, f.rgba);
+    });
     // the tile's covered pixels, in row order, are one batch (the same for any thread count)
     covered.clear();
     for (int i = 0; i < w * h; ++i)
@@ -101,9 +101,9 @@ std::vector<float> predictImportance(const RasterFrame& frame, const learn::Mode
 std::vector<FeatureAccumulator> accumulateFeatures(const RasterFrame& frame) {
   std::vector<FeatureAccumulator> pixels(frame.pixelCount());
   frame.forEachTile([&](int tile) {
-    frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
-                                           pixels[f.pixel].addWithCurveInputs(f.depth, f.rgba);
-                                         }});
+    detail::forEachShadedFragment(frame, tile, [&](const Fragment& f) {
+      pixels[f.pixel].addWithCurveInputs(f.depth, f.rgba);
+    });
   });
   return pixels;
 }

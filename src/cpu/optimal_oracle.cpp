@@ -2,13 +2,13 @@
 // error curves.
 //
 // The curves are built tile by tile, without a count pass: each worker rasterizes one tile with
-// full shading into its scratch (local pixel, node) in arrival order, counts per pixel, groups the
-// nodes by pixel (a counting sort, which keeps each pixel's arrival order), sorts each pixel's
-// nodes and writes its curve and n(p). The nodes are exactly the A-buffer's (every fragment, the
-// same shading, makeNode) and their sorted order does not depend on the arrival order, so the
-// curves are those of a whole-frame A-buffer without its 8 bytes per fragment (twice, with the
-// kept copy) ever existing at once: the pre-pass holds n(p), the curves and one tile's nodes per
-// worker.
+// full shading (shaded_fragments.hpp: on 8 lanes with AVX2) into its scratch (local pixel, node) in
+// arrival order, counts per pixel, groups the nodes by pixel (a counting sort, which keeps each
+// pixel's arrival order), sorts each pixel's nodes and writes its curve and n(p). The nodes are
+// exactly the A-buffer's (every fragment, the same shading, makeNode) and their sorted order does
+// not depend on the arrival order, so the curves are those of a whole-frame A-buffer without its 8
+// bytes per fragment (twice, with the kept copy) ever existing at once: the pre-pass holds n(p),
+// the curves and one tile's nodes per worker.
 //
 // Memory: n(p) and the curves (8 bytes per fragment, a vector per pixel) are checked against the
 // limit as the tiles add their fragments, before each tile's curves are allocated. Once the sum
@@ -27,6 +27,7 @@
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/allocation.hpp"
 #include "mfr/method/optimal_allocation.hpp"
+#include "shaded_fragments.hpp"
 
 namespace mfr {
 
@@ -85,15 +86,14 @@ Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 ba
     thread_local std::vector<FragmentNode> arrived, nodes;
     local.clear();
     arrived.clear();
-    frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
-                                           // row and column in the tile without an integer
-                                           // division: (d + 0.5) / width is exact enough
-                                           const uint32_t d = f.pixel - origin;
-                                           const uint32_t y =
-                                               static_cast<uint32_t>((d + 0.5) * inverseWidth);
-                                           local.push_back(y * w + (d - y * frame.width()));
-                                           arrived.push_back(makeNode(f));
-                                         }});
+    detail::forEachShadedFragment(frame, tile, [&](const Fragment& f) {
+      // row and column in the tile without an integer division: (d + 0.5) / width is exact
+      // enough
+      const uint32_t d = f.pixel - origin;
+      const uint32_t y = static_cast<uint32_t>((d + 0.5) * inverseWidth);
+      local.push_back(y * w + (d - y * frame.width()));
+      arrived.push_back(makeNode(f));
+    });
     tileFragments[tile] = arrived.size();
     const uint64_t sum = fragments.fetch_add(arrived.size()) + arrived.size();
     if (needed(sum) > limit) {

@@ -29,11 +29,12 @@
 //   no slots (k == 0):    0           (nothing passes)
 // so "passes the early k+ test" is (depth bits < cull depth), one signed compare.
 //
-// A tile whose triangles all have untextured, non-masked materials takes the wide path (their
-// alpha test cannot reject, so testing before the surface is the scalar order; the base colour is
-// the material's, or for a vertex-coloured triangle the material's times the perspective-correct
-// colour, per lane in the scalar operation order); any other tile runs the scalar rasterizeTile
-// on the same sink.
+// A tile whose triangles all have non-masked materials blending "over" takes the wide path
+// (their alpha test cannot reject, so testing before the surface is the scalar order; the base
+// colour is the material's, times the texture sampled on the lanes (LaneTexture: bilinear or
+// nearest, every wrap mode, texels gathered and decoded by the sRGB table) and the
+// perspective-correct vertex colour, per lane in the scalar operation order); any other tile
+// runs the scalar rasterizeTile on the same sink.
 #pragma once
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -178,20 +179,129 @@ struct LaneShading {
   }
 };
 
-/// A vertex-coloured triangle's base colour on 8 lanes, as RasterFrame::surface computes it: the
-/// perspective-correct colour ((c0 l0 + c1 l1) + c2 l2) / ((1/w0 l0 + 1/w1 l1) + 1/w2 l2) times
-/// the material's colour and alpha (alpha 1 when opaque, the override when set: then constant),
-/// the alpha as packFragmentColor's byte.
+/// The integer texel coordinates (texelIndex, each axis then wrapTexel) of 8 lanes: lanes whose
+/// floored coordinate is finite, below 1e9 in magnitude and inside [0, n - 1 - extra] need no
+/// wrapping (the common case, all on lanes); otherwise every lane goes through the scalar
+/// functions.
+[[gnu::always_inline]] inline MFR_TARGET_AVX2 void wrapTexelLanes(__m256 floored, int n,
+                                                                  TextureWrap wrap, __m256i& i0,
+                                                                  __m256i* i1) {
+  const __m256 absMask = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  const __m256 inRange =
+      _mm256_cmp_ps(_mm256_and_ps(floored, absMask), _mm256_set1_ps(1e9f), _CMP_LT_OQ);
+  const __m256i index = _mm256_cvttps_epi32(floored);  // exact: floored, |f| < 1e9
+  const int last = n - 1 - (i1 != nullptr ? 1 : 0);
+  const __m256i inside =
+      _mm256_andnot_si256(_mm256_or_si256(_mm256_cmpgt_epi32(_mm256_setzero_si256(), index),
+                                          _mm256_cmpgt_epi32(index, _mm256_set1_epi32(last))),
+                          _mm256_castps_si256(inRange));
+  if (_mm256_movemask_ps(_mm256_castsi256_ps(inside)) == 0xff) {
+    i0 = index;
+    if (i1 != nullptr) i1[0] = _mm256_add_epi32(index, _mm256_set1_epi32(1));
+    return;
+  }
+  alignas(32) float f[8];
+  alignas(32) int32_t a[8], b[8];
+  _mm256_store_ps(f, floored);
+  const auto mode = static_cast<uint32_t>(wrap);
+  for (int lane = 0; lane < 8; ++lane) {
+    const int i = texelIndex(f[lane], n, wrap);
+    a[lane] = method_math::wrapTexel(i, n, mode);
+    b[lane] = method_math::wrapTexel(i + 1, n, mode);
+  }
+  i0 = _mm256_load_si256(reinterpret_cast<const __m256i*>(a));
+  if (i1 != nullptr) i1[0] = _mm256_load_si256(reinterpret_cast<const __m256i*>(b));
+}
+
+/// A texture sampled on 8 lanes, as detail::sampleTexture samples it (the same float operations
+/// in the same order: bilinear with texel centres at half-integers and glm::mix's x (1 - a) + y a,
+/// or nearest; texels decoded by the sRGB table, alpha times 1/255). The texels of the lanes in
+/// use are read one by one (a step shades one to eight lanes, and on Zen 3 a gather of 8 costs
+/// more than 8 loads), the filtering runs on the lanes.
+struct LaneTexture {
+  const uint8_t* rgba = nullptr;
+  const float* toLinear = nullptr;
+  int width = 0, height = 0;
+  TextureSampler sampler;
+
+  /// Texel (x[lane], y[lane]) of each lane set in `bits` into out[channel][lane].
+  [[gnu::always_inline]] void texels(const int32_t* x, const int32_t* y, uint32_t bits,
+                                     float (*out)[8]) const {
+    for (; bits != 0; bits &= bits - 1) {
+      const int lane = std::countr_zero(bits);
+      const uint8_t* p = rgba + (static_cast<size_t>(y[lane]) * width + x[lane]) * 4;
+      out[0][lane] = toLinear[p[0]];
+      out[1][lane] = toLinear[p[1]];
+      out[2][lane] = toLinear[p[2]];
+      out[3][lane] = static_cast<float>(p[3]) * (1.0f / 255.0f);
+    }
+  }
+
+  /// The linear RGBA of the lanes set in `bits` at texture coordinates (u, v) (the other lanes:
+  /// unspecified).
+  [[gnu::always_inline]] MFR_TARGET_AVX2 void sample(__m256 u, __m256 v, uint32_t bits,
+                                                     __m256* out) const {
+    const __m256 w = _mm256_set1_ps(static_cast<float>(width));
+    const __m256 h = _mm256_set1_ps(static_cast<float>(height));
+    alignas(32) int32_t x0[8], x1[8], y0[8], y1[8];
+    alignas(32) float t[4][4][8];  // corner (x0y0, x1y0, x0y1, x1y1), channel, lane (unused: unset)
+    __m256i a, b;
+    if (sampler.filter == TextureFilter::Nearest) {
+      wrapTexelLanes(_mm256_floor_ps(_mm256_mul_ps(u, w)), width, sampler.wrapS, a, nullptr);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(x0), a);
+      wrapTexelLanes(_mm256_floor_ps(_mm256_mul_ps(v, h)), height, sampler.wrapT, a, nullptr);
+      _mm256_store_si256(reinterpret_cast<__m256i*>(y0), a);
+      texels(x0, y0, bits, t[0]);
+      for (int ch = 0; ch < 4; ++ch) out[ch] = _mm256_load_ps(t[0][ch]);
+      return;
+    }
+    const __m256 half = _mm256_set1_ps(0.5f), one = _mm256_set1_ps(1.0f);
+    const __m256 fx = _mm256_sub_ps(_mm256_mul_ps(u, w), half);
+    const __m256 fy = _mm256_sub_ps(_mm256_mul_ps(v, h), half);
+    const __m256 flx = _mm256_floor_ps(fx), fly = _mm256_floor_ps(fy);
+    const __m256 ax = _mm256_sub_ps(fx, flx), ay = _mm256_sub_ps(fy, fly);
+    wrapTexelLanes(flx, width, sampler.wrapS, a, &b);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(x0), a);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(x1), b);
+    wrapTexelLanes(fly, height, sampler.wrapT, a, &b);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(y0), a);
+    _mm256_store_si256(reinterpret_cast<__m256i*>(y1), b);
+    texels(x0, y0, bits, t[0]);
+    texels(x1, y0, bits, t[1]);
+    texels(x0, y1, bits, t[2]);
+    texels(x1, y1, bits, t[3]);
+    const __m256 bx = _mm256_sub_ps(one, ax), by = _mm256_sub_ps(one, ay);
+    for (int ch = 0; ch < 4; ++ch) {
+      const __m256 top = _mm256_add_ps(_mm256_mul_ps(_mm256_load_ps(t[0][ch]), bx),
+                                       _mm256_mul_ps(_mm256_load_ps(t[1][ch]), ax));
+      const __m256 bottom = _mm256_add_ps(_mm256_mul_ps(_mm256_load_ps(t[2][ch]), bx),
+                                          _mm256_mul_ps(_mm256_load_ps(t[3][ch]), ax));
+      out[ch] = _mm256_add_ps(_mm256_mul_ps(top, by), _mm256_mul_ps(bottom, ay));
+    }
+  }
+};
+
+/// A textured, vertex-coloured or alpha-masked triangle's base colour on 8 lanes, as
+/// RasterFrame::surface computes it: the material's colour and alpha, times the texture sampled
+/// at the perspective-correct uv (uvW interpolated, times 1 / ((1/w0 l0 + 1/w1 l1) + 1/w2 l2)),
+/// times the perspective-correct vertex colour ((c0 l0 + c1 l1) + c2 l2) / q. A masked material's
+/// lanes pass the alpha test when that alpha is not below the cutoff (NaN passes, as in the scalar
+/// test); their alpha is then 1, and the override when set. The alpha as packFragmentColor's byte.
 struct LaneColors {
   __m256 invW0, invW1, invW2;
-  __m256 c[3][4];  // vertex i's colour / w, channel
-  __m256 materialR, materialG, materialB, materialA;
-  bool alphaVaries;
+  __m256 c[3][4];   // vertex i's colour / w, channel (hasColor)
+  __m256 uv[3][2];  // vertex i's uv / w (texture)
+  __m256 materialR, materialG, materialB, materialA, cutoff;
+  const LaneTexture* texture;
+  bool hasColor;
+  bool masked;       // AlphaMode::Mask: alphaTest() before the early tests
+  bool alphaVaries;  // blended and not overridden: the alpha byte per lane
   __m256i constantAlpha;
 
   [[gnu::always_inline]] MFR_TARGET_AVX2 LaneColors(const TriangleSetup& t,
-                                                    const TriangleColors& colors,
-                                                    const ShadeMaterial& m, uint32_t alphaByte)
+                                                    const TriangleColors* colors,
+                                                    const LaneTexture* tex, const ShadeMaterial& m,
+                                                    uint32_t alphaByte)
       : invW0(_mm256_set1_ps(t.invW[0])),
         invW1(_mm256_set1_ps(t.invW[1])),
         invW2(_mm256_set1_ps(t.invW[2])),
@@ -199,40 +309,77 @@ struct LaneColors {
         materialG(_mm256_set1_ps(m.color.g)),
         materialB(_mm256_set1_ps(m.color.b)),
         materialA(_mm256_set1_ps(m.alpha)),
-        alphaVaries(m.mode != AlphaMode::Opaque && !m.alphaOverridden),
+        cutoff(_mm256_set1_ps(m.cutoff)),
+        texture(tex),
+        hasColor(colors != nullptr),
+        masked(m.mode == AlphaMode::Mask),
+        alphaVaries(m.mode == AlphaMode::Blend && !m.alphaOverridden),
         constantAlpha(_mm256_set1_epi32(static_cast<int>(alphaByte))) {
-    for (int i = 0; i < 3; ++i)
-      for (int ch = 0; ch < 4; ++ch) c[i][ch] = _mm256_set1_ps(colors.colorW[i][ch]);
+    for (int i = 0; i < 3; ++i) {
+      for (int ch = 0; ch < 4; ++ch)
+        c[i][ch] = _mm256_set1_ps(colors != nullptr ? colors->colorW[i][ch] : 0.0f);
+      uv[i][0] = _mm256_set1_ps(t.uvW[i].x);
+      uv[i][1] = _mm256_set1_ps(t.uvW[i].y);
+    }
   }
 
-  /// Channel `ch` of the perspective-correct colour.
-  [[gnu::always_inline]] MFR_TARGET_AVX2 __m256 channel(int ch, __m256 l0, __m256 l1, __m256 l2,
-                                                        __m256 invQ) const {
-    const __m256 sum =
-        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(c[0][ch], l0), _mm256_mul_ps(c[1][ch], l1)),
-                      _mm256_mul_ps(c[2][ch], l2));
-    return _mm256_mul_ps(sum, invQ);
+  /// (v0 l0 + v1 l1) + v2 l2 of per-vertex lanes v.
+  [[gnu::always_inline]] static MFR_TARGET_AVX2 __m256 interpolate(__m256 v0, __m256 v1, __m256 v2,
+                                                                   __m256 l0, __m256 l1,
+                                                                   __m256 l2) {
+    return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(v0, l0), _mm256_mul_ps(v1, l1)),
+                         _mm256_mul_ps(v2, l2));
   }
 
-  /// The base colour (r, g, b) and alpha word of the lanes at barycentrics (l1, l2).
-  [[gnu::always_inline]] MFR_TARGET_AVX2 void base(__m256 l1, __m256 l2, __m256& r, __m256& g,
-                                                   __m256& b, __m256i& alphaWord) const {
+  /// RasterFrame::surface's base colour and alpha (before the mask's and the override's alpha)
+  /// of the lanes at barycentrics (l1, l2); texture samples are read for the lanes in `bits` only.
+  [[gnu::always_inline]] MFR_TARGET_AVX2 void surface(__m256 l1, __m256 l2, uint32_t bits,
+                                                      __m256* rgba) const {
     const __m256 one = _mm256_set1_ps(1.0f);
     const __m256 l0 = _mm256_sub_ps(_mm256_sub_ps(one, l1), l2);
-    const __m256 q =
-        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(invW0, l0), _mm256_mul_ps(invW1, l1)),
-                      _mm256_mul_ps(invW2, l2));
-    const __m256 invQ = _mm256_div_ps(one, q);
-    r = _mm256_mul_ps(materialR, channel(0, l0, l1, l2, invQ));
-    g = _mm256_mul_ps(materialG, channel(1, l0, l1, l2, invQ));
-    b = _mm256_mul_ps(materialB, channel(2, l0, l1, l2, invQ));
+    const __m256 invQ = _mm256_div_ps(one, interpolate(invW0, invW1, invW2, l0, l1, l2));
+    rgba[0] = materialR;
+    rgba[1] = materialG;
+    rgba[2] = materialB;
+    rgba[3] = materialA;
+    if (texture != nullptr) {
+      __m256 s[4];
+      texture->sample(_mm256_mul_ps(interpolate(uv[0][0], uv[1][0], uv[2][0], l0, l1, l2), invQ),
+                      _mm256_mul_ps(interpolate(uv[0][1], uv[1][1], uv[2][1], l0, l1, l2), invQ),
+                      bits, s);
+      for (int ch = 0; ch < 4; ++ch) rgba[ch] = _mm256_mul_ps(rgba[ch], s[ch]);
+    }
+    if (hasColor)
+      for (int ch = 0; ch < 4; ++ch)
+        rgba[ch] = _mm256_mul_ps(
+            rgba[ch], _mm256_mul_ps(interpolate(c[0][ch], c[1][ch], c[2][ch], l0, l1, l2), invQ));
+  }
+
+  /// The lanes of `bits` that pass a masked material's alpha test (alpha not below the cutoff).
+  [[gnu::always_inline]] MFR_TARGET_AVX2 uint32_t alphaTest(__m256 l1, __m256 l2,
+                                                            uint32_t bits) const {
+    __m256 rgba[4];
+    surface(l1, l2, bits, rgba);
+    return bits &
+           ~static_cast<uint32_t>(_mm256_movemask_ps(_mm256_cmp_ps(rgba[3], cutoff, _CMP_LT_OQ)));
+  }
+
+  /// The base colour (r, g, b) and alpha word of the lanes at barycentrics (l1, l2) (texture
+  /// samples are read for the lanes set in `bits` only).
+  [[gnu::always_inline]] MFR_TARGET_AVX2 void base(__m256 l1, __m256 l2, uint32_t bits, __m256& r,
+                                                   __m256& g, __m256& b, __m256i& alphaWord) const {
+    __m256 rgba[4];
+    surface(l1, l2, bits, rgba);
+    r = rgba[0];
+    g = rgba[1];
+    b = rgba[2];
     if (!alphaVaries) {
       alphaWord = constantAlpha;
       return;
     }
     // packFragmentColor's alpha: min(max(a, 0), 1) (NaN -> 0), * 255 + 0.5, truncated, << 24
-    const __m256 a = _mm256_mul_ps(materialA, channel(3, l0, l1, l2, invQ));
-    const __m256 clamped = _mm256_min_ps(_mm256_max_ps(a, _mm256_setzero_ps()), one);
+    const __m256 clamped =
+        _mm256_min_ps(_mm256_max_ps(rgba[3], _mm256_setzero_ps()), _mm256_set1_ps(1.0f));
     alphaWord = _mm256_slli_epi32(
         _mm256_cvttps_epi32(
             _mm256_add_ps(_mm256_mul_ps(clamped, _mm256_set1_ps(255.0f)), _mm256_set1_ps(0.5f))),
@@ -319,7 +466,7 @@ template <bool Colored, bool OneRow, class Sink>
   if constexpr (Colored) {
     __m256 r, g, b;
     __m256i alphaWord;
-    colors->base(l1, l2, r, g, b, alphaWord);
+    colors->base(l1, l2, bits, r, g, b, alphaWord);
     rgba = shading.shadeBase(*in.tables, l1, l2, px, dy, dySquared, ndotv, r, g, b, alphaWord);
   } else {
     (void)colors;
@@ -418,12 +565,20 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
   // (w1lo .. w2hi); the passing lanes go to `pending`, 8 of them at a time to shading.
   auto lanes = [&](int x, int y, uint32_t covered, __m256d w1lo, __m256d w1hi, __m256d w2lo,
                    __m256d w2hi, int32_t* cull) __attribute__((target("avx2"), always_inline)) {
-    const __m256i valid = _mm256_cmpeq_epi32(
-        _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(covered)), laneBit), laneBit);
     const __m256 w1 = _mm256_set_m128(_mm256_cvtpd_ps(w1hi), _mm256_cvtpd_ps(w1lo));
     const __m256 w2 = _mm256_set_m128(_mm256_cvtpd_ps(w2hi), _mm256_cvtpd_ps(w2lo));
     const __m256 l1 = _mm256_mul_ps(w1, invArea);
     const __m256 l2 = _mm256_mul_ps(w2, invArea);
+    if constexpr (Colored) {
+      // a masked material's alpha test comes first, as in the scalar loop: a lane it rejects is
+      // no fragment (not generated, never tested)
+      if (colors->masked) {
+        covered = colors->alphaTest(l1, l2, covered);
+        if (covered == 0) return;
+      }
+    }
+    const __m256i valid = _mm256_cmpeq_epi32(
+        _mm256_and_si256(_mm256_set1_epi32(static_cast<int>(covered)), laneBit), laneBit);
     const __m256 z =
         _mm256_add_ps(_mm256_add_ps(z0v, _mm256_mul_ps(l1, dz1v)), _mm256_mul_ps(l2, dz2v));
     // z > 0 ? min(z, 1) : 0 (NaN -> 0): max returns its second operand on NaN and on +-0
@@ -533,6 +688,14 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
   }
 }
 
+/// How many triangles ahead rasterizeTileAvx2 prefetches set-ups.
+inline constexpr int kPrefetchAhead = 4;
+[[gnu::always_inline]] inline void prefetchSetup(const TriangleSetup& t) {
+  const char* p = reinterpret_cast<const char*>(&t);
+  for (size_t line = 0; line < sizeof(TriangleSetup); line += 64) __builtin_prefetch(p + line);
+  __builtin_prefetch(p + sizeof(TriangleSetup) - 1);
+}
+
 /// The capture pass over one tile: rasterizeTile<ShadeMode::Full> on 8 lanes, with the lane
 /// protocol of `sink` (beginTile, cullDepthRow, countEarly / acceptLane, emitLane) and its scalar
 /// protocol (accept, emit) for the tiles the lanes do not take.
@@ -540,29 +703,45 @@ template <class Sink>
 MFR_TARGET_AVX2 void rasterizeTileAvx2(const RasterFrame& frame, const ShadingInputs& in, int tile,
                                        Sink& sink) {
   const TileRect r = frame.tileRect(tile);
-  for (const uint32_t* it = frame.tileBegin(tile); it != frame.tileEnd(tile); ++it) {
+  const uint32_t* end = frame.tileEnd(tile);
+  for (const uint32_t* it = frame.tileBegin(tile); it != end; ++it) {
+    // the set-ups are scattered in memory (a tile's triangles are a sparse subset): start
+    // loading the ones a few triangles ahead (each spans three cache lines)
+    if (end - it > kPrefetchAhead) prefetchSetup(frame.setups()[it[kPrefetchAhead]]);
     const TriangleSetup& t = frame.setups()[*it];
     const ShadeMaterial& m = (*in.materials)[t.material];
-    if (m.texture != nullptr || m.mode == AlphaMode::Mask || m.blend != BlendMode::Over) {
+    if (m.blend != BlendMode::Over) {
       frame.rasterizeTile<ShadeMode::Full>(tile, sink);  // no cull depths: all scalar
       return;
     }
   }
   sink.beginTile(r, frame.tileSize());
   PendingLanes pending;
-  for (const uint32_t* it = frame.tileBegin(tile); it != frame.tileEnd(tile); ++it) {
+  for (const uint32_t* it = frame.tileBegin(tile); it != end; ++it) {
+    if (end - it > kPrefetchAhead) prefetchSetup(frame.setups()[it[kPrefetchAhead]]);
     const TriangleSetup& t = frame.setups()[*it];
-    // the base colour (untextured and not masked: RasterFrame::surface gives the material's
-    // colour and alpha, 1 when opaque, the override when set) and its alpha byte
+    // the base colour of an untextured, uncoloured triangle (RasterFrame::surface gives the
+    // material's colour and alpha, 1 when opaque, the override when set) and its alpha byte
     const ShadeMaterial& material = (*in.materials)[t.material];
     glm::vec4 base(material.color, material.alpha);
-    if (material.mode == AlphaMode::Opaque) base.a = 1.0f;
+    if (material.mode != AlphaMode::Blend) base.a = 1.0f;  // opaque, or masked and passing
     if (material.alphaOverridden) base.a = material.overrideAlpha;
     const uint32_t alphaByte = alphaWordOf(base.a);
     const LaneShading shading(in, t, base, alphaByte);
-    if (t.hasColor) {
-      // vertex colours: the base colour and alpha per lane (RasterFrame::surface's order)
-      const LaneColors colors(t, frame.vertexColors(*it), material, alphaByte);
+    if (t.hasColor || material.texture != nullptr || material.mode == AlphaMode::Mask) {
+      // a texture or vertex colours: the base colour and alpha per lane (RasterFrame::surface's
+      // order)
+      LaneTexture texture;
+      if (material.texture != nullptr) {
+        texture.rgba = material.texture->rgba.data();
+        texture.toLinear = in.tables->srgb8ToLinear.data();
+        texture.width = material.texture->width;
+        texture.height = material.texture->height;
+        texture.sampler = material.sampler;
+      }
+      const LaneColors colors(t, t.hasColor ? &frame.vertexColors(*it) : nullptr,
+                              material.texture != nullptr ? &texture : nullptr, material,
+                              alphaByte);
       rasterizeRectAvx2<true>(frame, in, t, r, shading, &colors, pending, sink);
     } else {
       rasterizeRectAvx2<false>(frame, in, t, r, shading, nullptr, pending, sink);

@@ -23,6 +23,7 @@
 #include "mfr/method/optimal_allocation.hpp"
 #include "mfr/method/pass_plan.hpp"
 #include "pipeline.hpp"
+#include "shaded_fragments.hpp"
 #include "sort_nodes.hpp"
 
 namespace mfr {
@@ -107,13 +108,13 @@ std::vector<float> nearestCosine(const RasterFrame& frame) {
   std::vector<FragmentNode> nearest(frame.pixelCount(), kFarNode);
   std::vector<float> cosine(frame.pixelCount(), 0.0f);
   frame.forEachTile([&](int tile) {
-    frame.rasterizeTile<ShadeMode::Full>(tile, EmitAll{[&](const Fragment& f) {
-                                           const FragmentNode node = makeNode(f);
-                                           if (node < nearest[f.pixel]) {
-                                             nearest[f.pixel] = node;
-                                             cosine[f.pixel] = std::fabs(f.ndotv);
-                                           }
-                                         }});
+    detail::forEachShadedFragment(frame, tile, [&](const Fragment& f) {
+      const FragmentNode node = makeNode(f);
+      if (node < nearest[f.pixel]) {
+        nearest[f.pixel] = node;
+        cosine[f.pixel] = std::fabs(f.ndotv);
+      }
+    });
   });
   // the previous-frame buffer keeps |n.v| as unorm8 (1 byte per pixel in the memory model)
   for (float& c : cosine) c = static_cast<float>(unorm8(c)) / 255.0f;
