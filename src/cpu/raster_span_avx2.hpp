@@ -688,14 +688,6 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
   }
 }
 
-/// How many triangles ahead rasterizeTileAvx2 prefetches set-ups.
-inline constexpr int kPrefetchAhead = 4;
-[[gnu::always_inline]] inline void prefetchSetup(const TriangleSetup& t) {
-  const char* p = reinterpret_cast<const char*>(&t);
-  for (size_t line = 0; line < sizeof(TriangleSetup); line += 64) __builtin_prefetch(p + line);
-  __builtin_prefetch(p + sizeof(TriangleSetup) - 1);
-}
-
 /// The capture pass over one tile: rasterizeTile<ShadeMode::Full> on 8 lanes, with the lane
 /// protocol of `sink` (beginTile, cullDepthRow, countEarly / acceptLane, emitLane) and its scalar
 /// protocol (accept, emit) for the tiles the lanes do not take.
@@ -705,8 +697,7 @@ MFR_TARGET_AVX2 void rasterizeTileAvx2(const RasterFrame& frame, const ShadingIn
   const TileRect r = frame.tileRect(tile);
   const uint32_t* end = frame.tileEnd(tile);
   for (const uint32_t* it = frame.tileBegin(tile); it != end; ++it) {
-    // the set-ups are scattered in memory (a tile's triangles are a sparse subset): start
-    // loading the ones a few triangles ahead (each spans three cache lines)
+    // (the set-ups a few triangles ahead: raster_frame_impl.hpp's prefetchSetup)
     if (end - it > kPrefetchAhead) prefetchSetup(frame.setups()[it[kPrefetchAhead]]);
     const TriangleSetup& t = frame.setups()[*it];
     const ShadeMaterial& m = (*in.materials)[t.material];

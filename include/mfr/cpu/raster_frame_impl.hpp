@@ -47,6 +47,17 @@ void RasterFrame::forEachTile(Fn&& fn) const {
 }
 
 namespace detail {
+/// The tile passes walk a tile's triangles in binning order, and their set-ups are scattered in
+/// memory (a tile's triangles are a sparse subset of the frame's): each pass starts loading the
+/// set-up kPrefetchAhead triangles ahead (about 10% off the capture of the dragon's and the
+/// hairball's small triangles, measured 2026-12-05).
+inline constexpr int kPrefetchAhead = 4;
+[[gnu::always_inline]] inline void prefetchSetup(const TriangleSetup& t) {
+  const char* p = reinterpret_cast<const char*>(&t);
+  for (size_t line = 0; line < sizeof(TriangleSetup); line += 64) __builtin_prefetch(p + line);
+  __builtin_prefetch(p + sizeof(TriangleSetup) - 1);
+}
+
 // Integer quotients for the row spans. A double division gives the quotient to within one (the
 // operands stay below 2^51), an exact integer check fixes it: much cheaper than a 64-bit idiv.
 inline int64_t floorDivPositive(int64_t a, int64_t b) {  // a >= 0, b > 0
@@ -230,8 +241,12 @@ inline void RasterFrame::rasterizeRect(const TriangleSetup& t, int x0, int y0, i
 template <ShadeMode Mode, class Sink>
 void RasterFrame::rasterizeTile(int tile, Sink&& sink) const {
   const TileRect r = tileRect(tile);
-  for (const uint32_t* it = tileBegin(tile); it != tileEnd(tile); ++it)
+  const uint32_t* end = tileEnd(tile);
+  for (const uint32_t* it = tileBegin(tile); it != end; ++it) {
+    if (end - it > detail::kPrefetchAhead)
+      detail::prefetchSetup(setups_[it[detail::kPrefetchAhead]]);
     rasterizeRect<Mode>(setups_[*it], r.x0, r.y0, r.x1, r.y1, sink);
+  }
 }
 
 template <ShadeMode Mode, class Sink>
