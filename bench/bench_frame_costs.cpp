@@ -13,17 +13,22 @@
 //   passes   the render's own passes (allocate, clear, capture, resolve)
 //   frame    the passes' sum, what the statistics call the frame (set-up excluded: it is shown
 //            on its own, and "with set-up" ratios beside)
-// and the capture rate (fragments generated / capture time).
+// and the capture rate (fragments generated / capture time). Each case renders through its own
+// FrameBuffers (mfr/cpu/frame_buffers.hpp), as CpuEngine does: from the second round on, a frame
+// reuses the previous one's node pool and per-pixel stores (a GPU renderer's steady state; a
+// single `mfr render` allocates them, and first-touches them, once).
 //
 // Goals checked (printed per row): hairball capture >= 150 M fragments/s; the real meshes' frame
 // <= 3x their count pass; the almost empty view's frame < 10 ms. CSV: frame_costs.csv.
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "bench_common.hpp"
+#include "mfr/cpu/frame_buffers.hpp"
 
 namespace {
 
@@ -70,7 +75,8 @@ struct Measured {
   RasterFrame frame;
   Case c;
   std::vector<double> setupMs, countMs;
-  uint64_t counted = 0;  // fragments the count pass saw: must equal the capture's
+  uint64_t counted = 0;                   // fragments the count pass saw: must equal the capture's
+  std::unique_ptr<FrameBuffers> buffers;  // kept from frame to frame, as CpuEngine keeps them
 };
 
 std::string scenePath(const char* relative) {
@@ -136,9 +142,21 @@ int main(int argc, char** argv) {
     c.method = methodPreset("kplus-heap").value();
     c.method.k = 8;
     c.method.compositing = w.compositing;
-    cases.push_back({&w, scene, camera, raster, std::move(built.value()), std::move(c), {}, {}});
+    cases.push_back({&w,
+                     scene,
+                     camera,
+                     raster,
+                     std::move(built.value()),
+                     std::move(c),
+                     {},
+                     {},
+                     0,
+                     std::make_unique<FrameBuffers>()});
   }
-  for (Measured& m : cases) m.c.frame = &m.frame;  // the vector no longer moves
+  for (Measured& m : cases) {  // the vector no longer moves
+    m.c.frame = &m.frame;
+    m.c.options.reuse = m.buffers.get();
+  }
 
   // interleaved rounds: per case, a fresh set-up (timed, then dropped), the count pass, the render
   std::fflush(stdout);

@@ -4,6 +4,7 @@
 // then the only one; the ctest entry CaptureScalarPath runs the capture tests with MFR_ISA=scalar).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -12,6 +13,7 @@
 #include <random>
 
 #include "cpu/max_heap_replace.hpp"
+#include "cpu/raster_span_avx2.hpp"
 #include "mfr/core/isa.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/fragment_stores.hpp"
@@ -242,6 +244,54 @@ TEST(CaptureIsa, ShadedPassesGiveWhatTheScalarPathGives) {
     const uint64_t budget = 70 * 70 * 60;
     expectSameCapture(*frame, optimal, budget, name + " optimal");
   }
+}
+
+#if MFR_HAS_AVX2_KERNELS
+/// encodeSrgb8x8 of 8 values (compiled for AVX2, called only where the CPU has it).
+__attribute__((target("avx2"))) void encodeLanes(const float* v, int32_t* out) {
+  _mm256_storeu_si256(reinterpret_cast<__m256i*>(out),
+                      detail::encodeSrgb8x8(ColorTables::get(), _mm256_loadu_ps(v)));
+}
+#endif
+
+// The lanes' sRGB encode (two gathers) gives the scalar encode's code: for the 64 floats on each
+// side of every code boundary and of every bucket edge, on a sweep of [0, 1] and outside it.
+TEST(CaptureIsa, LaneSrgbEncodeIsTheScalarEncode) {
+#if MFR_HAS_AVX2_KERNELS
+  if (detectedIsa() == Isa::Scalar) GTEST_SKIP() << "no AVX2 on this CPU: only the scalar path";
+  std::vector<float> values = {-1.0f,
+                               -0.0f,
+                               0.0f,
+                               1.0f,
+                               2.0f,
+                               std::numeric_limits<float>::quiet_NaN(),
+                               std::numeric_limits<float>::infinity(),
+                               -std::numeric_limits<float>::infinity()};
+  const auto around = [&](float x) {
+    float below = x, above = x;
+    for (int i = 0; i < 64; ++i) {
+      values.push_back(below = std::nextafter(below, -1.0f));
+      values.push_back(above = std::nextafter(above, 2.0f));
+    }
+  };
+  const ColorTables& t = ColorTables::get();
+  for (int c = 1; c < 256; ++c) around(t.lowerBound[c]);
+  for (int b = 0; b < 4096; ++b) around((static_cast<float>(b) - 0.5f) / 4095.0f);
+  for (int i = 0; i <= 200000; ++i) values.push_back(static_cast<float>(i) / 200000.0f);
+  while (values.size() % 8 != 0) values.push_back(0.5f);
+  int mismatches = 0;
+  for (size_t i = 0; i < values.size(); i += 8) {
+    int32_t codes[8];
+    encodeLanes(values.data() + i, codes);
+    for (int lane = 0; lane < 8; ++lane)
+      if (codes[lane] != encodeSrgb8(values[i + lane]) && ++mismatches <= 5)
+        ADD_FAILURE() << values[i + lane] << ": lanes " << codes[lane] << ", scalar "
+                      << int{encodeSrgb8(values[i + lane])};
+  }
+  EXPECT_EQ(mismatches, 0) << "of " << values.size() << " values";
+#else
+  GTEST_SKIP() << "no AVX2 kernels in this build";
+#endif
 }
 
 // The branchless root replacement leaves every slot as maxHeapInsert does, on heaps of every size

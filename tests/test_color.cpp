@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "mfr/core/color.hpp"
@@ -34,6 +35,40 @@ TEST(Color, FastSrgbEncodeIsExactAtEveryCodeBoundary) {
     const float above = std::nextafter(static_cast<float>(boundary), 1.0f);
     EXPECT_EQ(encodeSrgb8(below), referenceEncode(below)) << c;
     EXPECT_EQ(encodeSrgb8(above), referenceEncode(above)) << c;
+  }
+}
+
+// The 8-lane encode's guess (ColorTables::bucketLowSrgb8) is the code of its bucket's smallest
+// input and at most one below the code of any input of the bucket, so one upward correction makes
+// it exact: checked on every bucket's smallest and largest input, found by bisection over the
+// float bits with the encode's own bucket arithmetic.
+TEST(Color, BucketGuessIsAtMostOneBelowEveryInputOfItsBucket) {
+  const ColorTables& t = ColorTables::get();
+  const auto bucketOf = [](float c) { return static_cast<int32_t>(c * 4095.0f + 0.5f); };
+  const auto firstWithBucketAtLeast = [&](int b) {  // float bits in [0, 1]
+    uint32_t lo = 0, hi = 0x3f800000u;
+    if (bucketOf(1.0f) < b) return hi + 1;
+    while (lo < hi) {
+      const uint32_t mid = lo + (hi - lo) / 2;
+      float c;
+      std::memcpy(&c, &mid, sizeof c);
+      (bucketOf(c) >= b ? hi : lo) = bucketOf(c) >= b ? mid : mid + 1;
+    }
+    return lo;
+  };
+  for (int b = 0; b < 4096; ++b) {
+    const uint32_t first = firstWithBucketAtLeast(b), next = firstWithBucketAtLeast(b + 1);
+    ASSERT_LT(first, next) << "bucket " << b << " is empty";
+    float smallest, largest;
+    const uint32_t last = next - 1;
+    std::memcpy(&smallest, &first, sizeof smallest);
+    std::memcpy(&largest, &last, sizeof largest);
+    ASSERT_EQ(bucketOf(smallest), b);
+    ASSERT_EQ(bucketOf(largest), b);
+    EXPECT_EQ(t.bucketLowSrgb8[b], referenceEncode(smallest)) << "bucket " << b;
+    const int spread = referenceEncode(largest) - t.bucketLowSrgb8[b];
+    EXPECT_TRUE(spread == 0 || spread == 1)
+        << "bucket " << b << " spans " << spread + 1 << " codes";
   }
 }
 

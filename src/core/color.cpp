@@ -1,6 +1,7 @@
 #include "mfr/core/color.hpp"
 
 #include <cmath>
+#include <cstring>
 
 namespace mfr {
 
@@ -29,6 +30,25 @@ ColorTables ColorTables::build() {
     t.lowerBound[c] = f;
   }
   t.lowerBound[256] = 2.0f;  // above any clamped input
+  // per bucket, the smallest input in [0, 1] whose bucket (the encode's float operations) is it,
+  // by bisection over the float bits (the bucket grows with the input), and its exact code
+  const auto bucketOf = [](float c) { return static_cast<int32_t>(c * 4095.0f + 0.5f); };
+  for (int b = 0; b < 4096; ++b) {
+    uint32_t lo = 0, hi = 0x3f800000u;  // the bits of 0 and 1
+    while (lo < hi) {
+      const uint32_t mid = lo + (hi - lo) / 2;
+      float c;
+      std::memcpy(&c, &mid, sizeof c);
+      if (bucketOf(c) >= b) {
+        hi = mid;
+      } else {
+        lo = mid + 1;
+      }
+    }
+    float c;
+    std::memcpy(&c, &lo, sizeof c);
+    t.bucketLowSrgb8[b] = encodeSrgb8(t, c);
+  }
   return t;
 }
 

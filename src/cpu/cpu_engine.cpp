@@ -41,7 +41,9 @@ Result<RenderOutput> CpuEngine::render(const PreparedView& view, const MethodDes
                                        const RenderOptions& options) {
   auto frame = cpuFrame(view);
   if (!frame) return frame.error();
-  auto out = mfr::render(**frame, method, options);
+  RenderOptions reusing = options;
+  if (!reusing.reuse) reusing.reuse = buffers_.get();
+  auto out = mfr::render(**frame, method, reusing);
   if (out) {
     out->stats.engine = "cpu";
     out->stats.engineCounters["threads"] = (*frame)->threads();

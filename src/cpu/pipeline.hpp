@@ -65,12 +65,19 @@ struct CaptureCounters {
 
 /// Fixed-size array that is not zero-filled on allocation: the node pool is written before it is
 /// read (slots at and above a pixel's count are never read), so clearing it would only cost time.
+/// A buffer reused from an earlier frame (FrameBuffers) keeps its block when it holds n and is
+/// not more than twice as large.
 template <class T>
 class UninitializedBuffer {
  public:
   void allocate(size_t n) {
+    if (n <= capacity_ && capacity_ <= 2 * n) {
+      size_ = n;
+      return;
+    }
+    data_.reset();
     data_.reset(n ? new T[n] : nullptr);
-    size_ = n;
+    size_ = capacity_ = n;
   }
   T* data() { return data_.get(); }
   const T* data() const { return data_.get(); }
@@ -79,6 +86,7 @@ class UninitializedBuffer {
  private:
   std::unique_ptr<T[]> data_;
   size_t size_ = 0;
+  size_t capacity_ = 0;
 };
 
 /// Fixed-size array of zero bytes from calloc: a large one comes as fresh pages the kernel zeroes
@@ -143,6 +151,7 @@ struct Stores {
   bool peerHoldsNodes = false;     // the peer buffer holds nodes (mlab), not accumulators
   std::vector<uint32_t> heads;     // linked lists: each pixel's newest node (kListEnd: none)
   UninitializedBuffer<LinkedNode> pool;  // linked lists: the node pool
+  Allocation spare;  // an earlier frame's offsets and store kinds, for allocate() to take over
 };
 
 /// The instruction set capture() runs this method on (what the statistics report as "isa").

@@ -61,23 +61,23 @@ inline int32_t cullDepthOf(const FragmentNode* slots, uint32_t count, uint32_t c
   return static_cast<int32_t>((max >> 32) + ((max & 0xffffffffu) != 0 ? 1 : 0));
 }
 
-/// The sRGB codes of 8 linear values, as packFragmentColor computes each: clamp (NaN -> 0), the
-/// coarse guess from the 4096-entry table, the fix-up against the exact code boundaries.
+/// The sRGB codes of 8 linear values, the codes packFragmentColor computes: clamp (NaN -> 0),
+/// the code of the smallest input of the value's bucket round(c * 4095) (bucketLowSrgb8), one
+/// more when c reaches the next code's exact lower bound. Two gathers (the scalar encode's guess
+/// may be one too high or too low and needs three).
 [[gnu::always_inline]] inline MFR_TARGET_AVX2 __m256i encodeSrgb8x8(const ColorTables& tables,
                                                                     __m256 v) {
-  const int* coarse = reinterpret_cast<const int*>(tables.coarseSrgb8.data());
+  const int* low = reinterpret_cast<const int*>(tables.bucketLowSrgb8.data());
   const float* lowerBound = tables.lowerBound.data();
   const __m256 c = _mm256_min_ps(_mm256_max_ps(v, _mm256_setzero_ps()), _mm256_set1_ps(1.0f));
   const __m256i index = _mm256_cvttps_epi32(
       _mm256_add_ps(_mm256_mul_ps(c, _mm256_set1_ps(4095.0f)), _mm256_set1_ps(0.5f)));
   // 4-byte gathers of the byte table (the last index reads into lowerBound, in the same struct)
-  __m256i code =
-      _mm256_and_si256(_mm256_i32gather_epi32(coarse, index, 1), _mm256_set1_epi32(0xff));
+  const __m256i code =
+      _mm256_and_si256(_mm256_i32gather_epi32(low, index, 1), _mm256_set1_epi32(0xff));
   const __m256 above =
       _mm256_i32gather_ps(lowerBound, _mm256_add_epi32(code, _mm256_set1_epi32(1)), 4);
-  code = _mm256_sub_epi32(code, _mm256_castps_si256(_mm256_cmp_ps(c, above, _CMP_GE_OQ)));
-  const __m256 below = _mm256_i32gather_ps(lowerBound, code, 4);
-  return _mm256_add_epi32(code, _mm256_castps_si256(_mm256_cmp_ps(c, below, _CMP_LT_OQ)));
+  return _mm256_sub_epi32(code, _mm256_castps_si256(_mm256_cmp_ps(c, above, _CMP_GE_OQ)));
 }
 
 /// The pixels [xs, xe] of a row whose three edge values (row[i] at x0, stepping stepX[i]) are

@@ -17,6 +17,7 @@
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/dkb_curve_pass.hpp"
+#include "mfr/cpu/frame_buffers.hpp"
 #include "mfr/cpu/optimal_oracle.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/blend_support.hpp"
@@ -287,20 +288,33 @@ Result<void> checkNodePool(const RasterFrame& frame, const MethodDesc& method,
                          " fragment slots and buffers");
 }
 
+/// `n` copies of `value` in `v`, which keeps its block (from an earlier frame, FrameBuffers) only
+/// when that holds exactly n: the ledger counts capacities, as for a fresh render. n = 0 frees it.
+template <class T>
+void assignExact(std::vector<T>& v, size_t n, const T& value) {
+  if (v.capacity() != n) std::vector<T>().swap(v);
+  v.assign(n, value);
+}
+
 /// The stores the capture fills: nodes (or the peer method's buffer), counters, locks, tails.
+/// `stores` may hold an earlier frame's buffers (FrameBuffers): each is sized and cleared for this
+/// frame, and those this method does not use are freed.
 void clearStores(const MethodDesc& method, const RenderOptions& options, const Allocation& alloc,
                  size_t pixels, detail::Stores& stores, detail::BufferLedger& ledger) {
   const bool peer = detail::isPeerRule(method.compositing);
   const bool lists = method.store == StoreChoice::LinkedList;
   stores.nodes.allocate(peer || lists ? 0 : alloc.slots);
   stores.pool.allocate(lists ? alloc.slots : 0);
-  if (lists) stores.heads.assign(pixels, kListEnd);
+  assignExact(stores.heads, lists ? pixels : 0, kListEnd);
+  stores.peer = {};
+  stores.peerHoldsNodes = false;
   detail::allocatePeerStores(method, alloc, pixels, stores);
   if (options.keepStores && !peer && !lists)  // unused slots are handed out: make them defined
     std::fill(stores.nodes.data(), stores.nodes.data() + alloc.slots, FragmentNode{0});
-  stores.counts.assign(pixels, 0);
-  if (options.capture == CaptureMode::FragmentParallel && !lists) stores.locks.assign(pixels, 0);
-  if (method.compositing == Compositing::Hybrid || method.peelTail) stores.tails.allocate(pixels);
+  assignExact(stores.counts, pixels, 0u);
+  assignExact(stores.locks,
+              options.capture == CaptureMode::FragmentParallel && !lists ? pixels : size_t{0}, 0u);
+  stores.tails.allocate(method.compositing == Compositing::Hybrid || method.peelTail ? pixels : 0);
   ledger.addBytes("nodes", stores.nodes.size() * sizeof(FragmentNode));
   ledger.addBytes("nodes", stores.pool.size() * sizeof(LinkedNode));
   ledger.add("heads", stores.heads);
@@ -375,11 +389,24 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
   MFR_TRY(importanceStep(frame, method, options, plan, memory, timer, out, inputs, ledger));
   MFR_TRY(oracleStep(frame, method, options, plan, memory, timer, out, inputs, ledger));
 
+  // the buffers: those of the previous render when the caller keeps them (FrameBuffers; handed back
+  // on every way out, errors included)
+  std::unique_ptr<detail::Stores> kept = options.reuse ? options.reuse->take() : nullptr;
+  struct GiveBack {
+    FrameBuffers* to;
+    std::unique_ptr<detail::Stores>& stores;
+    ~GiveBack() {
+      if (to) to->give(std::move(stores));
+    }
+  } giveBack{kept ? options.reuse : nullptr, kept};
+  if (!kept) kept = std::make_unique<detail::Stores>();
+  detail::Stores& stores = *kept;
+
   // allocate
   auto allocated = timer.run("allocate", [&] {
     return allocate(PixelLayout{frame.width(), frame.height(), frame.tileSize()}, method, memory,
                     options.budgetBytes, out.depthComplexity, out.importance.importance,
-                    inputs.oracleK);
+                    inputs.oracleK, &stores.spare);
   });
   if (!allocated) return allocated.error();
   Allocation& alloc = allocated.value();
@@ -391,7 +418,6 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
   MFR_TRY(checkNodePool(frame, method, options, memory, alloc, ledger, memoryLimit));
 
   // buffers
-  detail::Stores stores;
   timer.run("clear", [&] { clearStores(method, options, alloc, pixels, stores, ledger); });
 
   // occupancy culling passes
@@ -445,6 +471,8 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
     out.offsets = std::move(alloc.offsets);
     out.counts = std::move(stores.counts);
   }
+  stores.spare.offsets = std::move(alloc.offsets);  // for the next frame (FrameBuffers)
+  stores.spare.kind = std::move(alloc.kind);
   return out;
 }
 

@@ -444,11 +444,16 @@ void tileMajorOffsets(const PixelLayout& frame, Allocation& a) {
 Result<Allocation> allocate(const PixelLayout& frame, const MethodDesc& method,
                             const MemoryModel& memory, std::optional<uint64_t> budget,
                             const std::vector<uint32_t>& n, const std::vector<float>& importanceIn,
-                            const std::vector<uint32_t>& oracleK) {
+                            const std::vector<uint32_t>& oracleK, Allocation* reuse) {
   std::vector<float> sanitized;
   const std::vector<float>& importance = usableImportance(importanceIn, sanitized);
   const uint64_t pixels = frame.pixels();
   Allocation a;
+  if (reuse) {  // arrays of exactly this size only: callers count their capacities
+    if (reuse->capacity.capacity() == pixels) a.capacity = std::move(reuse->capacity);
+    if (reuse->offsets.capacity() == pixels) a.offsets = std::move(reuse->offsets);
+    if (reuse->kind.capacity() == pixels) a.kind = std::move(reuse->kind);
+  }
   a.capacity.assign(pixels, 0);
   a.kind.assign(pixels, StoreKind::MaxArray);
 

@@ -26,6 +26,11 @@ struct ColorTables {
   // encode: a coarse guess from round(linear * 4095), corrected by the exact code boundaries
   // (lowerBound[c] = linear value of sRGB (c - 0.5) / 255); 5 KB, so it stays in L1
   std::array<uint8_t, 4096> coarseSrgb8;
+  // the 8-lane encode's guess (raster_span_avx2.hpp): the code of the smallest input of each
+  // bucket round(linear * 4095), which no bucket exceeds by more than one (at most one code
+  // boundary lies in a bucket: the boundaries are at least 1/3295 apart, the buckets 1/4095
+  // wide), so one correction upwards, against lowerBound, makes it exact (ColorTables test)
+  std::array<uint8_t, 4096> bucketLowSrgb8;
   std::array<float, 257> lowerBound;
   static const ColorTables& get() {
     static const ColorTables tables = build();

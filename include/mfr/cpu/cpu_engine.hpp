@@ -4,6 +4,7 @@
 
 #include <memory>
 
+#include "mfr/cpu/frame_buffers.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/engine/engine.hpp"
 
@@ -37,6 +38,8 @@ class CpuEngine final : public Engine {
 
  private:
   EngineOptions options_;
+  /// Kept from one render to the next (frame_buffers.hpp), unless the caller passes its own.
+  std::unique_ptr<FrameBuffers> buffers_ = std::make_unique<FrameBuffers>();
 };
 
 /// The CPU frame of a view prepared by the CPU engine; an error naming the engine otherwise.

@@ -80,11 +80,13 @@ Result<void> checkCoveredPixels(const PixelLayout& layout, const MethodDesc& met
 /// `fragmentCounts`: n(p) (empty when the method does not count); `importance`: I(p) of the
 /// importance policies; `oracleK`: the optimal policy's k(p). Errors (one line): a budget too
 /// small for the per-pixel words and (unless allowsTailOnlyPixels) one node per (covered) pixel,
-/// a bounded policy with neither budget nor k, an explicit k that does not fit.
+/// a bounded policy with neither budget nor k, an explicit k that does not fit. `reuse`: an
+/// earlier allocation whose per-pixel arrays of exactly this frame's size are taken over instead
+/// of allocated afresh (the CPU engine's FrameBuffers; the result is the same).
 Result<Allocation> allocate(const PixelLayout& layout, const MethodDesc& method,
                             const MemoryModel& memory, std::optional<uint64_t> budget,
                             const std::vector<uint32_t>& fragmentCounts,
                             const std::vector<float>& importance,
-                            const std::vector<uint32_t>& oracleK);
+                            const std::vector<uint32_t>& oracleK, Allocation* reuse = nullptr);
 
 }  // namespace mfr

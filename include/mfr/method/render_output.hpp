@@ -19,6 +19,8 @@
 
 namespace mfr {
 
+class FrameBuffers;  // mfr/cpu/frame_buffers.hpp
+
 enum class CaptureMode : uint8_t {
   TileOwned,         // each tile owned by one worker: no locks, deterministic
   FragmentParallel,  // the paper's algorithm as written: triangles from many threads, per-pixel
@@ -40,6 +42,9 @@ struct RenderOptions {
   /// size, the bytes needed and this limit when they exceed it. None: defaultMemoryLimit()
   /// (mfr/core/memory_limit.hpp, 75% of the physical memory).
   std::optional<uint64_t> memoryLimitBytes;
+  /// The CPU engine: buffers kept from the previous render, reused by this one (the same output;
+  /// see mfr/cpu/frame_buffers.hpp). CpuEngine passes its own when this is unset.
+  FrameBuffers* reuse = nullptr;
 };
 
 struct PassTime {
