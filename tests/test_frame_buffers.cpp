@@ -106,8 +106,8 @@ TEST(FrameBuffers, TheSameFrameAgainReusesTheNodePool) {
   EXPECT_EQ(kept->nodes.size(), 0u) << "release() kept the pool";
 }
 
-// CpuEngine keeps its buffers between renders: a second render of the same view gives the same
-// image.
+// CpuEngine keeps its buffers between renders: a second render of the same view, and one after
+// releaseBuffers(), give the same image.
 TEST(FrameBuffers, CpuEngineRendersTheSameImageTwice) {
   auto scene = makeProceduralScene("layers?k=4&r=2&pd=0.55", 1);
   ASSERT_TRUE(scene.ok());
@@ -119,8 +119,11 @@ TEST(FrameBuffers, CpuEngineRendersTheSameImageTwice) {
   const MethodDesc method = test::presetWithK("kplus-heap", 4, Compositing::KBuffer);
   const auto first = engine.render(**prepared, method, RenderOptions{});
   const auto second = engine.render(**prepared, method, RenderOptions{});
-  ASSERT_TRUE(first.ok() && second.ok());
+  engine.releaseBuffers();
+  const auto third = engine.render(**prepared, method, RenderOptions{});
+  ASSERT_TRUE(first.ok() && second.ok() && third.ok());
   EXPECT_TRUE(first->image.pixels == second->image.pixels);
+  EXPECT_TRUE(first->image.pixels == third->image.pixels);
 }
 
 }  // namespace
