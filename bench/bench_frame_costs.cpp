@@ -160,7 +160,7 @@ int main(int argc, char** argv) {
   }
 
   // untimed warm-up renders (three per case: the process's first frames grow its heap and page
-  // in the buffers, 10-12 ms against 5.5-6.3 for the almost empty hybrid view, measured
+  // in the buffers, 10-12 ms against 5.4-6.3 for the almost empty hybrid view, measured
   // 2026-12-05), then interleaved rounds: per case, a fresh set-up (timed, then dropped), the
   // count pass, the render
   for (int warm = 0; warm < 3; ++warm)

@@ -32,7 +32,7 @@
 // A tile whose triangles all have non-masked materials blending "over" takes the wide path
 // (their alpha test cannot reject, so testing before the surface is the scalar order; the base
 // colour is the material's, times the texture sampled on the lanes (LaneTexture: bilinear or
-// nearest, every wrap mode, texels gathered and decoded by the sRGB table) and the
+// nearest, every wrap mode, the texels of the lanes in use read one by one) and the
 // perspective-correct vertex colour, per lane in the scalar operation order); any other tile
 // runs the scalar rasterizeTile on the same sink.
 #pragma once
@@ -180,9 +180,9 @@ struct LaneShading {
 };
 
 /// The integer texel coordinates (texelIndex, each axis then wrapTexel) of 8 lanes: lanes whose
-/// floored coordinate is finite, below 1e9 in magnitude and inside [0, n - 1 - extra] need no
-/// wrapping (the common case, all on lanes); otherwise every lane goes through the scalar
-/// functions.
+/// floored coordinate is finite, below 1e9 in magnitude and inside [0, n - 1] (with i1, the
+/// bilinear pair's second texel, [0, n - 2]) need no wrapping (the common case, all on lanes);
+/// otherwise every lane goes through the scalar functions.
 [[gnu::always_inline]] inline MFR_TARGET_AVX2 void wrapTexelLanes(__m256 floored, int n,
                                                                   TextureWrap wrap, __m256i& i0,
                                                                   __m256i* i1) {
@@ -220,7 +220,7 @@ struct LaneShading {
 /// more than 8 loads), the filtering runs on the lanes.
 struct LaneTexture {
   const uint8_t* rgba = nullptr;
-  const float* toLinear = nullptr;
+  const ColorTables* tables = nullptr;
   int width = 0, height = 0;
   TextureSampler sampler;
 
@@ -229,11 +229,8 @@ struct LaneTexture {
                                      float (*out)[8]) const {
     for (; bits != 0; bits &= bits - 1) {
       const int lane = std::countr_zero(bits);
-      const uint8_t* p = rgba + (static_cast<size_t>(y[lane]) * width + x[lane]) * 4;
-      out[0][lane] = toLinear[p[0]];
-      out[1][lane] = toLinear[p[1]];
-      out[2][lane] = toLinear[p[2]];
-      out[3][lane] = static_cast<float>(p[3]) * (1.0f / 255.0f);
+      const glm::vec4 c = texelColor(*tables, rgba, static_cast<size_t>(y[lane]) * width + x[lane]);
+      for (int ch = 0; ch < 4; ++ch) out[ch][lane] = c[ch];
     }
   }
 
@@ -725,7 +722,7 @@ MFR_TARGET_AVX2 void rasterizeTileAvx2(const RasterFrame& frame, const ShadingIn
       LaneTexture texture;
       if (material.texture != nullptr) {
         texture.rgba = material.texture->rgba.data();
-        texture.toLinear = in.tables->srgb8ToLinear.data();
+        texture.tables = in.tables;
         texture.width = material.texture->width;
         texture.height = material.texture->height;
         texture.sampler = material.sampler;

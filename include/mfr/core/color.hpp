@@ -148,11 +148,13 @@ inline uint32_t packBlendedColor(const ColorTables& t, BlendMode mode, const glm
   return overNodeWord(packFragmentColor(t, rgb, alpha));
 }
 
-/// Unpacks a fragment colour word to linear RGB and alpha.
-inline glm::vec4 unpackFragmentColor(uint32_t rgba) {
-  const ColorTables& t = ColorTables::get();
+/// Unpacks a fragment colour word (or an RGBA8 texel read as a word) to linear RGB and alpha.
+inline glm::vec4 unpackFragmentColor(const ColorTables& t, uint32_t rgba) {
   return {t.srgb8ToLinear[rgba & 0xffu], t.srgb8ToLinear[(rgba >> 8) & 0xffu],
           t.srgb8ToLinear[(rgba >> 16) & 0xffu], static_cast<float>(rgba >> 24) * (1.0f / 255.0f)};
+}
+inline glm::vec4 unpackFragmentColor(uint32_t rgba) {
+  return unpackFragmentColor(ColorTables::get(), rgba);
 }
 
 }  // namespace mfr

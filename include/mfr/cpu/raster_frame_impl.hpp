@@ -89,6 +89,15 @@ inline int texelIndex(float f, int n, TextureWrap wrap) {
   return static_cast<int>(std::fmod(f, static_cast<float>(period)));
 }
 
+/// Texel i of an RGBA8 texture (sRGB colour, linear alpha) in linear RGB and alpha: the fragment
+/// colour word's decode (the scalar sampler's and the 8-lane sampler's, raster_span_avx2.hpp).
+inline glm::vec4 texelColor(const ColorTables& t, const uint8_t* rgba, size_t i) {
+  const uint8_t* p = rgba + i * 4;
+  return unpackFragmentColor(t, static_cast<uint32_t>(p[0]) | static_cast<uint32_t>(p[1]) << 8 |
+                                    static_cast<uint32_t>(p[2]) << 16 |
+                                    static_cast<uint32_t>(p[3]) << 24);
+}
+
 /// One sample of `tex` at `uv` by `sampler`: bilinear (texel centres at half-integers, the four
 /// neighbours wrapped) or nearest (the texel containing uv), each axis wrapped by
 /// method_math::wrapTexel; returns linear RGB and alpha.
@@ -97,9 +106,7 @@ inline glm::vec4 sampleTexture(const Texture& tex, const TextureSampler& sampler
   const auto modeS = static_cast<uint32_t>(sampler.wrapS);
   const auto modeT = static_cast<uint32_t>(sampler.wrapT);
   auto texel = [&](int x, int y) {
-    const uint8_t* p = &tex.rgba[(static_cast<size_t>(y) * tex.width + x) * 4];
-    return glm::vec4(t.srgb8ToLinear[p[0]], t.srgb8ToLinear[p[1]], t.srgb8ToLinear[p[2]],
-                     static_cast<float>(p[3]) * (1.0f / 255.0f));
+    return texelColor(t, tex.rgba.data(), static_cast<size_t>(y) * tex.width + x);
   };
   if (sampler.filter == TextureFilter::Nearest) {
     const float fx = std::floor(uv.x * static_cast<float>(tex.width));

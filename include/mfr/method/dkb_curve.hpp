@@ -58,7 +58,8 @@ inline constexpr const char* kDkbCurveTailOnlyTargetScaling =
     "err(n-1) = 0 (include/mfr/method/dkb_curve.hpp)";
 
 /// The log scale of curves from k = 0: values from 3 (the largest squared linear-RGB error) down
-/// 16 decades map to [1, 0]. kDkbCurveTailOnlyTargetScaling names both numbers: change it with them.
+/// 16 decades map to [1, 0]. kDkbCurveTailOnlyTargetScaling names both numbers: change it with
+/// them.
 inline constexpr double kCurveLogTop = 3.0;
 inline constexpr double kCurveLogDecades = 16.0;
 
