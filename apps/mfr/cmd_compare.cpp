@@ -147,6 +147,7 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
   request.stepDegrees = static_cast<float>(a.orbitStep);
   request.width = a.scene.width;
   request.height = a.scene.height;
+  request.samples = a.scene.sampleCount();
   request.versionNumber = versionNumber;
   request.info = info;
   request.progress = [&progress](const std::string& stage, int done, int total) {
@@ -188,6 +189,7 @@ int run(const CompareArgs& a, const std::string& version) {
   options.scene = a.scene.source;
   options.seed = a.scene.seed;
   options.flipPixelsPerDegree = a.pixelsPerDegree;
+  options.sampleStorage = a.scene.storage();
   if (!(a.pixelsPerDegree > 0.0 && std::isfinite(a.pixelsPerDegree)))
     return fail("--ppd: must be a positive number");
 
@@ -279,7 +281,7 @@ int run(const CompareArgs& a, const std::string& version) {
   // --orbit-view I: view I - 1 precedes it (vkb's Fresnel term)
   auto previous = previousViewCosine(**engine, prepared->scene, a.scene.source,
                                      {prepared->cameras, prepared->previousCamera}, a.scene.width,
-                                     a.scene.height);
+                                     a.scene.height, a.scene.sampleCount());
   if (!previous) return fail(previous.error().message);
   options.previousNearestCosine = std::move(previous.value());
   options.progress = [&progress](const std::string& stage, int done, int total) {

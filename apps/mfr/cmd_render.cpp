@@ -29,6 +29,7 @@ struct RenderArgs {
   std::string out = "mfr.png";
   std::string depthComplexity;
   std::string kMap;
+  std::string overflowMap;
   std::string statsJson;
   std::string method = "abuffer";
   std::string budget;
@@ -93,6 +94,9 @@ Result<void> writeViewImages(const RenderArgs& a, Engine& engine, const Rendered
       writeMap(viewPath(a.depthComplexity, v, views), n, width, height, "fragments per pixel");
     }
     if (!a.kMap.empty()) writeMap(viewPath(a.kMap, v, views), result.kMap, width, height, "k(p)");
+    if (!a.overflowMap.empty())
+      writeMap(viewPath(a.overflowMap, v, views), result.lostPerPixel, width, height,
+               "fragments without a node");
     const ImportanceMaps& imp = result.importance;
     if (!a.importanceMap.empty() && !imp.importance.empty())
       writeMap(viewPath(a.importanceMap, v, views), imp.importance, width, height,
@@ -133,7 +137,10 @@ int run(const RenderArgs& a) {
   auto capture = parseCaptureOption(a.capture);
   if (!capture) return fail(capture.error().message);
   options.capture = capture.value();
+  options.sampleStorage = a.scene.storage();
   if (a.out.empty()) return fail("--out: empty path");
+  if (!a.overflowMap.empty() && a.scene.sampleCount() == 1)
+    return fail("--overflow-map: needs --samples 2, 4 or 8");
 
   auto memoryLimit = a.scene.memoryLimitBytes();
   if (!memoryLimit) return fail(memoryLimit.error().message);
@@ -155,8 +162,8 @@ int run(const RenderArgs& a) {
   const SceneViews sceneViews{prepared->cameras, prepared->previousCamera};
   progress.set("rendering " + method->name, 0, views);
   auto rendered = renderViews(
-      **engine, prepared->scene, a.scene.source, sceneViews, a.scene.width, a.scene.height, *method,
-      options, budget, [&](const RenderedView& r) -> Result<void> {
+      **engine, prepared->scene, a.scene.source, sceneViews, a.scene.width, a.scene.height,
+      a.scene.sampleCount(), *method, options, budget, [&](const RenderedView& r) -> Result<void> {
         MFR_TRY(writeViewImages(a, **engine, r, views));
         nlohmann::json stats = statsToJson(r.output.stats);
         stats["scene"] = a.scene.source;
@@ -206,6 +213,9 @@ Runner addRenderCommand(CLI::App& app) {
   cmd->add_option("--depth-complexity", args->depthComplexity,
                   "Write the fragments-per-pixel map (colour-mapped PNG with legend)");
   cmd->add_option("--k-map", args->kMap, "Write the per-pixel k as a colour-mapped PNG");
+  cmd->add_option("--overflow-map", args->overflowMap,
+                  "With --samples > 1: write, per pixel, the fragments that got no node (lost "
+                  "or sent to the hybrid tail) as a colour-mapped PNG");
   cmd->add_option("--stats-json", args->statsJson, "Write the run's statistics as JSON");
   cmd->add_option("--method,-m", args->method, presetHelp());
   cmd->add_option(

@@ -55,6 +55,13 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
                  "premultiplied, additive or multiply (docs/METHODS.md, blend modes)")
       ->expected(1)
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
+  app.add_option("--samples", samples,
+                 "Samples per pixel: 1, 2, 4 or 8 at the standard Direct3D / Vulkan positions "
+                 "(antialiasing; CPU engine) (default 1)");
+  app.add_option("--sample-storage", sampleStorage,
+                 "With --samples > 1, how a method stores a pixel's samples: pixel (one node per "
+                 "fragment with its coverage mask, composited per sample) or sample (nodes per "
+                 "sample) (default pixel; the ground truth is always per sample)");
   app.add_flag("--quiet,-q", quiet, "No progress or summary on the terminal");
   app.add_flag("--json", json, "Print machine-readable JSON on stdout");
   app.add_flag("--allow-outside-references", allowOutsideReferences,
@@ -95,6 +102,7 @@ View sceneView(const PreparedScene& prepared, const SceneOptions& o, const Camer
   v.camera = camera;
   v.width = o.width;
   v.height = o.height;
+  v.samples = o.sampleCount();
   return v;
 }
 
@@ -126,6 +134,8 @@ Result<PreparedScene> prepareScene(const SceneOptions& o) {
   const SceneRequest request = o.request();
   MFR_TRY(checkSceneRequest(request));
   MFR_TRY(checkThreads(o.threads, "--threads"));
+  if (auto s = parseSamples(o.samples, "--samples"); !s) return s.error();
+  if (auto s = parseSampleStorage(o.sampleStorage, "--sample-storage"); !s) return s.error();
   auto memoryLimit = o.memoryLimitBytes();
   if (!memoryLimit) return memoryLimit.error();
 

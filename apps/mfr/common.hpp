@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "mfr/core/result.hpp"
+#include "mfr/core/samples.hpp"
 #include "mfr/engine/engine.hpp"
 #include "mfr/learn/model_file.hpp"
 #include "mfr/method/method_options.hpp"
@@ -47,6 +48,18 @@ struct SceneOptions {
   std::string engine = "cpu";           // --engine (render, compare, info)
   std::string glSync = "auto";          // --gl-sync (the GL engine's k-buffer sync)
   std::string glRaster = "native";      // --gl-raster (the GL engine's geometry passes)
+  std::string samples = "1";            // --samples 1|2|4|8 (core/samples.hpp)
+  std::string sampleStorage = "pixel";  // --sample-storage pixel|sample
+
+  /// --samples and --sample-storage, parsed (prepareScene checks them first).
+  int sampleCount() const {
+    auto s = parseSamples(samples, "--samples");
+    return s ? s.value() : 1;
+  }
+  SampleStorage storage() const {
+    auto s = parseSampleStorage(sampleStorage, "--sample-storage");
+    return s ? s.value() : SampleStorage::Pixel;
+  }
 
   /// Registers the options (and the positional scene unless the command takes several; --engine
   /// for the commands that run on either engine).

@@ -2,6 +2,8 @@
 // results as JSON and CSV (the HTML page is in report_html.cpp).
 #include "mfr/compare/compare.hpp"
 
+#include "mfr/method/pass_plan.hpp"
+
 #include "mfr/method/peel.hpp"
 
 #include <algorithm>
@@ -173,7 +175,9 @@ Result<void> renderGroundTruth(Engine& engine, const PreparedView& view,
                                const RenderOptions& renderOptions, CompareResult& result) {
   auto abuffer = methodPreset("abuffer");
   if (!abuffer) return abuffer.error();
-  auto truth = engine.render(view, abuffer.value(), renderOptions);
+  RenderOptions exact = renderOptions;  // multisampled: the per-sample A-buffer, box-filtered
+  exact.sampleStorage = SampleStorage::Sample;
+  auto truth = engine.render(view, abuffer.value(), exact);
   if (!truth) return makeError("ground truth (abuffer): " + truth.error().message);
   CompareRun& gt = result.groundTruth;
   gt.method = "abuffer";
@@ -209,13 +213,16 @@ Result<std::vector<uint32_t>> compareOneRun(const RunSetting& s, const BudgetSpe
   run.method = method.name;
   run.compositing = method.compositing;
   const MemoryModel memory = s.engine.memoryModel(method, s.renderOptions);
-  auto budget = resolveBudget(spec, method, memory, s.counts, s.sizeName);
+  const uint64_t storagePixels = s.view.storagePixels(sampleStorageOf(method, s.renderOptions));
+  FrameCounts counts = s.counts;  // per-pixel words: per sample under per-sample storage
+  counts.pixels = storagePixels;
+  auto budget = resolveBudget(spec, method, memory, counts, s.sizeName);
   if (!budget) {
     run.error = budget.error().message;
     return std::vector<uint32_t>{};
   }
   run.budgetBytes = budget.value();
-  run.budgetSlots = memory.fragmentSlots(budget.value(), s.view.pixelCount());
+  run.budgetSlots = memory.fragmentSlots(budget.value(), storagePixels);
   progress.report("rendering " + method.name + " at " + budgetLabel);
   RenderOptions ro = s.renderOptions;
   ro.budgetBytes = budget.value();
@@ -286,11 +293,14 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   result.compositing = options.compositing;
   result.capture = options.capture;
   result.flipPixelsPerDegree = options.flipPixelsPerDegree;
+  result.samples = view.samples();
+  result.sampleStorage = options.sampleStorage;
 
   RenderOptions renderOptions;
   renderOptions.capture = options.capture;
   renderOptions.background = options.background;
   renderOptions.memoryLimitBytes = options.memoryLimitBytes;
+  renderOptions.sampleStorage = options.sampleStorage;
   if (!options.previousNearestCosine.empty())
     renderOptions.previousNearestCosine = &options.previousNearestCosine;
 
@@ -299,12 +309,12 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   ++progress.step;
   // relative budgets: the A-buffer's node bytes of this frame (a count pass)
   FrameCounts counts;
-  counts.pixels = view.pixelCount();
   if (anyRelative) {
     auto n = engine.countFragments(view);
     if (!n) return makeError("count pass: " + n.error().message);
     counts = FrameCounts::of(n.value());
   }
+  counts.pixels = view.pixelCount();  // each run's own storage pixels: compareOneRun
   const std::string sizeName = std::to_string(w) + "x" + std::to_string(h);
   const RunSetting setting{
       engine, view, options, renderOptions, counts, sizeName, result.groundTruth.image};
@@ -342,6 +352,8 @@ nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersi
   j["capture"] = captureName(r.capture);
   j["cull"] = toString(r.groundTruth.stats.cull);  // every run rasterizes the same view
   j["flip_pixels_per_degree"] = r.flipPixelsPerDegree;
+  j["samples"] = r.samples;
+  j["sample_storage"] = toString(r.sampleStorage);
   j["budget_bytes"] =
       r.budgets.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.budgets[0].budgetBytes);
   nlohmann::json gt = runToJson(r.groundTruth);

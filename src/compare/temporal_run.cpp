@@ -48,7 +48,7 @@ Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest&
   std::vector<float> previousCosine;  // vkb's Fresnel term: the previous frame's nearest |n.v|
   std::string engineName;
   for (int f = 0; f < r.frames; ++f) {
-    auto view = engine.prepare(View{r.scene, path[f], r.width, r.height});
+    auto view = engine.prepare(View{r.scene, path[f], r.width, r.height, r.samples});
     if (!view) return named(view.error());
     options.previousNearestCosine = previousCosine;
     options.progress = [&r, f](const std::string& stage, int done, int total) {

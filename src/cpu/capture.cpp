@@ -77,8 +77,8 @@ struct CaptureSink {
     return true;
   }
 
-  void toTail(uint32_t p, uint32_t rgba) {
-    if constexpr (Hybrid) stores.tails[p].add(rgba);
+  void toTail(uint32_t p, FragmentNode node) {
+    if constexpr (Hybrid) stores.toTail(p, node);
   }
 
   void emit(const Fragment& f) {
@@ -88,7 +88,7 @@ struct CaptureSink {
       if (occupancy->culls(p, f.depth)) {
         ++counters.culledOccupancy;
         Lock::lock(stores, p);
-        toTail(p, f.rgba);
+        toTail(p, node);
         Lock::unlock(stores, p);
         return;
       }
@@ -99,7 +99,7 @@ struct CaptureSink {
         ++counters.culledKPlus;
         if constexpr (Hybrid) {
           Lock::lock(stores, p);
-          toTail(p, f.rgba);
+          toTail(p, node);
           Lock::unlock(stores, p);
         }
         return;
@@ -115,11 +115,11 @@ struct CaptureSink {
       case InsertOutcome::Replaced:
         ++counters.inserted;
         ++counters.evicted;
-        toTail(p, nodeColor(evicted));
+        toTail(p, evicted);
         break;
       case InsertOutcome::Rejected:
         ++counters.rejected;
-        toTail(p, f.rgba);
+        toTail(p, node);
         break;
     }
     Lock::unlock(stores, p);
@@ -306,8 +306,9 @@ CaptureCounters runCapture(const RasterFrame& frame, const Allocation& alloc,
 
 }  // namespace
 
-Isa captureIsaFor(const MethodDesc& method, CaptureMode mode) {
+Isa captureIsaFor(const RasterFrame& frame, const MethodDesc& method, CaptureMode mode) {
   if (isPeerRule(method.compositing) || method.store == StoreChoice::LinkedList) return Isa::Scalar;
+  if (frame.samples() > 1) return Isa::Scalar;  // the 8-lane kernel tests pixel centres only
   return captureIsa(method, mode);
 }
 
@@ -319,7 +320,7 @@ CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,
   const bool hybrid = method.compositing == Compositing::Hybrid;
   const bool occ = occupancy != nullptr;
   const bool kplus = method.culling == CullingTest::KPlus;
-  const Isa isa = captureIsa(method, mode);
+  const Isa isa = captureIsaFor(frame, method, mode);
   // one instantiation per combination, so each inner loop carries only the tests it needs
   if (hybrid) {
     if (occ)

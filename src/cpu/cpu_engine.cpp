@@ -1,11 +1,103 @@
 // The CPU engine behind the Engine seam (mfr/cpu/cpu_engine.hpp).
 #include "mfr/cpu/cpu_engine.hpp"
 
+#include <algorithm>
 #include <thread>
 
 #include "mfr/cpu/render.hpp"
+#include "mfr/method/pass_plan.hpp"
 
 namespace mfr {
+
+Result<const RasterFrame*> CpuView::frame(SampleStorage storage) const {
+  if (frame_.samples() == 1 || storage == SampleStorage::Pixel) return &frame_;
+  const std::lock_guard lock(mutex_);
+  if (!sampleFrame_) {
+    RasterOptions o = options_;
+    o.storage = SampleStorage::Sample;
+    auto built = RasterFrame::build(*scene_, frame_.camera(), o);
+    if (!built) return built.error();
+    sampleFrame_ = std::make_unique<RasterFrame>(std::move(built.value()));
+  }
+  return sampleFrame_.get();
+}
+
+const std::vector<uint8_t>& CpuView::edgePixels() const {
+  const std::lock_guard lock(mutex_);
+  if (edges_.empty()) {
+    edges_.assign(frame_.pixelCount(), 0);
+    const int samples = frame_.samples();
+    const uint32_t full = (1u << samples) - 1u;
+    frame_.forEachTile([&](int tile) {  // a tile's pixels are its worker's
+      frame_.rasterizeTile<ShadeMode::Coverage>(tile, CoverageAll{[&](uint32_t p, float depth) {
+                                                  if (coverageOf(depth, samples) != full)
+                                                    edges_[p] = 1;
+                                                }});
+    });
+  }
+  return edges_;
+}
+
+namespace {
+
+// Multisampled renders: the fragments that did not get a node, at the pixels an edge crosses and
+// at the other covered pixels. n(p) and the nodes per storage pixel (RenderOutput::counts, which
+// render() leaves for a multisampled frame).
+void edgeStatistics(const CpuView& view, const RasterFrame& frame, RenderOutput& out) {
+  const std::vector<uint32_t> n = out.depthComplexity.size() == frame.pixelCount()
+                                      ? out.depthComplexity
+                                      : countFragments(frame);
+  const std::vector<uint8_t>& edges = view.edgePixels();
+  const int per = frame.storagePerPixel();
+  RenderStats& st = out.stats;
+  out.lostPerPixel.assign(edges.size(), 0);
+  for (size_t q = 0; q < n.size(); ++q) {
+    const uint32_t captured = q < out.counts.size() ? std::min(out.counts[q], n[q]) : n[q];
+    const size_t pixel = q / per;
+    out.lostPerPixel[pixel] += n[q] - captured;
+    (edges[pixel] ? st.lostAtEdges : st.lostInside) += n[q] - captured;
+    (edges[pixel] ? st.fragmentsAtEdges : st.fragmentsInside) += n[q];
+  }
+  st.edgePixels = static_cast<uint64_t>(std::count(edges.begin(), edges.end(), uint8_t{1}));
+}
+
+// Per-sample storage: the W*S x H storage maps back to the image's W x H pixels. The image is
+// box-filtered (the mean of the samples); counts (n(p), k(p)) are summed over the samples.
+void toImagePixels(RenderOutput& out, int samples) {
+  const int w = out.image.width / samples, h = out.image.height;
+  ImageRGB image(w, h);
+  for (size_t p = 0; p < image.pixels.size(); ++p) {
+    glm::vec3 sum(0.0f);
+    for (int s = 0; s < samples; ++s) sum += out.image.pixels[p * samples + s];
+    image.pixels[p] = sum / static_cast<float>(samples);
+  }
+  out.image = std::move(image);
+  auto sumSamples = [&](std::vector<uint32_t>& v) {
+    if (v.empty()) return;
+    for (size_t p = 0; p < v.size() / samples; ++p) {
+      uint32_t sum = 0;
+      for (int s = 0; s < samples; ++s) sum += v[p * samples + s];
+      v[p] = sum;
+    }
+    v.resize(v.size() / samples);
+  };
+  sumSamples(out.kMap);
+  sumSamples(out.depthComplexity);
+  auto meanSamples = [&](std::vector<float>& v) {
+    if (v.empty()) return;
+    for (size_t p = 0; p < v.size() / samples; ++p) {
+      float sum = 0.0f;
+      for (int s = 0; s < samples; ++s) sum += v[p * samples + s];
+      v[p] = sum / static_cast<float>(samples);
+    }
+    v.resize(v.size() / samples);
+  };
+  meanSamples(out.importance.importance);
+  meanSamples(out.nearestCosine);
+  (void)h;
+}
+
+}  // namespace
 
 Result<const RasterFrame*> cpuFrame(const PreparedView& view) {
   const auto* cpu = dynamic_cast<const CpuView*>(&view);
@@ -32,30 +124,59 @@ Result<std::unique_ptr<PreparedView>> CpuEngine::prepare(const View& view) {
   ro.height = view.height;
   ro.tileSize = options_.tileSize;
   ro.threads = options_.threads;
+  ro.samples = view.samples;
   auto frame = RasterFrame::build(*view.scene, view.camera, ro);
   if (!frame) return frame.error();
-  return std::unique_ptr<PreparedView>(std::make_unique<CpuView>(std::move(frame.value())));
+  return std::unique_ptr<PreparedView>(
+      std::make_unique<CpuView>(std::move(frame.value()), *view.scene, ro));
 }
 
 Result<RenderOutput> CpuEngine::render(const PreparedView& view, const MethodDesc& method,
                                        const RenderOptions& options) {
-  auto frame = cpuFrame(view);
+  const auto* cpu = dynamic_cast<const CpuView*>(&view);
+  if (!cpu) return makeError("engine cpu: the view was prepared by another engine");
+  const int samples = cpu->samples();
+  auto frame = cpu->frame(sampleStorageOf(method, options));
   if (!frame) return frame.error();
+  const int per = (*frame)->storagePerPixel();
   RenderOptions reusing = options;
   if (!reusing.reuse) reusing.reuse = buffers_.get();
+  std::vector<float> cosine;  // per-sample storage: the previous frame's |n.v| for each sample
+  if (per > 1 && options.previousNearestCosine) {
+    cosine.reserve(options.previousNearestCosine->size() * per);
+    for (float c : *options.previousNearestCosine) cosine.insert(cosine.end(), per, c);
+    reusing.previousNearestCosine = &cosine;
+  }
   auto out = mfr::render(**frame, method, reusing);
   if (out) {
     out->stats.engine = "cpu";
     out->stats.engineCounters["threads"] = (*frame)->threads();
     out->stats.engineCounters["tile_workers"] = (*frame)->arenaThreads();
+    if (samples > 1) {
+      edgeStatistics(*cpu, **frame, *out);
+      if (!options.keepStores) out->counts.clear();
+    }
+    if (per > 1) toImagePixels(*out, per);
   }
   return out;
 }
 
 Result<std::vector<uint32_t>> CpuEngine::countFragments(const PreparedView& view) {
-  auto frame = cpuFrame(view);
+  const auto* cpu = dynamic_cast<const CpuView*>(&view);
+  if (!cpu) return makeError("engine cpu: the view was prepared by another engine");
+  if (cpu->samples() == 1) return mfr::countFragments(cpu->frame());
+  // multisampled: the fragments of the pixel's samples (the per-sample A-buffer's nodes)
+  auto frame = cpu->frame(SampleStorage::Sample);
   if (!frame) return frame.error();
-  return mfr::countFragments(**frame);
+  std::vector<uint32_t> n = mfr::countFragments(**frame);
+  const int samples = cpu->samples();
+  for (size_t p = 0; p < n.size() / samples; ++p) {
+    uint32_t sum = 0;
+    for (int s = 0; s < samples; ++s) sum += n[p * samples + s];
+    n[p] = sum;
+  }
+  n.resize(n.size() / samples);
+  return n;
 }
 
 Result<std::vector<float>> CpuEngine::nearestCosine(const PreparedView& view) {

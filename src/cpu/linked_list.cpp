@@ -121,7 +121,7 @@ CaptureCounters captureLinkedList(const RasterFrame& frame, const MethodDesc& me
             stores.heads[f.pixel] = static_cast<uint32_t>(next++);
             ++stores.counts[f.pixel];
           } else if (hybrid) {
-            stores.tails[f.pixel].add(f.rgba);
+            stores.toTail(f.pixel, makeNode(f));
           }
         }});
     MFR_CHECK_EQ(next, firstNode[static_cast<size_t>(tile) + 1]);

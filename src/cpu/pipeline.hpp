@@ -152,10 +152,19 @@ struct Stores {
   std::vector<uint32_t> heads;     // linked lists: each pixel's newest node (kListEnd: none)
   UninitializedBuffer<LinkedNode> pool;  // linked lists: the node pool
   Allocation spare;  // an earlier frame's offsets and store kinds, for allocate() to take over
+  /// Per-pixel multisampled storage: the samples of the coverage masks in the nodes' depths
+  /// (core/samples.hpp), which weight a node that goes to the hybrid tail; 0 otherwise.
+  int maskSamples = 0;
+  void toTail(uint32_t p, FragmentNode node) {
+    if (maskSamples)
+      tails[p].addCovered(node, maskSamples);
+    else
+      tails[p].add(nodeColor(node));
+  }
 };
 
 /// The instruction set capture() runs this method on (what the statistics report as "isa").
-Isa captureIsaFor(const MethodDesc& method, CaptureMode mode);
+Isa captureIsaFor(const RasterFrame& frame, const MethodDesc& method, CaptureMode mode);
 
 /// The capture pass: every fragment through occupancy test, k+ test and store insertion.
 CaptureCounters capture(const RasterFrame& frame, const MethodDesc& method,
@@ -211,10 +220,12 @@ ImageRGB resolveSortedNodes(const RasterFrame& frame, const MethodDesc& method,
   const glm::vec3 empty = hybrid ? compositeHybrid(nullptr, 0, HybridTail{}, background)
                                  : compositeKBuffer(nullptr, 0, background);
   ImageRGB image(frame.width(), frame.height(), empty);
+  // per-pixel multisampled storage: each sample from the nodes that cover it (compositeSamples)
+  const int masked = frame.sampleStorage() == SampleStorage::Pixel ? frame.samples() : 1;
   frame.forEachTile([&](int tile) {
     if (frame.tileBegin(tile) == frame.tileEnd(tile)) return;
     FragmentNode small[kSortNetworkSize];
-    std::vector<FragmentNode> scratch, large;  // grow once per tile
+    std::vector<FragmentNode> scratch, large, covering;  // grow once per tile
     const TileRect r = frame.tileRect(tile);
     for (int y = r.y0; y <= r.y1; ++y)
       for (int x = r.x0; x <= r.x1; ++x) {
@@ -222,6 +233,15 @@ ImageRGB resolveSortedNodes(const RasterFrame& frame, const MethodDesc& method,
         const uint32_t n = stores.counts[p];
         if (n == 0 && (!hybrid || stores.tails[p].count == 0)) continue;
         const FragmentNode* sorted = sortNodes(nodesOf(p, n, scratch), n, small, large);
+        if (masked > 1) {
+          if (covering.size() < n) covering.resize(n);
+          image.pixels[p] = compositeSamples(
+              sorted, n, masked, covering.data(), [&](const FragmentNode* nodes, uint32_t m) {
+                return hybrid ? compositeHybrid(nodes, m, stores.tails[p], background)
+                              : compositeKBuffer(nodes, m, background);
+              });
+          continue;
+        }
         image.pixels[p] = hybrid ? compositeHybrid(sorted, n, stores.tails[p], background)
                                  : compositeKBuffer(sorted, n, background);
       }

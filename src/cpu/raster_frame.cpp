@@ -99,10 +99,12 @@ int clipPolygon(ClipVertex (&poly)[12], int count, unsigned planes) {
 
 struct SetupContext {
   int width, height;
+  // the extreme sample offsets (1/256 pixel; 0 with one sample)
+  int32_t minOffsetX = 0, maxOffsetX = 0, minOffsetY = 0, maxOffsetY = 0;
 };
 
-// Screen-space set-up of one clipped triangle; returns false when it covers no pixel centre or is
-// a back face that `cullBack` drops.
+// Screen-space set-up of one clipped triangle; returns false when it covers no pixel centre (no
+// sample position, multisampled) or is a back face that `cullBack` drops.
 bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVertex& v1,
                    const ClipVertex& v2, uint32_t prim, uint32_t material, bool cullBack,
                    TriangleSetup& t, TriangleColors& colors) {
@@ -151,17 +153,21 @@ bool setupTriangle(const SetupContext& ctx, const ClipVertex& v0, const ClipVert
     const int32_t dx = t.x[b] - t.x[a], dy = t.y[b] - t.y[a];
     if ((dy == 0 && dx > 0) || dy < 0) t.topLeft |= static_cast<uint8_t>(1u << i);
   }
-  // pixel centres c*256+128 inside [min, max] of the fixed-point bounds
+  // pixels with a sample position c*256+128+offset inside [min, max] of the fixed-point bounds
   const int32_t minFx = std::min({t.x[0], t.x[1], t.x[2]}),
                 maxFx = std::max({t.x[0], t.x[1], t.x[2]});
   const int32_t minFy = std::min({t.y[0], t.y[1], t.y[2]}),
                 maxFy = std::max({t.y[0], t.y[1], t.y[2]});
   auto ceilDiv = [](int64_t a, int64_t b) { return a >= 0 ? (a + b - 1) / b : -((-a) / b); };
   auto floorDiv = [](int64_t a, int64_t b) { return a >= 0 ? a / b : -((-a + b - 1) / b); };
-  t.minX = static_cast<int32_t>(std::max<int64_t>(0, ceilDiv(minFx - 128, 256)));
-  t.minY = static_cast<int32_t>(std::max<int64_t>(0, ceilDiv(minFy - 128, 256)));
-  t.maxX = static_cast<int32_t>(std::min<int64_t>(ctx.width - 1, floorDiv(maxFx - 128, 256)));
-  t.maxY = static_cast<int32_t>(std::min<int64_t>(ctx.height - 1, floorDiv(maxFy - 128, 256)));
+  t.minX = static_cast<int32_t>(
+      std::max<int64_t>(0, ceilDiv(int64_t{minFx} - 128 - ctx.maxOffsetX, 256)));
+  t.minY = static_cast<int32_t>(
+      std::max<int64_t>(0, ceilDiv(int64_t{minFy} - 128 - ctx.maxOffsetY, 256)));
+  t.maxX = static_cast<int32_t>(
+      std::min<int64_t>(ctx.width - 1, floorDiv(int64_t{maxFx} - 128 - ctx.minOffsetX, 256)));
+  t.maxY = static_cast<int32_t>(
+      std::min<int64_t>(ctx.height - 1, floorDiv(int64_t{maxFy} - 128 - ctx.minOffsetY, 256)));
   if (t.minX > t.maxX || t.minY > t.maxY) return false;
   t.prim = prim;
   t.material = material;
@@ -201,6 +207,19 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   MFR_TRY(checkThreads(options.threads, "threads"));
   if (options.tileSize < 8 || options.tileSize > 1024)
     return makeError("tile size " + std::to_string(options.tileSize) + ": must be in [8, 1024]");
+  const std::span<const SampleOffset> pattern = samplePattern(options.samples);
+  if (pattern.empty())
+    return makeError("samples " + std::to_string(options.samples) + ": expected 1, 2, 4 or 8");
+  const int storagePerPixel = options.storage == SampleStorage::Sample ? options.samples : 1;
+  if (options.tileSize % storagePerPixel != 0)
+    return makeError("tile size " + std::to_string(options.tileSize) +
+                     ": must be a multiple of the samples (" + std::to_string(options.samples) +
+                     ") under per-sample storage");
+  if (static_cast<int64_t>(options.width) * storagePerPixel > (int64_t{1} << 24) ||
+      static_cast<int64_t>(options.width) * storagePerPixel * options.height > (int64_t{1} << 31))
+    return makeError("image size " + std::to_string(options.width) + "x" +
+                     std::to_string(options.height) + " with " + std::to_string(options.samples) +
+                     " samples stored per sample: too many storage pixels");
   MFR_TRY(validateScene(scene));
   const Camera& c = cameraIn;
   const bool cameraFinite = std::isfinite(c.eye.x) && std::isfinite(c.eye.y) &&
@@ -218,11 +237,23 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
     return makeError("camera: need 0 < near < far (or 0 for automatic)");
 
   RasterFrame frame;
-  frame.width_ = options.width;
+  frame.imageWidth_ = options.width;
+  frame.samples_ = options.samples;
+  frame.storage_ = options.storage;
+  frame.width_ = options.width * storagePerPixel;
   frame.height_ = options.height;
   frame.threads_ = resolveThreads(options.threads);
   frame.tileSize_ = options.tileSize;
-  frame.tilesX_ = (options.width + options.tileSize - 1) / options.tileSize;
+  frame.tilesX_ = (frame.width_ + options.tileSize - 1) / options.tileSize;
+  SetupContext ctx{options.width, options.height};
+  for (size_t s = 0; s < pattern.size(); ++s) {
+    frame.sampleX_[s] = pattern[s].x * 16;  // 1/16 -> 1/256 pixel
+    frame.sampleY_[s] = pattern[s].y * 16;
+    ctx.minOffsetX = std::min(ctx.minOffsetX, frame.sampleX_[s]);
+    ctx.maxOffsetX = std::max(ctx.maxOffsetX, frame.sampleX_[s]);
+    ctx.minOffsetY = std::min(ctx.minOffsetY, frame.sampleY_[s]);
+    ctx.maxOffsetY = std::max(ctx.maxOffsetY, frame.sampleY_[s]);
+  }
   frame.tilesY_ = (options.height + options.tileSize - 1) / options.tileSize;
   frame.camera_ = fitClipPlanes(cameraIn, sceneBounds(scene));
   frame.materials_ = resolveMaterials(scene);
@@ -256,7 +287,6 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   });
 
   // clip + set-up, in chunks whose outputs are concatenated in order (deterministic)
-  const SetupContext ctx{options.width, options.height};
   const size_t triangleCount = scene.triangleCount();
   constexpr size_t kChunk = 8192;
   const size_t chunks = (triangleCount + kChunk - 1) / kChunk;
@@ -315,9 +345,12 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   // binning: count, prefix sum, fill (primitive order within each tile)
   const int tileSize = frame.tileSize_;
   frame.binOffsets_.assign(static_cast<size_t>(frame.tileCount()) + 1, 0);
+  // tiles in storage pixels: image pixel x is storage columns x * per .. x * per + per - 1
   auto forTiles = [&](const TriangleSetup& t, auto&& fn) {
     for (int ty = t.minY / tileSize; ty <= t.maxY / tileSize; ++ty)
-      for (int tx = t.minX / tileSize; tx <= t.maxX / tileSize; ++tx) fn(ty * frame.tilesX_ + tx);
+      for (int tx = t.minX * storagePerPixel / tileSize;
+           tx <= (t.maxX * storagePerPixel + storagePerPixel - 1) / tileSize; ++tx)
+        fn(ty * frame.tilesX_ + tx);
   };
   for (const TriangleSetup& t : frame.setups_)
     forTiles(t, [&](int tile) { ++frame.binOffsets_[tile + 1]; });

@@ -419,6 +419,8 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
 
   // buffers
   timer.run("clear", [&] { clearStores(method, options, alloc, pixels, stores, ledger); });
+  stores.maskSamples =
+      frame.samples() > 1 && frame.sampleStorage() == SampleStorage::Pixel ? frame.samples() : 0;
 
   // occupancy culling passes
   OccupancyMap occupancy;
@@ -435,7 +437,7 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
     });
 
   // capture
-  out.stats.isa = std::string(isaName(detail::captureIsaFor(method, options.capture)));
+  out.stats.isa = std::string(isaName(detail::captureIsaFor(frame, method, options.capture)));
   const bool lists = method.store == StoreChoice::LinkedList;
   const detail::CaptureCounters counters =
       plan.peel
@@ -464,6 +466,10 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
   cpuStats(counters, ledger, out.stats);
   out.stats.cull = frame.cull();
   out.kMap = alloc.reservedK.empty() ? std::move(alloc.capacity) : std::move(alloc.reservedK);
+  out.stats.samples = frame.samples();
+  out.stats.sampleStorage = frame.sampleStorage();
+  if (frame.samples() > 1 && !options.keepStores)  // the engine's edge statistics read them
+    out.counts = stores.counts;
   if (options.keepStores && lists) {
     detail::exportLinkedLists(stores, out);
   } else if (options.keepStores) {

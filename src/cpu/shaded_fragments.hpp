@@ -37,7 +37,7 @@ struct LaneEmitAll {
 template <class Fn>
 void forEachShadedFragment(const RasterFrame& frame, int tile, Fn&& fn) {
 #if MFR_HAS_AVX2_KERNELS
-  if (activeIsa() >= Isa::Avx2) {
+  if (activeIsa() >= Isa::Avx2 && frame.samples() == 1) {  // the lanes test pixel centres only
     if (frame.tileBegin(tile) == frame.tileEnd(tile)) return;
     thread_local std::vector<int32_t> noCull;  // reused by the worker's tiles
     LaneEmitAll<Fn> sink{fn, noCull};

@@ -3,15 +3,16 @@
 
 #include "mfr/core/quote.hpp"
 #include "mfr/method/memory_model.hpp"
+#include "mfr/method/pass_plan.hpp"
 
 namespace mfr {
 
 Result<std::vector<float>> previousViewCosine(Engine& engine, const Scene& scene,
                                               const std::string& source, const SceneViews& views,
-                                              int width, int height) {
+                                              int width, int height, int samples) {
   if (!views.previousCamera) return std::vector<float>{};
   const auto named = [&](const Error& e) { return makeError(echoPath(source) + ": " + e.message); };
-  auto previous = engine.prepare(View{&scene, *views.previousCamera, width, height});
+  auto previous = engine.prepare(View{&scene, *views.previousCamera, width, height, samples});
   if (!previous) return named(previous.error());
   auto cosine = engine.nearestCosine(**previous);
   if (!cosine) return named(cosine.error());
@@ -19,16 +20,19 @@ Result<std::vector<float>> previousViewCosine(Engine& engine, const Scene& scene
 }
 
 Result<void> renderViews(Engine& engine, const Scene& scene, const std::string& source,
-                         const SceneViews& views, int width, int height, const MethodDesc& method,
-                         RenderOptions options, const std::optional<BudgetSpec>& budget,
+                         const SceneViews& views, int width, int height, int samples,
+                         const MethodDesc& method, RenderOptions options,
+                         const std::optional<BudgetSpec>& budget,
                          const std::function<Result<void>(const RenderedView&)>& each) {
   const auto named = [&](const Error& e) { return makeError(echoPath(source) + ": " + e.message); };
-  const auto viewOf = [&](const Camera& camera) { return View{&scene, camera, width, height}; };
+  const auto viewOf = [&](const Camera& camera) {
+    return View{&scene, camera, width, height, samples};
+  };
   if (budget) options.budgetBytes = budget->bytes;
   std::vector<float> previousCosine;  // importance methods: nearest |n.v| of the previous view
   if (method.allocation == AllocationPolicy::Importance &&
       method.importanceSource == ImportanceSource::Heuristic) {
-    auto cosine = previousViewCosine(engine, scene, source, views, width, height);
+    auto cosine = previousViewCosine(engine, scene, source, views, width, height, samples);
     if (!cosine) return cosine.error();
     previousCosine = std::move(cosine.value());
   }
@@ -40,8 +44,11 @@ Result<void> renderViews(Engine& engine, const Scene& scene, const std::string& 
     if (budget && budget->isRelative()) {
       auto counted = engine.countFragments(**view);
       if (!counted) return named(counted.error());
-      auto bytes = resolveBudget(*budget, method, engine.memoryModel(method, options),
-                                 FrameCounts::of(counted.value()), size);
+      FrameCounts counts = FrameCounts::of(counted.value());
+      // the pixels the per-pixel words are kept for (per sample under per-sample storage)
+      counts.pixels = (*view)->storagePixels(sampleStorageOf(method, options));
+      auto bytes =
+          resolveBudget(*budget, method, engine.memoryModel(method, options), counts, size);
       if (!bytes) return named(bytes.error());
       options.budgetBytes = bytes.value();
     }

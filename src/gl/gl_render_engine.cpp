@@ -381,6 +381,9 @@ class GlRenderEngine final : public Engine {
 
   Result<std::unique_ptr<PreparedView>> prepare(const View& view) override {
     if (!view.scene) return makeError("--engine gl: a view without a scene");
+    if (view.samples != 1)
+      return makeError("--engine gl: --samples " + std::to_string(view.samples) +
+                       ": multisampling runs on the CPU engine only (--engine cpu)");
     auto engine = GlEngine::create(context_, *view.scene, view.camera, view.width, view.height,
                                    interlock_, raster_);
     if (!engine) return engine.error();

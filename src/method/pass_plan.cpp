@@ -148,4 +148,11 @@ void fillSharedStats(const SharedMeasures& in, RenderStats& s) {
   }
 }
 
+SampleStorage sampleStorageOf(const MethodDesc& method, const RenderOptions& options) {
+  if (options.sampleStorage == SampleStorage::Sample) return SampleStorage::Sample;
+  const bool ownState = visitPeer(method.compositing, []<class>() {});
+  const bool oracle = method.allocation == AllocationPolicy::Optimal && !method.predictedCurves;
+  return ownState || oracle ? SampleStorage::Sample : SampleStorage::Pixel;
+}
+
 }  // namespace mfr

@@ -33,6 +33,15 @@ nlohmann::json statsToJson(const RenderStats& s) {
   if (!s.engine.empty()) j["engine"] = s.engine;
   j["primitives_skipped"] = s.primitivesSkipped;
   j["cull"] = toString(s.cull);
+  j["samples"] = s.samples;
+  if (s.samples > 1) {
+    j["sample_storage"] = toString(s.sampleStorage);
+    j["edge_pixels"] = s.edgePixels;
+    j["fragments_at_edges"] = s.fragmentsAtEdges;
+    j["fragments_inside"] = s.fragmentsInside;
+    j["lost_at_edges"] = s.lostAtEdges;
+    j["lost_inside"] = s.lostInside;
+  }
   if (!s.isa.empty()) j["isa"] = s.isa;
   for (const auto& [name, value] : s.engineCounters) j["engine_counters"][name] = value;
   j["total_ms"] = s.totalMs();

@@ -52,6 +52,8 @@ struct CompareOptions {
   std::function<void(const std::string& stage, int done, int total)> progress;
   /// Memory pre-flight of every render (RenderOptions::memoryLimitBytes); none: the default.
   std::optional<uint64_t> memoryLimitBytes;
+  /// Multisampled views: how every method stores the samples (the ground truth: per sample).
+  SampleStorage sampleStorage = SampleStorage::Pixel;
 };
 
 /// Error of one image against the ground truth (both sRGB8 as written).
@@ -96,6 +98,8 @@ struct CompareResult {
   int width = 0, height = 0;
   std::optional<Compositing> compositing;  // CompareOptions::compositing (none: per preset)
   CaptureMode capture = CaptureMode::TileOwned;
+  int samples = 1;  // per pixel (View::samples)
+  SampleStorage sampleStorage = SampleStorage::Pixel;
   double flipPixelsPerDegree = kFlipDefaultPixelsPerDegree;
   CompareRun groundTruth;     // abuffer, no budget, metrics against itself (all 0, PSNR infinite)
   Image8 depthComplexityMap;  // colour-mapped n(p) with legend

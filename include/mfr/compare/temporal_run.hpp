@@ -21,6 +21,7 @@ struct TemporalRequest {
   int frames = 2;            // at least 2
   float stepDegrees = 0.0f;  // 0: 360 / frames
   int width = 1024, height = 1024;
+  int samples = 1;  // per pixel (View::samples)
   std::string versionNumber;
   ReportInfo info;
   /// Called before each step with ("frame F/N: stage", done, total). May be empty.

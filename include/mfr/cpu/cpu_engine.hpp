@@ -3,6 +3,8 @@
 #pragma once
 
 #include <memory>
+#include <mutex>
+#include <vector>
 
 #include "mfr/cpu/frame_buffers.hpp"
 #include "mfr/cpu/raster_frame.hpp"
@@ -10,16 +12,32 @@
 
 namespace mfr {
 
-/// A view prepared by the CPU engine: the frame the tile passes run on.
+/// A view prepared by the CPU engine: the frame the tile passes run on. A multisampled view
+/// (View::samples > 1) holds the per-pixel storage frame and builds its per-sample storage frame
+/// (RasterOptions::storage) on first use, from the scene the view refers to.
 class CpuView final : public PreparedView {
  public:
   explicit CpuView(RasterFrame frame) : frame_(std::move(frame)) {}
-  int width() const override { return frame_.width(); }
+  CpuView(RasterFrame frame, const Scene& scene, const RasterOptions& options)
+      : frame_(std::move(frame)), scene_(&scene), options_(options) {}
+  int width() const override { return frame_.imageWidth(); }
   int height() const override { return frame_.height(); }
+  int samples() const override { return frame_.samples(); }
+  /// The per-pixel storage frame (the only one with one sample).
   const RasterFrame& frame() const { return frame_; }
+  /// The frame of a storage discipline (built once, on first use).
+  Result<const RasterFrame*> frame(SampleStorage storage) const;
+  /// Multisampled views: 1 where an edge crosses the image pixel (some fragment covers part of
+  /// its samples), else 0 (built once, on first use).
+  const std::vector<uint8_t>& edgePixels() const;
 
  private:
   RasterFrame frame_;
+  const Scene* scene_ = nullptr;
+  RasterOptions options_;
+  mutable std::mutex mutex_;
+  mutable std::unique_ptr<RasterFrame> sampleFrame_;
+  mutable std::vector<uint8_t> edges_;
 };
 
 class CpuEngine final : public Engine {

@@ -23,6 +23,7 @@
 
 #include "mfr/core/color.hpp"
 #include "mfr/core/result.hpp"
+#include "mfr/core/samples.hpp"
 #include "mfr/cpu/fragment.hpp"
 #include "mfr/scene/scene.hpp"
 
@@ -35,8 +36,15 @@ inline constexpr float kAmbient = 0.2f;
 struct RasterOptions {
   int width = 512;
   int height = 512;
-  int tileSize = 16;  // pixels per tile side
+  int tileSize = 16;  // pixels per tile side (storage pixels: see samples)
   int threads = 0;    // 0 = all cores
+  /// Multisampling (core/samples.hpp): 1, 2, 4 or 8 samples at the standard positions. With more
+  /// than one, `storage` decides what a pass sees: Pixel, a width x height frame whose fragments
+  /// carry their coverage mask in the depth (withCoverage); Sample, a (width * samples) x height
+  /// frame whose storage pixel x * samples + s is sample s of pixel x (the tile size must then be
+  /// a multiple of the samples, so a tile holds whole pixels).
+  int samples = 1;
+  SampleStorage storage = SampleStorage::Pixel;
 };
 
 /// Shading inputs of one material, resolved once per frame.
@@ -111,9 +119,17 @@ class RasterFrame {
   static Result<RasterFrame> build(const Scene& scene, const Camera& camera,
                                    const RasterOptions& options);
 
+  /// The storage size the passes index (pixel = y * width() + x): the image's, except under
+  /// per-sample storage, where width() is the image's width times the samples.
   int width() const { return width_; }
   int height() const { return height_; }
   size_t pixelCount() const { return static_cast<size_t>(width_) * height_; }
+  /// The image's width (width() / samples() under per-sample storage).
+  int imageWidth() const { return imageWidth_; }
+  int samples() const { return samples_; }
+  SampleStorage sampleStorage() const { return storage_; }
+  /// Storage pixels per image pixel: the samples under per-sample storage, else 1.
+  int storagePerPixel() const { return storage_ == SampleStorage::Sample ? samples_ : 1; }
   int threads() const { return threads_; }
   /// Workers of the tile passes: the requested threads, at most the hardware's (more would only
   /// queue; the fragment-parallel capture uses the full requested count on its own threads).
@@ -163,15 +179,23 @@ class RasterFrame {
  private:
   template <ShadeMode Mode, class Sink>
   void rasterizeRect(const TriangleSetup& t, int x0, int y0, int x1, int y1, Sink& sink) const;
+  // the same with coverage at the sample positions (samples_ > 1): image pixel rectangle
+  template <ShadeMode Mode, class Sink>
+  void rasterizeRectSamples(const TriangleSetup& t, int x0, int y0, int x1, int y1,
+                            Sink& sink) const;
   // alpha test and base colour (texture x factor); false when the fragment is discarded
   template <ShadeMode Mode>
   bool surface(const TriangleSetup& t, const ShadeMaterial& m, float l0, float l1, float l2,
                glm::vec4& base) const;
   // colour and n.v of a surviving fragment
-  void shade(const TriangleSetup& t, float l0, float l1, float l2, int px, int py,
+  // (px, py): the image position shaded, in pixels from pixel (0, 0)'s centre
+  void shade(const TriangleSetup& t, float l0, float l1, float l2, float px, float py,
              const glm::vec4& base, Fragment& f) const;
 
   int width_ = 0, height_ = 0, threads_ = 1, tileSize_ = 32, tilesX_ = 0, tilesY_ = 0;
+  int imageWidth_ = 0, samples_ = 1;
+  SampleStorage storage_ = SampleStorage::Pixel;
+  int32_t sampleX_[kMaxSamples] = {}, sampleY_[kMaxSamples] = {};  // offsets in 1/256 pixel
   Camera camera_;
   CullMode cull_ = CullMode::Auto;
   std::vector<TriangleSetup> setups_;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <optional>
 
@@ -71,6 +72,24 @@ inline int64_t ceilDivPositive(int64_t a, int64_t b) {  // a > 0, b > 0
   while (q * b < a) ++q;
   while (q > 0 && (q - 1) * b >= a) --q;
   return q;
+}
+
+/// Narrows [xs, xe] to the pixels of a row (x0..x1, edge values row[i] at x0, steps stepX[i])
+/// where all three edge functions are >= 0: exact integer bounds; an edge that is non-negative at
+/// both ends of the row cannot cut it, by linearity. Leaves xs > xe when none is.
+inline void rowSpan(const int64_t row[3], const int64_t stepX[3], int x0, int x1, int& xs,
+                    int& xe) {
+  for (int i = 0; i < 3 && xs <= xe; ++i) {
+    const int64_t r = row[i], st = stepX[i];
+    if (r >= 0 && r + st * (x1 - x0) >= 0) continue;
+    if (st > 0) {  // r < 0 here: the first x with w >= 0
+      xs = static_cast<int>(std::max<int64_t>(xs, x0 + ceilDivPositive(-r, st)));
+    } else if (st < 0 && r >= 0) {  // the last x with w >= 0
+      xe = static_cast<int>(std::min<int64_t>(xe, x0 + floorDivPositive(r, -st)));
+    } else {
+      xe = xs - 1;  // st <= 0 and r < 0: nothing on this row
+    }
+  }
 }
 
 static_assert(static_cast<uint32_t>(TextureWrap::Repeat) == method_math::kTextureWrapRepeat &&
@@ -162,15 +181,15 @@ template <ShadeMode Mode>
 }
 
 [[gnu::always_inline]] inline void RasterFrame::shade(const TriangleSetup& t, float l0, float l1,
-                                                      float l2, int px, int py,
+                                                      float l2, float px, float py,
                                                       const glm::vec4& base, Fragment& f) const {
   // headlight: the light sits at the eye, so diffuse = |n.v| (scalar code: glm's vec3 is not
   // vectorised and this is the hottest loop of every capture pass)
   const float nx = t.normalW[0].x * l0 + t.normalW[1].x * l1 + t.normalW[2].x * l2;
   const float ny = t.normalW[0].y * l0 + t.normalW[1].y * l1 + t.normalW[2].y * l2;
   const float nz = t.normalW[0].z * l0 + t.normalW[1].z * l1 + t.normalW[2].z * l2;
-  const float dx = static_cast<float>(px) * rayScaleX_ + rayBiasX_;
-  const float dy = static_cast<float>(py) * rayScaleY_ + rayBiasY_;
+  const float dx = px * rayScaleX_ + rayBiasX_;
+  const float dy = py * rayScaleY_ + rayBiasY_;
   const float nn = (nx * nx + ny * ny + nz * nz) * (dx * dx + dy * dy + 1.0f);
   const float ndotv =
       nn > 0.0f ? std::clamp((nz - nx * dx - ny * dy) / std::sqrt(nn), -1.0f, 1.0f) : 1.0f;
@@ -212,17 +231,7 @@ inline void RasterFrame::rasterizeRect(const TriangleSetup& t, int x0, int y0, i
     // edge that is non-negative at both ends of the row cannot cut it, by linearity), so thin
     // triangles cost their pixels, not their bounding boxes
     int xs = x0, xe = x1;
-    for (int i = 0; i < 3 && xs <= xe; ++i) {
-      const int64_t r = row[i], st = stepX[i];
-      if (r >= 0 && r + st * (x1 - x0) >= 0) continue;
-      if (st > 0) {  // r < 0 here: the first x with w >= 0
-        xs = static_cast<int>(std::max<int64_t>(xs, x0 + detail::ceilDivPositive(-r, st)));
-      } else if (st < 0 && r >= 0) {  // the last x with w >= 0
-        xe = static_cast<int>(std::min<int64_t>(xe, x0 + detail::floorDivPositive(r, -st)));
-      } else {
-        xe = xs - 1;  // st <= 0 and r < 0: nothing on this row
-      }
-    }
+    detail::rowSpan(row, stepX, x0, x1, xs, xe);
     const int64_t skip = xs - x0;
     int64_t w1 = row[1] + skip * stepX[1], w2 = row[2] + skip * stepX[2];
     const uint32_t rowPixel = static_cast<uint32_t>(y) * static_cast<uint32_t>(width_);
@@ -236,8 +245,87 @@ inline void RasterFrame::rasterizeRect(const TriangleSetup& t, int x0, int y0, i
       f.depth = z > 0.0f ? (z < 1.0f ? z : 1.0f) : 0.0f;
       f.pixel = rowPixel + static_cast<uint32_t>(x);
       if (!sink.accept(f.pixel, f.depth)) continue;  // early test before shading
-      if constexpr (Mode == ShadeMode::Full) shade(t, l0, l1, l2, x, y, base, f);
+      if constexpr (Mode == ShadeMode::Full)
+        shade(t, l0, l1, l2, static_cast<float>(x), static_cast<float>(y), base, f);
       sink.emit(f);
+    }
+    row[0] += stepY[0];
+    row[1] += stepY[1];
+    row[2] += stepY[2];
+  }
+}
+
+template <ShadeMode Mode, class Sink>
+inline void RasterFrame::rasterizeRectSamples(const TriangleSetup& t, int x0, int y0, int x1,
+                                              int y1, Sink& sink) const {
+  x0 = std::max(x0, t.minX);
+  y0 = std::max(y0, t.minY);
+  x1 = std::min(x1, t.maxX);
+  y1 = std::min(y1, t.maxY);
+  if (x0 > x1 || y0 > y1) return;
+  const int samples = samples_;
+  // the centre's edge values as rasterizeRect has them, and each sample's offset from them
+  int64_t stepX[3], stepY[3], row[3], bias[3], offset[kMaxSamples][3];
+  const int64_t px0 = static_cast<int64_t>(x0) * 256 + 128;
+  const int64_t py0 = static_cast<int64_t>(y0) * 256 + 128;
+  for (int i = 0; i < 3; ++i) {
+    const int a = (i + 1) % 3, b = (i + 2) % 3;
+    const int64_t A = static_cast<int64_t>(t.y[a]) - t.y[b];
+    const int64_t B = static_cast<int64_t>(t.x[b]) - t.x[a];
+    stepX[i] = A * 256;
+    stepY[i] = B * 256;
+    bias[i] = (t.topLeft >> i) & 1 ? 0 : -1;
+    row[i] = B * (py0 - t.y[a]) + A * (px0 - t.x[a]) + bias[i];
+    for (int s = 0; s < samples; ++s) offset[s][i] = A * sampleX_[s] + B * sampleY_[s];
+  }
+  const float dz1 = t.z[1] - t.z[0], dz2 = t.z[2] - t.z[0];
+  const ShadeMaterial& material = materials_[t.material];
+  const bool perPixel = storage_ == SampleStorage::Pixel;
+  Fragment f;
+  f.prim = t.prim;
+  f.rgba = 0;
+  f.ndotv = 0.0f;
+  for (int y = y0; y <= y1; ++y) {
+    // the row's pixels: the union of each sample's exact span
+    int xs = x1 + 1, xe = x0 - 1;
+    for (int s = 0; s < samples; ++s) {
+      const int64_t sampleRow[3] = {row[0] + offset[s][0], row[1] + offset[s][1],
+                                    row[2] + offset[s][2]};
+      int a = x0, b = x1;
+      detail::rowSpan(sampleRow, stepX, x0, x1, a, b);
+      if (a > b) continue;
+      xs = std::min(xs, a);
+      xe = std::max(xe, b);
+    }
+    for (int x = xs; x <= xe; ++x) {
+      const int64_t dx = x - x0;
+      const int64_t w0 = row[0] + dx * stepX[0], w1 = row[1] + dx * stepX[1],
+                    w2 = row[2] + dx * stepX[2];
+      uint32_t mask = 0;
+      for (int s = 0; s < samples; ++s)
+        if (w0 + offset[s][0] >= 0 && w1 + offset[s][1] >= 0 && w2 + offset[s][2] >= 0)
+          mask |= 1u << s;
+      // one fragment per covered sample (per-sample storage), or one for the pixel at its first
+      // covered sample, carrying the mask (per-pixel storage)
+      for (uint32_t left = perPixel && mask ? 1u << std::countr_zero(mask) : mask; left != 0;
+           left &= left - 1) {
+        const int s = std::countr_zero(left);
+        const float l1 = static_cast<float>(w1 + offset[s][1] - bias[1]) * t.invArea;
+        const float l2 = static_cast<float>(w2 + offset[s][2] - bias[2]) * t.invArea;
+        const float l0 = 1.0f - l1 - l2;
+        glm::vec4 base;
+        if (!surface<Mode>(t, material, l0, l1, l2, base)) continue;  // alpha test
+        const float z = t.z[0] + l1 * dz1 + l2 * dz2;
+        const float depth = z > 0.0f ? (z < 1.0f ? z : 1.0f) : 0.0f;
+        f.depth = perPixel ? withCoverage(depth, mask, samples) : depth;
+        f.pixel = static_cast<uint32_t>(y) * static_cast<uint32_t>(width_) +
+                  (perPixel ? static_cast<uint32_t>(x) : static_cast<uint32_t>(x * samples + s));
+        if (!sink.accept(f.pixel, f.depth)) continue;  // early test before shading
+        if constexpr (Mode == ShadeMode::Full)
+          shade(t, l0, l1, l2, static_cast<float>(x) + static_cast<float>(sampleX_[s]) / 256.0f,
+                static_cast<float>(y) + static_cast<float>(sampleY_[s]) / 256.0f, base, f);
+        sink.emit(f);
+      }
     }
     row[0] += stepY[0];
     row[1] += stepY[1];
@@ -249,6 +337,12 @@ template <ShadeMode Mode, class Sink>
 void RasterFrame::rasterizeTile(int tile, Sink&& sink) const {
   const TileRect r = tileRect(tile);
   const uint32_t* end = tileEnd(tile);
+  if (samples_ > 1) {  // the image pixels of the tile (a tile holds whole pixels)
+    const int per = storagePerPixel();
+    for (const uint32_t* it = tileBegin(tile); it != end; ++it)
+      rasterizeRectSamples<Mode>(setups_[*it], r.x0 / per, r.y0, r.x1 / per, r.y1, sink);
+    return;
+  }
   for (const uint32_t* it = tileBegin(tile); it != end; ++it) {
     if (end - it > detail::kPrefetchAhead)
       detail::prefetchSetup(setups_[it[detail::kPrefetchAhead]]);
@@ -258,7 +352,10 @@ void RasterFrame::rasterizeTile(int tile, Sink&& sink) const {
 
 template <ShadeMode Mode, class Sink>
 void RasterFrame::rasterizeTriangle(size_t setupIndex, Sink&& sink) const {
-  rasterizeRect<Mode>(setups_[setupIndex], 0, 0, width_ - 1, height_ - 1, sink);
+  if (samples_ > 1)
+    rasterizeRectSamples<Mode>(setups_[setupIndex], 0, 0, imageWidth_ - 1, height_ - 1, sink);
+  else
+    rasterizeRect<Mode>(setups_[setupIndex], 0, 0, width_ - 1, height_ - 1, sink);
 }
 
 }  // namespace mfr

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "mfr/core/result.hpp"
+#include "mfr/core/samples.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/method/render_output.hpp"
@@ -24,12 +25,15 @@
 namespace mfr {
 
 /// One frame to render: the scene (it must outlive the PreparedView: the CPU engine's triangles
-/// point at its textures), the camera and the image size.
+/// point at its textures), the camera, the image size and the samples per pixel (core/samples.hpp:
+/// 1, 2, 4 or 8 at the standard positions; RenderOptions::sampleStorage says how a method stores
+/// them).
 struct View {
   const Scene* scene = nullptr;
   Camera camera;
   int width = 512;
   int height = 512;
+  int samples = 1;
 };
 
 /// Engine settings. `threads` (0 = all cores) and `tileSize` are the CPU engine's.
@@ -52,7 +56,14 @@ class PreparedView {
   virtual ~PreparedView() = default;
   virtual int width() const = 0;
   virtual int height() const = 0;
+  /// Samples per pixel (View::samples).
+  virtual int samples() const { return 1; }
   size_t pixelCount() const { return static_cast<size_t>(width()) * static_cast<size_t>(height()); }
+  /// The pixels a method's per-pixel words are kept for: the image's, times the samples under
+  /// per-sample storage (what a memory model's per-pixel bytes are charged on).
+  uint64_t storagePixels(SampleStorage storage) const {
+    return pixelCount() * (storage == SampleStorage::Sample ? static_cast<uint64_t>(samples()) : 1);
+  }
 };
 
 class Engine {

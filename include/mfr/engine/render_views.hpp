@@ -27,14 +27,16 @@ struct RenderedView {
 /// Errors are prefixed with the scene `source`.
 Result<std::vector<float>> previousViewCosine(Engine& engine, const Scene& scene,
                                               const std::string& source, const SceneViews& views,
-                                              int width, int height);
+                                              int width, int height, int samples = 1);
 
-/// Renders `method` on every view of `views` (at width x height) with `options`; `budget`, when
-/// given, replaces options.budgetBytes (a share resolved per view). `each` receives each output in
-/// view order; its error stops the run. Engine errors are prefixed with the scene `source`.
+/// Renders `method` on every view of `views` (at width x height, `samples` per pixel) with
+/// `options`; `budget`, when given, replaces options.budgetBytes (a share resolved per view: of the
+/// per-sample A-buffer when multisampled). `each` receives each output in view order; its error
+/// stops the run. Engine errors are prefixed with the scene `source`.
 Result<void> renderViews(Engine& engine, const Scene& scene, const std::string& source,
-                         const SceneViews& views, int width, int height, const MethodDesc& method,
-                         RenderOptions options, const std::optional<BudgetSpec>& budget,
+                         const SceneViews& views, int width, int height, int samples,
+                         const MethodDesc& method, RenderOptions options,
+                         const std::optional<BudgetSpec>& budget,
                          const std::function<Result<void>(const RenderedView&)>& each);
 
 }  // namespace mfr

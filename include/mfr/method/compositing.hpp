@@ -21,12 +21,14 @@
 #pragma once
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 
 #include <glm/glm.hpp>
 
 #include "mfr/core/color.hpp"
+#include "mfr/core/samples.hpp"
 #include "mfr/method/fragment_node.hpp"
 #include "mfr/method/method_math.h"
 
@@ -41,6 +43,20 @@ struct HybridTail {
   void add(uint32_t rgba) {
     const glm::vec4 c = unpackFragmentColor(rgba);
     method_math::hybridTailAddNode(r, g, b, alpha, count, rgba >> 24, c.a, c.r, c.g, c.b);
+  }
+  /// A node of per-pixel multisampled storage (core/samples.hpp) into the pixel's one tail: its
+  /// alpha (an additive node: its emission) weighted by the share of the samples it covers.
+  void addCovered(FragmentNode node, int samples) {
+    const uint32_t rgba = nodeColor(node);
+    const float share = static_cast<float>(std::popcount(coverageOf(nodeDepth(node), samples))) /
+                        static_cast<float>(samples);
+    const glm::vec4 c = unpackFragmentColor(rgba);
+    const uint32_t kind = rgba >> 24;
+    if (kind == method_math::kAdditiveNode)
+      method_math::hybridTailAddNode(r, g, b, alpha, count, kind, c.a, c.r * share, c.g * share,
+                                     c.b * share);
+    else
+      method_math::hybridTailAddNode(r, g, b, alpha, count, kind, c.a * share, c.r, c.g, c.b);
   }
 };
 static_assert(sizeof(HybridTail) == 20);
@@ -61,6 +77,22 @@ inline glm::vec3 compositeCore(const FragmentNode* sorted, uint32_t n, glm::vec3
   }
   transmittance = glm::vec3(tr, tg, tb);
   return {r, g, b};
+}
+
+/// A multisampled pixel of per-pixel storage (core/samples.hpp): each sample composited from the
+/// sorted nodes whose coverage mask holds it (kbuffer, or hybrid over the pixel's one tail), then
+/// the samples averaged (the box filter). `scratch` holds at least n nodes.
+template <class Rule>
+glm::vec3 compositeSamples(const FragmentNode* sorted, uint32_t n, int samples,
+                           FragmentNode* scratch, Rule&& rule) {
+  glm::vec3 sum(0.0f);
+  for (int s = 0; s < samples; ++s) {
+    uint32_t m = 0;
+    for (uint32_t i = 0; i < n; ++i)
+      if ((coverageOf(nodeDepth(sorted[i]), samples) >> s) & 1u) scratch[m++] = sorted[i];
+    sum += rule(scratch, m);
+  }
+  return sum / static_cast<float>(samples);
 }
 
 inline glm::vec3 compositeKBuffer(const FragmentNode* sorted, uint32_t n, glm::vec3 background) {

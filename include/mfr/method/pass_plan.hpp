@@ -58,6 +58,13 @@ struct PassPlan {
 /// occupancy culling needs a bounded k-buffer, importance and the network need a budget.
 Result<PassPlan> planPasses(const MethodDesc& method, const RenderOptions& options);
 
+/// How a multisampled render of `method` stores its samples: the requested discipline
+/// (RenderOptions::sampleStorage), except that the methods without per-pixel nodes of their own
+/// store per sample whatever is asked: the peer methods and depth peeling (their state
+/// accumulates per sample, as in a multisampled target) and the optimal oracle (its error curves
+/// composite samples, not coverage masks).
+SampleStorage sampleStorageOf(const MethodDesc& method, const RenderOptions& options);
+
 /// What an engine measured in one render, for fillSharedStats.
 struct SharedMeasures {
   const MethodDesc& method;

@@ -13,6 +13,7 @@
 #include <glm/glm.hpp>
 
 #include "mfr/core/image.hpp"
+#include "mfr/core/samples.hpp"
 #include "mfr/method/fragment_node.hpp"
 #include "mfr/method/importance.hpp"
 #include "mfr/scene/cull_mode.hpp"
@@ -45,6 +46,9 @@ struct RenderOptions {
   /// The CPU engine: buffers kept from the previous render, reused by this one (the same output;
   /// see mfr/cpu/frame_buffers.hpp). CpuEngine passes its own when this is unset.
   FrameBuffers* reuse = nullptr;
+  /// Multisampled views (View::samples > 1): how the method stores a pixel's samples
+  /// (core/samples.hpp): one node per fragment with its coverage mask, or nodes per sample.
+  SampleStorage sampleStorage = SampleStorage::Pixel;
 };
 
 struct PassTime {
@@ -98,6 +102,16 @@ struct RenderStats {
   std::optional<uint32_t> peelPasses;
   uint64_t primitivesSkipped = 0;  // the scene's points and lines, not rendered
   CullMode cull = CullMode::Auto;  // the back faces the raster culled (Scene::cull)
+  /// Multisampling (core/samples.hpp): samples per pixel and, with more than one, the storage
+  /// discipline. Per-sample storage counts its k, slots and covered pixels per sample.
+  int samples = 1;
+  SampleStorage sampleStorage = SampleStorage::Pixel;
+  /// Multisampled renders: the pixels an edge crosses (some fragment covers part of the pixel's
+  /// samples) and the fragments lost there and in the other covered pixels (per-pixel counts:
+  /// the fragments of the per-pixel storage; per-sample storage: summed over the samples).
+  uint64_t edgePixels = 0;
+  uint64_t lostAtEdges = 0, lostInside = 0;
+  uint64_t fragmentsAtEdges = 0, fragmentsInside = 0;
   /// The engine that rendered (Engine::name) and what only it measures (the CPU engine: threads,
   /// tile_workers), beside the shared fields above.
   std::string engine;
@@ -117,6 +131,9 @@ struct RenderOutput {
   std::vector<uint32_t> depthComplexity;  // n(p), when a count pass ran (else empty)
   ImportanceMaps importance;              // importance allocation only
   std::vector<float> nearestCosine;       // importance allocation: this frame's nearest |n.v|
+  /// Multisampled renders: per pixel, the fragments that got no node (summed over the samples
+  /// under per-sample storage; RenderStats::lostAtEdges and lostInside sum it).
+  std::vector<uint32_t> lostPerPixel;
   RenderStats stats;
   // with keepStores: pixel p's captured nodes are nodes[offsets[p] .. offsets[p] + counts[p]),
   // unsorted, as the store left them
