@@ -121,7 +121,7 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
            background=None, transmission_floor=0.1, shuffle_draw_order=None, gltf_scene=None,
            cull=None, blend=None, engine="cpu", gl_sync="auto", gl_raster="native",
            memory_limit=None, allow_outside_references=False, depth_complexity=True,
-           max_peels=None):
+           max_peels=None, samples=1, sample_storage="pixel"):
     """Renders with one method, exactly as `mfr render` with the same options (the library checks
     both the same way: its errors name the Python argument where the CLI names its flag).
 
@@ -160,6 +160,11 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
     depth_complexity: also count the fragments per pixel when the method does not.
     max_peels: depth peeling (peel, dual-peel): at most this many geometry passes, as
         `mfr render --max-peels` (the rest dropped, or with composite="hybrid" blended into a tail).
+    samples: 1, 2, 4 or 8 samples per pixel at the standard Direct3D / Vulkan positions
+        (antialiasing, engine="cpu"), as `mfr --samples`; sample_storage: "pixel" (one node per
+        fragment with its coverage mask) or "sample" (nodes per sample), as `mfr
+        --sample-storage` (docs/METHODS.md, multisampling). The arrays are per pixel: the image
+        box-filtered, k_map and depth_complexity summed over the samples.
 
     Returns an mfr.RenderResult (a list of them with orbit and no orbit_view): image (float32
     (h, w, 3) linear RGB), srgb (uint8 (h, w, 4), the PNG's pixels), k_map (uint32 (h, w); None
@@ -175,7 +180,8 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
                    shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
                    blend=blend, engine=engine, gl_sync=gl_sync, gl_raster=gl_raster,
                    memory_limit=memory_limit, allow_outside_references=allow_outside_references,
-                   depth_complexity=depth_complexity, max_peels=max_peels)
+                   depth_complexity=depth_complexity, max_peels=max_peels,
+                   samples=str(samples), sample_storage=sample_storage)
 
 
 def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_METHODS, width=1024,
@@ -184,7 +190,8 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
             composite=None, capture="tile", threads=0, seed=1, model=None, ppd=FLIP_DEFAULT_PPD,
             alpha=None, background=None, transmission_floor=0.1, shuffle_draw_order=None,
             gltf_scene=None, cull=None, blend=None, engine="cpu", gl_sync="auto",
-            gl_raster="native", memory_limit=None, allow_outside_references=False) -> dict:
+            gl_raster="native", memory_limit=None, allow_outside_references=False, samples=1,
+            sample_storage="pixel") -> dict:
     """Writes the folder `mfr compare --out OUT` writes for the same options and returns its
     results.json as a dict.
 
@@ -199,7 +206,8 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
     orbit_step: degrees between frames, default 360/N); with orbit_view=I only view I of the N
     is compared. scene, camera, view, zoom, width, height, threads, seed, alpha, background,
     transmission_floor, shuffle_draw_order, gltf_scene, cull, blend, engine, gl_sync, gl_raster,
-    memory_limit, allow_outside_references: as in mfr.render. A method that fails at a budget is
+    memory_limit, allow_outside_references, samples, sample_storage: as in mfr.render (the
+    ground truth of a multisampled comparison is the per-sample A-buffer, box-filtered). A method that fails at a budget is
     recorded with its error; bad input raises mfr.Error.
     """
     if isinstance(budgets, (str, int)):
@@ -224,7 +232,9 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                                  ("engine", engine, "cpu"), ("gl_sync", gl_sync, "auto"),
                                  ("gl_raster", gl_raster, "native"),
                                  ("memory_limit", memory_limit, None),
-                                 ("allow_outside_references", allow_outside_references, False)):
+                                 ("allow_outside_references", allow_outside_references, False),
+                                 ("samples", samples, 1), ("sample_storage", sample_storage,
+                                                           "pixel")):
         if value != default:
             call.append(f"{name}={value!r}")
     if model is not None:
@@ -238,7 +248,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                     shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
                     blend=blend, engine=engine, gl_sync=gl_sync, gl_raster=gl_raster,
                     memory_limit=memory_limit, allow_outside_references=allow_outside_references,
-                    command_line="mfr.compare(" + ", ".join(call) + ")")
+                    samples=str(samples), sample_storage=sample_storage, command_line="mfr.compare(" + ", ".join(call) + ")")
 
 
 # --- the deep k-buffer's models ----------------------------------------------------------------

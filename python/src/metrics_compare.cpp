@@ -85,8 +85,10 @@ py::object compare(const py::object& sceneArg, const std::string& out,
                    const py::object& cull, const py::object& blend, const std::string& engineName,
                    const std::string& glSync, const std::string& glRaster,
                    const py::object& memoryLimitArg, bool allowOutsideReferences,
+                   const std::string& samplesArg, const std::string& sampleStorage,
                    const std::string& commandLine) {
   if (out.empty()) throw LibraryError("out: an output folder is required");
+  const int samples = unwrap(parseSamples(samplesArg, "samples"));
   const bool temporal = orbit != 0 && orbitView.is_none();  // every view of the orbit
   if (temporal && orbit < 2)
     throw LibraryError("orbit " + std::to_string(orbit) +
@@ -135,6 +137,7 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     unwrap(checkComparisonModel(*options.model, modelName, options.methods, options.compositing,
                                 Spelling::Python));
   options.capture = captureArgument(capture);
+  options.sampleStorage = unwrap(parseSampleStorage(sampleStorage, "sample_storage"));
   const SceneRequest request =
       sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
                            transmissionFloor, shuffleDrawOrder, gltfScene, cull, blend);
@@ -175,16 +178,19 @@ py::object compare(const py::object& sceneArg, const std::string& out,
       request.stepDegrees = static_cast<float>(orbitStep);
       request.width = width;
       request.height = height;
+      request.samples = samples;
       request.versionNumber = MFR_VERSION;
       request.info = info;
       jsonText =
           unwrap(runTemporalComparison(*engine, request, options, folder.staging())).jsonText;
     } else {
-      auto view = engine->prepare(View{&*scene.scene, views.cameras.front(), width, height});
+      auto view =
+          engine->prepare(View{&*scene.scene, views.cameras.front(), width, height, samples});
       if (!view) throw named(view.error());
       // orbit_view I: view I - 1 precedes it (vkb's Fresnel term)
       options.previousNearestCosine =
-          unwrap(previousViewCosine(*engine, *scene.scene, scene.source, views, width, height));
+          unwrap(previousViewCosine(*engine, *scene.scene, scene.source, views, width, height,
+                                    samples));
       auto result = runComparison(*engine, **view, options);
       if (!result) throw named(result.error());
       jsonText = unwrap(writeComparison(result.value(), folder.staging(), MFR_VERSION, info));
@@ -213,7 +219,7 @@ flip_map (LDR-FLIP per pixel, float32 (h, w) in [0, 1]).)");
         py::arg("transmission_floor"), py::arg("shuffle_draw_order"), py::arg("gltf_scene"),
         py::arg("cull"), py::arg("blend"), py::arg("engine"), py::arg("gl_sync"),
         py::arg("gl_raster"), py::arg("memory_limit"), py::arg("allow_outside_references"),
-        py::arg("command_line"), "mfr.compare's work (see python/mfr/__init__.py).");
+        py::arg("samples"), py::arg("sample_storage"), py::arg("command_line"), "mfr.compare's work (see python/mfr/__init__.py).");
 }
 
 }  // namespace mfr::python

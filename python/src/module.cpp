@@ -122,7 +122,8 @@ py::object renderScene(
     const py::object& gltfScene, const py::object& cull, const py::object& blend,
     const std::string& engineName, const std::string& glSync, const std::string& glRaster,
     const py::object& memoryLimitArg, bool allowOutsideReferences, bool wantDepthComplexity,
-    const py::object& maxPeels) {
+    const py::object& maxPeels, const std::string& samplesArg, const std::string& sampleStorage) {
+  const int samples = unwrap(parseSamples(samplesArg, "samples"));
   const std::optional<uint64_t> memoryLimit = memoryLimitArgument(memoryLimitArg);
   const SceneRequest request =
       sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
@@ -134,6 +135,7 @@ py::object renderScene(
   std::optional<BudgetSpec> spec;
   if (!budget.is_none()) spec = budgetSpecArgument(budget);
   options.capture = captureArgument(capture);
+  options.sampleStorage = unwrap(parseSampleStorage(sampleStorage, "sample_storage"));
   options.memoryLimitBytes = memoryLimit;
   const SceneArgument scene =
       sceneArgument(sceneArg, seed, request, memoryLimit, allowOutsideReferences);
@@ -165,7 +167,7 @@ py::object renderScene(
     if (spec) options.budgetBytes = spec->bytes;
     if (auto fits = engine->preflight(width, height, m, options); !fits)
       throw LibraryError(echoPath(scene.source) + ": " + fits.error().message);
-    unwrap(renderViews(*engine, *scene.scene, scene.source, views, width, height, 1, m, options,
+    unwrap(renderViews(*engine, *scene.scene, scene.source, views, width, height, samples, m, options,
                        spec, [&](const RenderedView& r) -> Result<void> {
                          RenderOutput out = std::move(r.output);
                          if (wantDepthComplexity && out.depthComplexity.empty()) {
@@ -353,6 +355,7 @@ lines are not rendered: Scene.primitives_skipped counts them.)");
         py::arg("gl_sync") = "auto", py::arg("gl_raster") = "native",
         py::arg("memory_limit") = py::none(), py::arg("allow_outside_references") = false,
         py::arg("depth_complexity") = true, py::arg("max_peels") = py::none(),
+        py::arg("samples") = "1", py::arg("sample_storage") = "pixel",
         R"(Renders a scene (an mfr.Scene, or a source string loaded with `seed`) with one method, as
 `mfr render` does with the same options, and returns an mfr.RenderResult (a list of them for an
 orbit of several views). See mfr.render's Python documentation (python/mfr/__init__.py) for the

@@ -257,6 +257,27 @@ def test_cull_argument_and_scene_property():
         scene.cull = "side"
 
 
+def test_samples_and_sample_storage():
+    # --samples / --sample-storage: per-pixel nodes with coverage masks, or nodes per sample; the
+    # arrays stay per pixel (image box-filtered, counts summed over the samples)
+    one = mfr.render("procedural:layers", width=W, height=H, method="abuffer")
+    pixel = mfr.render("procedural:layers", width=W, height=H, method="abuffer", samples=4)
+    sample = mfr.render("procedural:layers", width=W, height=H, method="abuffer", samples=4,
+                        sample_storage="sample")
+    assert pixel.image.shape == sample.image.shape == (H, W, 3)
+    assert pixel.stats["samples"] == 4 and pixel.stats["sample_storage"] == "pixel"
+    assert sample.stats["sample_storage"] == "sample"
+    # per sample: about 4 nodes for each per-pixel node inside the layers
+    assert 3.0 < sample.stats["fragment_slots"] / pixel.stats["fragment_slots"] <= 4.0
+    assert int(sample.depth_complexity.sum()) == sample.stats["fragment_slots"]
+    assert np.abs(pixel.image - sample.image).max() < 0.01
+    assert np.abs(one.image - sample.image).max() > 0.05  # the edges are antialiased
+    with pytest.raises(mfr.Error, match=r"^samples '3': expected 1, 2, 4 or 8$"):
+        mfr.render("procedural:layers", width=W, height=H, samples=3)
+    with pytest.raises(mfr.Error, match=r"^sample_storage 'node': expected pixel or sample$"):
+        mfr.render("procedural:layers", width=W, height=H, samples=2, sample_storage="node")
+
+
 def test_engine_names_and_bad_engine():
     assert mfr.engine_names()[0] == "cpu"
     with pytest.raises(mfr.Error, match=r"engine"):

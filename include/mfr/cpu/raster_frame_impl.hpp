@@ -268,6 +268,7 @@ inline void RasterFrame::rasterizeRectSamples(const TriangleSetup& t, int x0, in
   int64_t stepX[3], stepY[3], row[3], bias[3], offset[kMaxSamples][3];
   const int64_t px0 = static_cast<int64_t>(x0) * 256 + 128;
   const int64_t py0 = static_cast<int64_t>(y0) * 256 + 128;
+  int64_t widest[3];  // per edge, the largest sample offset: a row's pixels lie in its span
   for (int i = 0; i < 3; ++i) {
     const int a = (i + 1) % 3, b = (i + 2) % 3;
     const int64_t A = static_cast<int64_t>(t.y[a]) - t.y[b];
@@ -276,7 +277,11 @@ inline void RasterFrame::rasterizeRectSamples(const TriangleSetup& t, int x0, in
     stepY[i] = B * 256;
     bias[i] = (t.topLeft >> i) & 1 ? 0 : -1;
     row[i] = B * (py0 - t.y[a]) + A * (px0 - t.x[a]) + bias[i];
-    for (int s = 0; s < samples; ++s) offset[s][i] = A * sampleX_[s] + B * sampleY_[s];
+    widest[i] = INT64_MIN;
+    for (int s = 0; s < samples; ++s) {
+      offset[s][i] = A * sampleX_[s] + B * sampleY_[s];
+      widest[i] = std::max(widest[i], offset[s][i]);
+    }
   }
   const float dz1 = t.z[1] - t.z[0], dz2 = t.z[2] - t.z[0];
   const ShadeMaterial& material = materials_[t.material];
@@ -286,17 +291,11 @@ inline void RasterFrame::rasterizeRectSamples(const TriangleSetup& t, int x0, in
   f.rgba = 0;
   f.ndotv = 0.0f;
   for (int y = y0; y <= y1; ++y) {
-    // the row's pixels: the union of each sample's exact span
-    int xs = x1 + 1, xe = x0 - 1;
-    for (int s = 0; s < samples; ++s) {
-      const int64_t sampleRow[3] = {row[0] + offset[s][0], row[1] + offset[s][1],
-                                    row[2] + offset[s][2]};
-      int a = x0, b = x1;
-      detail::rowSpan(sampleRow, stepX, x0, x1, a, b);
-      if (a > b) continue;
-      xs = std::min(xs, a);
-      xe = std::max(xe, b);
-    }
+    // the row's pixels: a span holding every sample's (each edge at its largest sample offset,
+    // which no sample's edge value exceeds); the samples are tested per pixel below
+    const int64_t widestRow[3] = {row[0] + widest[0], row[1] + widest[1], row[2] + widest[2]};
+    int xs = x0, xe = x1;
+    detail::rowSpan(widestRow, stepX, x0, x1, xs, xe);
     for (int x = xs; x <= xe; ++x) {
       const int64_t dx = x - x0;
       const int64_t w0 = row[0] + dx * stepX[0], w1 = row[1] + dx * stepX[1],
