@@ -8,7 +8,10 @@
 //   kNodes         false: one Slot per pixel; true: k(p) Slots at the fixed-k allocation's offsets
 //   kExtraPasses   its geometry passes before the capture, by name (mboit: "moments", aoit:
 //                  "visibility")
-//   add(px, pass, depth, rgba)   one fragment in pass `pass` (0..extra-1, then the capture's)
+//   add(px, pass, depth, rgba)   one fragment in pass `pass` (0..extra-1, then the capture's);
+//                or add(px, pass, const PeerFragment&) for a peer that needs more of the fragment
+//                (its pixel, primitive id; with kNeedsPosition its surface point:
+//                peer_fragment.hpp)
 //   composite(slots, count, bg)  the pixel's colour over the background
 //
 // A peer whose capture is repeated a number of times decided at run time (depth peeling,
@@ -45,6 +48,7 @@
 #include "mfr/method/method.hpp"
 #include "mfr/method/mlab.hpp"
 #include "mfr/method/peel.hpp"
+#include "mfr/method/peer_fragment.hpp"
 #include "mfr/method/wboit.hpp"
 
 namespace mfr {
@@ -81,6 +85,24 @@ constexpr uint32_t peerBlendModes() {
     return Peer::kBlendModes;
   else
     return blendBit(BlendMode::Over) | blendBit(BlendMode::Premultiplied);
+}
+
+/// Whether a peer's add() takes the whole fragment (peer_fragment.hpp: its primitive id, and its
+/// surface point under kNeedsPosition) instead of its depth and colour word.
+template <class Peer>
+constexpr bool peerTakesFragment() {
+  return requires(PeerPixel<typename Peer::Slot> px, const PeerFragment& f) {
+    Peer::add(px, 0, f);
+  };
+}
+
+/// Whether a peer reads PeerFragment::position and footprint; false when it does not say.
+template <class Peer>
+constexpr bool peerNeedsPosition() {
+  if constexpr (requires { Peer::kNeedsPosition; })
+    return Peer::kNeedsPosition;
+  else
+    return false;
 }
 
 /// Whether a peer's capture repeats (depth peeling's kRepeatsCapture); false when it does not say.
