@@ -11,6 +11,13 @@
 //          Myers, "Order Independent Transparency with Dual Depth Peeling", NVIDIA 2008
 //          (peel.hpp): the capture repeated (runPeelPass: a geometry pass, then each pixel's step)
 //          until a pass takes every fragment in range or --max-peels passes, [the tail pass].
+//   stochastic, stochastic-strat  Enderton, Sintorn, Shirley, Luebke, "Stochastic Transparency",
+//          I3D 2010; Laine & Karras, "Stratified Sampling for Stochastic Transparency", EGSR 2011
+//          (stochastic.hpp): total-alpha and stochastic-depth passes, then the capture weighting
+//          each fragment by its stochastic visibility, composite with the alpha correction;
+//   hashed-alpha  Wyman & McGuire, "Hashed Alpha Testing", I3D 2017 (hashed_alpha.hpp): one pass
+//          into a z-buffer of the fragments whose alpha passes a hash of their surface point (the
+//          point reconstructed here, SurfacePoints).
 // Each is a type (mfr/method/peer_method.hpp) run by the one template below inside render()'s pass
 // structure (allocate -> [its extra passes, e.g. moments] -> capture -> resolve) on the same
 // rasterizer; only the per-pixel update and the resolve differ from the k-buffer family.

@@ -1,6 +1,6 @@
 // The peer methods as types: the transparency methods engines ship instead of k-buffers, each
 // described by one type in its own header beside its per-pixel state and rules (wboit.hpp,
-// mboit.hpp, mlab.hpp, aoit.hpp, dfaoit.hpp). A peer type says
+// mboit.hpp, mlab.hpp, aoit.hpp, dfaoit.hpp, stochastic.hpp, hashed_alpha.hpp). A peer type says
 //
 //   kRule          the Compositing value that names it, kRuleName its name (toString)
 //   preset()       its row of the preset table (name, paper, summary)
@@ -44,11 +44,13 @@
 
 #include "mfr/method/aoit.hpp"
 #include "mfr/method/dfaoit.hpp"
+#include "mfr/method/hashed_alpha.hpp"
 #include "mfr/method/mboit.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/method/mlab.hpp"
 #include "mfr/method/peel.hpp"
 #include "mfr/method/peer_fragment.hpp"
+#include "mfr/method/stochastic.hpp"
 #include "mfr/method/wboit.hpp"
 
 namespace mfr {
@@ -73,7 +75,8 @@ struct PeerList {
 using PeerMethods = PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Method, MboitTrig3Method,
                              MboitTrig4Method, Mboit16Method, Mboit6_16Method, Mboit8_16Method,
                              MboitTrig3_16Method, MboitTrig4_16Method, MlabMethod, Aoit4Method,
-                             Aoit8Method, Aoit16Method, PeelMethod, DualPeelMethod, DfaoitMethod>;
+                             Aoit8Method, Aoit16Method, PeelMethod, DualPeelMethod, DfaoitMethod,
+                             Stochastic8Method, StochasticStrat8Method, HashedAlphaMethod>;
 
 /// The blend modes a peer composites (core/blend_mode.hpp), as blendBit masks: its kBlendModes,
 /// else over and premultiplied (a premultiplied fragment reaches the rule as an over fragment of
