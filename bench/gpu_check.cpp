@@ -8,7 +8,8 @@
 //   Dish      IridescentDishWithOlives (../shared/scenes, or --dish PATH), alpha 0.5, zoom 1.6 as
 //             in bench_engines; a row with status "skipped" when the file is absent
 //   hairball  procedural:hairball
-// Presets: every name presetNames() lists and the +occupancy form of each that has one, as
+// Presets: every name presetNames() lists that the GL engine runs (not the CPU engine's
+// stochastic, stochastic-strat, hashed-alpha) and the +occupancy form of each that has one, as
 // tests/gl/test_gl_native.cpp enumerates them; bounded ones under M = 64 bytes per pixel (64 MiB
 // at 1024x1024; the GlNative ctest gives 50-67), or --budget: bench_presets' 20 MiB would leave
 // every preset whose per-pixel buffers take more than 20 bytes (the deep and optimal k-buffers,
@@ -42,6 +43,7 @@
 #include "gl_pass_timer.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 #include "mfr/gl/gl_render_engine.hpp"
+#include "mfr/gl/gl_technique.hpp"
 #include "mfr/method/aoit.hpp"
 #include "mfr/method/mboit.hpp"
 #include "mfr/metrics/flip.hpp"
@@ -120,12 +122,13 @@ bool contains(const std::vector<std::string>& list, const std::string& name) {
   return std::find(list.begin(), list.end(), name) != list.end();
 }
 
-// every preset and the +occupancy form of each that has one (test_gl_native.cpp's list)
+// every preset the GL engine runs and the +occupancy form of each that has one
+// (test_gl_native.cpp's list; the CPU engine's stochastic presets are not in the GL engine)
 std::vector<std::string> allPresets() {
   std::vector<std::string> out;
   for (const std::string& base : presetNames())
     for (const std::string& name : {base, base + "+occupancy"})
-      if (methodPreset(name)) out.push_back(name);
+      if (auto m = methodPreset(name); m && gl::classifyGl(m.value()).ok()) out.push_back(name);
   return out;
 }
 

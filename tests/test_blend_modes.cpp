@@ -179,7 +179,8 @@ TEST(BlendModes, WhoTakesWhichMode) {
   EXPECT_EQ(blendModesOf(methodOf("peel")), noMultiply);
   EXPECT_EQ(blendModesOf(methodOf("dual-peel")), noMultiply);
   EXPECT_EQ(blendModesOf(methodOf("aoit8")), noMultiply);
-  for (const char* p : {"wboit", "mboit", "mboit8", "mboit-trig4-q16", "mlab"})
+  for (const char* p : {"wboit", "mboit", "mboit8", "mboit-trig4-q16", "mlab", "stochastic",
+                        "stochastic-strat", "hashed-alpha"})
     EXPECT_EQ(blendModesOf(methodOf(p)), alphaWeighted) << p;
 }
 

@@ -39,7 +39,7 @@ std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const 
   if (m.allocation == AllocationPolicy::NoNodes) {  // wboit, mboit*: accumulators, no nodes
     // documented: wboit 20 B, mboit 36 B, mboit6 and mboit-trig3 44 B, mboit8 and mboit-trig4
     // 52 B, aoit4 44 B, aoit8 76 B, aoit16 140 B per pixel; the 16-bit moment forms 28, 32, 36 B;
-    // peel 36 B, dual-peel 72 B; dfaoit 52 B
+    // peel 36 B, dual-peel 72 B; dfaoit 52 B; stochastic, stochastic-strat 52 B; hashed-alpha 8 B
     const uint64_t perPixel = m.compositing == Compositing::WeightedBlended       ? 20
                               : m.compositing == Compositing::MomentBased6        ? 44
                               : m.compositing == Compositing::MomentBased8        ? 52
@@ -55,6 +55,9 @@ std::map<std::string, uint64_t> documentedCpuBuffers(const MethodDesc& m, const 
                               : m.compositing == Compositing::Adaptive16          ? 140
                               : m.compositing == Compositing::DualPeel            ? 72
                               : m.compositing == Compositing::DeepApproximate     ? 52
+                              : m.compositing == Compositing::Stochastic8         ? 52
+                              : m.compositing == Compositing::StochasticStrat8    ? 52
+                              : m.compositing == Compositing::HashedAlpha         ? 8
                                                                                   : 36;
     b["accumulators"] = perPixel * pixels;
     b["counters"] = 4 * pixels;  // the CPU engine's count of accumulated fragments

@@ -59,6 +59,14 @@ TEST(PassPlan, EachPresetsPassesAsItsPaperRunsThem) {
     EXPECT_EQ(planPasses(methodPreset(aoit).value(), withBudget(1 << 20))->names(),
               (Names{"allocate", "clear", "visibility", "capture", "resolve"}))
         << aoit;
+  // stochastic transparency: the total-alpha and the stochastic-depth passes before the capture
+  // (the accumulation); hashed alpha: its one pass into the z-buffer
+  for (const char* stochastic : {"stochastic", "stochastic-strat"})
+    EXPECT_EQ(planPasses(methodPreset(stochastic).value(), withBudget(1 << 20))->names(),
+              (Names{"allocate", "clear", "total-alpha", "stochastic-depth", "capture", "resolve"}))
+        << stochastic;
+  EXPECT_EQ(planPasses(methodPreset("hashed-alpha").value(), withBudget(1 << 20))->names(),
+            (Names{"allocate", "clear", "capture", "resolve"}));
   EXPECT_EQ(planPasses(methodPreset("kplus-sb+occupancy").value(), withBudget(1 << 20))->names(),
             (Names{"count", "allocate", "clear", "depth_range", "occupancy_fill", "occupancy_count",
                    "capture", "resolve"}));

@@ -121,6 +121,8 @@ TEST(PeerMethods, OneLayerEveryPresetIsExact) {
   const RasterFrame frame = frameOf({{-1.0f, {0.8f, 0.3f, 0.1f, 0.6f}}});
   const auto frags = fragmentsOf(frame);
   for (const std::string& preset : presetNames()) {
+    // hashed alpha shows the layer or the background, exact only in expectation (test_stochastic)
+    if (preset == "hashed-alpha") continue;
     const RenderOutput out = run(frame, preset);
     double worst = 0.0;
     for (size_t p = 0; p < frags.size(); ++p) {
@@ -709,6 +711,9 @@ TEST(PeerMethods, ShuffledDrawOrderOverEveryPreset) {
       // linked lists admit the first fragments of the submission order once the pool overflows,
       // by design (LinkedList.DrawOrderMattersOnlyOnceThePoolOverflows)
       if (m.allocation == AllocationPolicy::Pool) continue;
+      // hashed alpha's threshold hashes the primitive id, which the shuffle renumbers: another
+      // dither pattern of the same expectation, by design (hashed_alpha.hpp)
+      if (m.compositing == Compositing::HashedAlpha) continue;
       // at least the method's own per-pixel words (mboit8: 52 B per pixel)
       const uint64_t words = std::max(budget, MemoryModel::of(m).overhead(40 * 40));
       const RenderOutput x = run(*a, preset, words), y = run(*b, preset, words);

@@ -37,7 +37,7 @@ struct CompareArgs {
   std::string methods =
       "fkb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,optimal,wboit,mboit,mboit6,mboit8,mboit-trig3,"
       "mboit-trig4,mboit-q16,mboit6-q16,mboit8-q16,mboit-trig3-q16,mboit-trig4-q16,mlab,aoit4,"
-      "aoit8,aoit16,linked-list,peel,dual-peel,dfaoit";
+      "aoit8,aoit16,linked-list,peel,dual-peel,dfaoit,stochastic,stochastic-strat,hashed-alpha";
   std::string model;
   std::string out;
   std::string composite;            // empty: each preset's own rule

@@ -112,7 +112,8 @@ DEFAULT_COMPARE_METHODS = ("fkb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "dk
                            "wboit", "mboit", "mboit6", "mboit8", "mboit-trig3", "mboit-trig4",
                            "mboit-q16", "mboit6-q16", "mboit8-q16", "mboit-trig3-q16",
                            "mboit-trig4-q16", "mlab", "aoit4", "aoit8", "aoit16", "linked-list",
-                           "peel", "dual-peel", "dfaoit")
+                           "peel", "dual-peel", "dfaoit", "stochastic", "stochastic-strat",
+                           "hashed-alpha")
 
 
 def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1024, camera=None,

@@ -11,6 +11,13 @@
 //          Myers, "Order Independent Transparency with Dual Depth Peeling", NVIDIA 2008
 //          (peel.hpp): the capture repeated (runPeelPass: a geometry pass, then each pixel's step)
 //          until a pass takes every fragment in range or --max-peels passes, [the tail pass].
+//   stochastic, stochastic-strat  Enderton, Sintorn, Shirley, Luebke, "Stochastic Transparency",
+//          I3D 2010; Laine & Karras, "Stratified Sampling for Stochastic Transparency", EGSR 2011
+//          (stochastic.hpp): total-alpha and stochastic-depth passes, then the capture weighting
+//          each fragment by its stochastic visibility, composite with the alpha correction;
+//   hashed-alpha  Wyman & McGuire, "Hashed Alpha Testing", I3D 2017 (hashed_alpha.hpp): one pass
+//          into a z-buffer of the fragments whose alpha passes a hash of their surface point (the
+//          point reconstructed here, SurfacePoints).
 // Each is a type (mfr/method/peer_method.hpp) run by the one template below inside render()'s pass
 // structure (allocate -> [its extra passes, e.g. moments] -> capture -> resolve) on the same
 // rasterizer; only the per-pixel update and the resolve differ from the k-buffer family.
@@ -18,9 +25,11 @@
 // float sums in a fixed order). Fragment-parallel mode: any interleaving, each update under the
 // pixel's spin-lock (the lock word MemoryModel charges in that mode or for mlab).
 #include <atomic>
+#include <cmath>
 #include <thread>
 #include <type_traits>
 
+#include "mfr/scene/camera.hpp"
 #include "pipeline.hpp"
 
 namespace mfr::detail {
@@ -117,6 +126,36 @@ FragmentTally forEachFragment(const RasterFrame& frame, CaptureMode mode, Stores
   return total;
 }
 
+/// The world-space point of the surface a fragment shows and its pixel's footprint there
+/// (PeerFragment::position, footprint), from the pixel, the window depth and the frame's camera:
+/// the view depth from the depth (GL's perspective, the frame's fitted clip planes), the view-space
+/// point along the pixel centre's ray, back to world space.
+class SurfacePoints {
+ public:
+  explicit SurfacePoints(const RasterFrame& frame)
+      : width_(static_cast<uint32_t>(frame.width())),
+        inverseView_(glm::inverse(viewMatrix(frame.camera()))),
+        near_(frame.camera().zNear),
+        far_(frame.camera().zFar),
+        rays_(frame.shadingInputs()) {}
+
+  void locate(PeerFragment& f) const {
+    const float x = static_cast<float>(f.pixel % width_), y = static_cast<float>(f.pixel / width_);
+    const float ndcZ = 2.0f * f.depth - 1.0f;
+    const float viewDepth = 2.0f * near_ * far_ / (far_ + near_ - ndcZ * (far_ - near_));
+    const glm::vec3 view(x * rays_.rayScaleX + rays_.rayBiasX, y * rays_.rayScaleY + rays_.rayBiasY,
+                         -1.0f);
+    f.position = glm::vec3(inverseView_ * glm::vec4(view * viewDepth, 1.0f));
+    f.footprint = viewDepth * std::abs(rays_.rayScaleX);
+  }
+
+ private:
+  uint32_t width_;
+  glm::mat4 inverseView_;
+  float near_, far_;
+  ShadingInputs rays_;
+};
+
 /// The CPU engine's run of one peer method (peer_method.hpp): its buffer, each of its geometry
 /// passes, its resolve.
 template <class Peer>
@@ -131,11 +170,18 @@ struct PeerRun {
 
   static FragmentTally pass(const RasterFrame& frame, const Allocation& a, CaptureMode mode,
                             Stores& stores, int pass) {
+    const SurfacePoints surface(frame);
     const auto update = [&](const Fragment& f) {
       const uint32_t p = f.pixel;
-      return Peer::add(PeerPixel<Slot>{slotsOf(stores, a, p), stores.counts[p],
-                                       Peer::kNodes ? a.capacity[p] : 1u},
-                       pass, f.depth, f.rgba);
+      const PeerPixel<Slot> px{slotsOf(stores, a, p), stores.counts[p],
+                               Peer::kNodes ? a.capacity[p] : 1u};
+      if constexpr (peerTakesFragment<Peer>()) {
+        PeerFragment pf{f.pixel, f.depth, f.rgba, f.prim};
+        if constexpr (peerNeedsPosition<Peer>()) surface.locate(pf);
+        return Peer::add(px, pass, pf);
+      } else {
+        return Peer::add(px, pass, f.depth, f.rgba);
+      }
     };
     if constexpr (peerRepeatsCapture<Peer>()) {
       // depth peeling: a fragment whose depth alone puts it outside the range still to peel is

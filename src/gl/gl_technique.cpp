@@ -145,6 +145,10 @@ std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
           m.occupancyWords != 0)
         return std::nullopt;
       return GlTechnique::Peel;
+    case Compositing::Stochastic8:  // not in the GL engine (stochastic.hpp, hashed_alpha.hpp)
+    case Compositing::StochasticStrat8:
+    case Compositing::HashedAlpha:
+      return std::nullopt;
   }
   return std::nullopt;
 }

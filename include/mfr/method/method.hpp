@@ -79,6 +79,11 @@ enum class Compositing : uint8_t {
   DualPeel,             // dual-peel: nearest and farthest layer per pass (Bavoil & Myers 2008)
   DeepApproximate,      // dfaoit: per-pixel sums, a network predicts the colour (Tsopouridis
                         // 2024), dfaoit.hpp
+  Stochastic8,          // stochastic: stochastic transparency, 8 samples (Enderton 2010),
+                        // stochastic.hpp
+  StochasticStrat8,     // stochastic-strat: the same, stratified (Laine & Karras 2011)
+  HashedAlpha,          // hashed-alpha: hashed alpha testing (Wyman & McGuire 2017),
+                        // hashed_alpha.hpp
 };
 
 /// True for kbuffer and hybrid, the rules `--composite` chooses between (the k-buffer family).

@@ -1,6 +1,6 @@
 // The peer methods as types: the transparency methods engines ship instead of k-buffers, each
 // described by one type in its own header beside its per-pixel state and rules (wboit.hpp,
-// mboit.hpp, mlab.hpp, aoit.hpp, dfaoit.hpp). A peer type says
+// mboit.hpp, mlab.hpp, aoit.hpp, dfaoit.hpp, stochastic.hpp, hashed_alpha.hpp). A peer type says
 //
 //   kRule          the Compositing value that names it, kRuleName its name (toString)
 //   preset()       its row of the preset table (name, paper, summary)
@@ -8,7 +8,10 @@
 //   kNodes         false: one Slot per pixel; true: k(p) Slots at the fixed-k allocation's offsets
 //   kExtraPasses   its geometry passes before the capture, by name (mboit: "moments", aoit:
 //                  "visibility")
-//   add(px, pass, depth, rgba)   one fragment in pass `pass` (0..extra-1, then the capture's)
+//   add(px, pass, depth, rgba)   one fragment in pass `pass` (0..extra-1, then the capture's);
+//                or add(px, pass, const PeerFragment&) for a peer that needs more of the fragment
+//                (its pixel, primitive id; with kNeedsPosition its surface point:
+//                peer_fragment.hpp)
 //   composite(slots, count, bg)  the pixel's colour over the background
 //
 // A peer whose capture is repeated a number of times decided at run time (depth peeling,
@@ -41,10 +44,13 @@
 
 #include "mfr/method/aoit.hpp"
 #include "mfr/method/dfaoit.hpp"
+#include "mfr/method/hashed_alpha.hpp"
 #include "mfr/method/mboit.hpp"
 #include "mfr/method/method.hpp"
 #include "mfr/method/mlab.hpp"
 #include "mfr/method/peel.hpp"
+#include "mfr/method/peer_fragment.hpp"
+#include "mfr/method/stochastic.hpp"
 #include "mfr/method/wboit.hpp"
 
 namespace mfr {
@@ -69,7 +75,8 @@ struct PeerList {
 using PeerMethods = PeerList<WboitMethod, MboitMethod, Mboit6Method, Mboit8Method, MboitTrig3Method,
                              MboitTrig4Method, Mboit16Method, Mboit6_16Method, Mboit8_16Method,
                              MboitTrig3_16Method, MboitTrig4_16Method, MlabMethod, Aoit4Method,
-                             Aoit8Method, Aoit16Method, PeelMethod, DualPeelMethod, DfaoitMethod>;
+                             Aoit8Method, Aoit16Method, PeelMethod, DualPeelMethod, DfaoitMethod,
+                             Stochastic8Method, StochasticStrat8Method, HashedAlphaMethod>;
 
 /// The blend modes a peer composites (core/blend_mode.hpp), as blendBit masks: its kBlendModes,
 /// else over and premultiplied (a premultiplied fragment reaches the rule as an over fragment of
@@ -81,6 +88,24 @@ constexpr uint32_t peerBlendModes() {
     return Peer::kBlendModes;
   else
     return blendBit(BlendMode::Over) | blendBit(BlendMode::Premultiplied);
+}
+
+/// Whether a peer's add() takes the whole fragment (peer_fragment.hpp: its primitive id, and its
+/// surface point under kNeedsPosition) instead of its depth and colour word.
+template <class Peer>
+constexpr bool peerTakesFragment() {
+  return requires(PeerPixel<typename Peer::Slot> px, const PeerFragment& f) {
+    Peer::add(px, 0, f);
+  };
+}
+
+/// Whether a peer reads PeerFragment::position and footprint; false when it does not say.
+template <class Peer>
+constexpr bool peerNeedsPosition() {
+  if constexpr (requires { Peer::kNeedsPosition; })
+    return Peer::kNeedsPosition;
+  else
+    return false;
 }
 
 /// Whether a peer's capture repeats (depth peeling's kRepeatsCapture); false when it does not say.
