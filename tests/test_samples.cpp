@@ -285,6 +285,26 @@ TEST(Samples, BothStoragesEqualTheTruthWhenNothingOverflows) {
   }
 }
 
+TEST(Samples, FragmentParallelCaptureGivesTheTileOwnedImage) {
+  static const mfr::Scene scene = rectScene();
+  mfr::CpuEngine engine({.threads = 2});
+  auto view = engine.prepare(mfr::View{&scene, mfr::test::screenCamera(), kRectSize, kRectSize, 4});
+  ASSERT_TRUE(view.ok());
+  mfr::MethodDesc m = mfr::methodPreset("kplus-heap").value();
+  m.k = 2;  // the rectangles overlap 3 deep: nearest-two sets, any arrival order
+  for (SampleStorage storage : {SampleStorage::Pixel, SampleStorage::Sample}) {
+    mfr::RenderOptions o;
+    o.sampleStorage = storage;
+    auto tile = engine.render(**view, m, o);
+    o.capture = mfr::CaptureMode::FragmentParallel;
+    auto parallel = engine.render(**view, m, o);
+    ASSERT_TRUE(tile.ok() && parallel.ok());
+    EXPECT_GT(tile->stats.lost, 0u);
+    EXPECT_EQ(mfr::test::largestDifference(tile->image, parallel->image), 0.0f)
+        << mfr::toString(storage);
+  }
+}
+
 TEST(Samples, PerPixelNodesCostLessThanPerSampleNodes) {
   mfr::CpuEngine engine({.threads = 2});
   const mfr::RenderOutput perPixel = renderRects(engine, 4, "abuffer", SampleStorage::Pixel);

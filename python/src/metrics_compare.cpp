@@ -188,9 +188,8 @@ py::object compare(const py::object& sceneArg, const std::string& out,
           engine->prepare(View{&*scene.scene, views.cameras.front(), width, height, samples});
       if (!view) throw named(view.error());
       // orbit_view I: view I - 1 precedes it (vkb's Fresnel term)
-      options.previousNearestCosine =
-          unwrap(previousViewCosine(*engine, *scene.scene, scene.source, views, width, height,
-                                    samples));
+      options.previousNearestCosine = unwrap(
+          previousViewCosine(*engine, *scene.scene, scene.source, views, width, height, samples));
       auto result = runComparison(*engine, **view, options);
       if (!result) throw named(result.error());
       jsonText = unwrap(writeComparison(result.value(), folder.staging(), MFR_VERSION, info));
@@ -219,7 +218,8 @@ flip_map (LDR-FLIP per pixel, float32 (h, w) in [0, 1]).)");
         py::arg("transmission_floor"), py::arg("shuffle_draw_order"), py::arg("gltf_scene"),
         py::arg("cull"), py::arg("blend"), py::arg("engine"), py::arg("gl_sync"),
         py::arg("gl_raster"), py::arg("memory_limit"), py::arg("allow_outside_references"),
-        py::arg("samples"), py::arg("sample_storage"), py::arg("command_line"), "mfr.compare's work (see python/mfr/__init__.py).");
+        py::arg("samples"), py::arg("sample_storage"), py::arg("command_line"),
+        "mfr.compare's work (see python/mfr/__init__.py).");
 }
 
 }  // namespace mfr::python

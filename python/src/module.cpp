@@ -167,8 +167,8 @@ py::object renderScene(
     if (spec) options.budgetBytes = spec->bytes;
     if (auto fits = engine->preflight(width, height, m, options); !fits)
       throw LibraryError(echoPath(scene.source) + ": " + fits.error().message);
-    unwrap(renderViews(*engine, *scene.scene, scene.source, views, width, height, samples, m, options,
-                       spec, [&](const RenderedView& r) -> Result<void> {
+    unwrap(renderViews(*engine, *scene.scene, scene.source, views, width, height, samples, m,
+                       options, spec, [&](const RenderedView& r) -> Result<void> {
                          RenderOutput out = std::move(r.output);
                          if (wantDepthComplexity && out.depthComplexity.empty()) {
                            auto counted = engine->countFragments(r.view);

@@ -133,14 +133,15 @@ FragmentTally forEachFragment(const RasterFrame& frame, CaptureMode mode, Stores
 class SurfacePoints {
  public:
   explicit SurfacePoints(const RasterFrame& frame)
-      : width_(static_cast<uint32_t>(frame.width())),
+      : frame_(frame),
         inverseView_(glm::inverse(viewMatrix(frame.camera()))),
         near_(frame.camera().zNear),
         far_(frame.camera().zFar),
         rays_(frame.shadingInputs()) {}
 
   void locate(PeerFragment& f) const {
-    const float x = static_cast<float>(f.pixel % width_), y = static_cast<float>(f.pixel / width_);
+    const glm::vec2 at = frame_.shadedPosition(f.pixel);
+    const float x = at.x, y = at.y;
     const float ndcZ = 2.0f * f.depth - 1.0f;
     const float viewDepth = 2.0f * near_ * far_ / (far_ + near_ - ndcZ * (far_ - near_));
     const glm::vec3 view(x * rays_.rayScaleX + rays_.rayBiasX, y * rays_.rayScaleY + rays_.rayBiasY,
@@ -150,7 +151,7 @@ class SurfacePoints {
   }
 
  private:
-  uint32_t width_;
+  const RasterFrame& frame_;
   glm::mat4 inverseView_;
   float near_, far_;
   ShadingInputs rays_;

@@ -130,6 +130,15 @@ class RasterFrame {
   SampleStorage sampleStorage() const { return storage_; }
   /// Storage pixels per image pixel: the samples under per-sample storage, else 1.
   int storagePerPixel() const { return storage_ == SampleStorage::Sample ? samples_ : 1; }
+  /// Where storage pixel `pixel` is shaded, in pixels from image pixel (0, 0)'s centre: the pixel,
+  /// or under per-sample storage its sample's position.
+  glm::vec2 shadedPosition(uint32_t pixel) const {
+    const uint32_t x = pixel % static_cast<uint32_t>(width_), y = pixel / width_;
+    if (storagePerPixel() == 1) return {static_cast<float>(x), static_cast<float>(y)};
+    const uint32_t s = x % static_cast<uint32_t>(samples_);
+    return {static_cast<float>(x / samples_) + static_cast<float>(sampleX_[s]) / 256.0f,
+            static_cast<float>(y) + static_cast<float>(sampleY_[s]) / 256.0f};
+  }
   int threads() const { return threads_; }
   /// Workers of the tile passes: the requested threads, at most the hardware's (more would only
   /// queue; the fragment-parallel capture uses the full requested count on its own threads).
