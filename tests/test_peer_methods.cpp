@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "abuffer_fragments.hpp"
 #include "mfr/core/color.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/cpu/render.hpp"
@@ -71,32 +72,12 @@ RenderOutput run(const RasterFrame& frame, const std::string& preset,
 }
 
 // A pixel's fragments as the A-buffer captured them, nearest first: (depth, linear rgb, alpha).
-struct Frag {
-  double d, r, g, b, a;
-  bool operator==(const Frag&) const = default;
-};
+using Frag = test::AbufferFragment;
 std::vector<std::vector<Frag>> fragmentsOf(const RasterFrame& frame) {
-  const RenderOutput ab = run(frame, "abuffer");
-  std::vector<std::vector<Frag>> out;
-  for (const std::vector<FragmentNode>& nodes : test::capturedSets(ab)) {
-    std::vector<Frag> px;
-    for (FragmentNode n : nodes) {
-      const glm::vec4 c = unpackFragmentColor(nodeColor(n));
-      px.push_back({nodeDepth(n), c.r, c.g, c.b, c.a});
-    }
-    out.push_back(px);
-  }
-  return out;
+  return test::abufferFragments(run(frame, "abuffer"));
 }
-
 glm::dvec3 overTruth(const std::vector<Frag>& f) {
-  glm::dvec3 c(0.0);
-  double T = 1.0;
-  for (const Frag& x : f) {
-    c += T * x.a * glm::dvec3(x.r, x.g, x.b);
-    T *= 1.0 - x.a;
-  }
-  return c + T * glm::dvec3(kBg);
+  return test::overComposite(f, glm::dvec3(kBg));
 }
 
 // McGuire & Bavoil Eq. 5 with the Eq. 10 weight, written out independently
@@ -105,7 +86,7 @@ glm::dvec3 wboitExpected(const std::vector<Frag>& f) {
   double sumA = 0.0, reveal = 1.0;
   for (const Frag& x : f) {
     const double w = x.a * std::max(0.01, 3000.0 * std::pow(1.0 - x.d, 3.0));
-    sum += w * x.a * glm::dvec3(x.r, x.g, x.b);
+    sum += w * x.a * x.c;
     sumA += w * x.a;
     reveal *= 1.0 - x.a;
   }
@@ -182,8 +163,7 @@ TEST(PeerMethods, TwoLayersInBothOrders) {
         // T(far) = (1-a_near) (1-a_far)^0.25; up to the bias 5e-7
         const double t0 = std::pow(1.0 - f[0].a, 0.25);
         const double t1 = (1.0 - f[0].a) * std::pow(1.0 - f[1].a, 0.25);
-        const glm::dvec3 acc = t0 * f[0].a * glm::dvec3(f[0].r, f[0].g, f[0].b) +
-                               t1 * f[1].a * glm::dvec3(f[1].r, f[1].g, f[1].b);
+        const glm::dvec3 acc = t0 * f[0].a * f[0].c + t1 * f[1].a * f[1].c;
         const double accA = t0 * f[0].a + t1 * f[1].a;
         const double total = (1.0 - f[0].a) * (1.0 - f[1].a);
         expected = (1.0 - total) * acc / accA + total * glm::dvec3(kBg);
@@ -389,7 +369,7 @@ TEST(MomentFamily, ThreeLayersRenderAsTheClosedForm) {
       double accA = 0.0, front = 1.0;
       for (const Frag& x : f) {
         const double t = front * std::pow(1.0 - x.a, 0.25);
-        acc += t * x.a * glm::dvec3(x.r, x.g, x.b);
+        acc += t * x.a * x.c;
         accA += t * x.a;
         front *= 1.0 - x.a;
       }
@@ -804,7 +784,7 @@ glm::dvec3 aoitComposite(const std::vector<RefNode>& nodes, const std::vector<Fr
     double vis = 1.0;
     for (const RefNode& n : nodes)
       if (n.d < x.d) vis = n.t;
-    c += vis * x.a * glm::dvec3(x.r, x.g, x.b);
+    c += vis * x.a * x.c;
   }
   return c + (nodes.empty() ? 1.0 : nodes.back().t) * glm::dvec3(kBg);
 }

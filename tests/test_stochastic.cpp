@@ -32,6 +32,7 @@
 #include <string>
 #include <vector>
 
+#include "abuffer_fragments.hpp"
 #include "cli_runner.hpp"
 #include "mfr/core/color.hpp"
 #include "mfr/core/image.hpp"
@@ -79,32 +80,12 @@ RenderOutput run(const RasterFrame& frame, const std::string& preset,
 }
 
 // A pixel's fragments as the A-buffer captured them, nearest first: linear rgb and alpha.
-struct Frag {
-  glm::dvec3 c;
-  double a;
-};
+using Frag = test::AbufferFragment;
 std::vector<std::vector<Frag>> fragmentsOf(const RasterFrame& frame) {
-  const RenderOutput ab = run(frame, "abuffer");
-  std::vector<std::vector<Frag>> out;
-  for (const std::vector<FragmentNode>& nodes : test::capturedSets(ab)) {
-    std::vector<Frag> px;
-    for (FragmentNode n : nodes) {
-      const glm::vec4 c = unpackFragmentColor(nodeColor(n));
-      px.push_back({glm::dvec3(c), c.a});
-    }
-    out.push_back(px);
-  }
-  return out;
+  return test::abufferFragments(run(frame, "abuffer"));
 }
-
 glm::dvec3 overTruth(const std::vector<Frag>& f) {
-  glm::dvec3 c(0.0);
-  double T = 1.0;
-  for (const Frag& x : f) {
-    c += T * x.a * x.c;
-    T *= 1.0 - x.a;
-  }
-  return c + T * glm::dvec3(kBg);
+  return test::overComposite(f, glm::dvec3(kBg));
 }
 
 // ---- the masks ---------------------------------------------------------------------------------

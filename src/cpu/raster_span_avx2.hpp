@@ -532,18 +532,11 @@ MFR_TARGET_AVX2 void rasterizeRectAvx2(const RasterFrame& frame, const ShadingIn
   const int x0 = std::max(tile.x0, t.minX), y0 = std::max(tile.y0, t.minY);
   const int x1 = std::min(tile.x1, t.maxX), y1 = std::min(tile.y1, t.maxY);
   if (x0 > x1 || y0 > y1) return;
-  int64_t stepX[3], stepY[3], row[3], bias[3];
-  const int64_t px0 = static_cast<int64_t>(x0) * 256 + 128;
-  const int64_t py0 = static_cast<int64_t>(y0) * 256 + 128;
-  for (int i = 0; i < 3; ++i) {
-    const int a = (i + 1) % 3, b = (i + 2) % 3;
-    const int64_t A = static_cast<int64_t>(t.y[a]) - t.y[b];
-    const int64_t B = static_cast<int64_t>(t.x[b]) - t.x[a];
-    stepX[i] = A * 256;
-    stepY[i] = B * 256;
-    bias[i] = (t.topLeft >> i) & 1 ? 0 : -1;
-    row[i] = B * (py0 - t.y[a]) + A * (px0 - t.x[a]) + bias[i];
-  }
+  detail::EdgeFunctions edges = detail::edgeFunctions(t, x0, y0);
+  int64_t(&row)[3] = edges.row;
+  const int64_t(&stepX)[3] = edges.stepX;
+  const int64_t(&stepY)[3] = edges.stepY;
+  const int64_t(&bias)[3] = edges.bias;
   const float dz1 = t.z[1] - t.z[0], dz2 = t.z[2] - t.z[0];
 
   const __m256 invArea = _mm256_set1_ps(t.invArea);

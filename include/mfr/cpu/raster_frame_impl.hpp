@@ -74,6 +74,29 @@ inline int64_t ceilDivPositive(int64_t a, int64_t b) {  // a > 0, b > 0
   return q;
 }
 
+/// The three edge functions of a set-up from the centre of pixel (x0, y0), in 1/256 pixel: edge i
+/// runs from vertex (i+1)%3 to (i+2)%3, w_i = B_i (py - ay) + A_i (px - ax), with the top-left
+/// rule's -1 for the other edges (bias) folded into row; one pixel right adds stepX, one down
+/// stepY. Every rasterizer of the frame (scalar, multisampled, 8-lane) starts from it.
+struct EdgeFunctions {
+  int64_t A[3], B[3], stepX[3], stepY[3], row[3], bias[3];
+};
+inline EdgeFunctions edgeFunctions(const TriangleSetup& t, int x0, int y0) {
+  EdgeFunctions e;
+  const int64_t px0 = static_cast<int64_t>(x0) * 256 + 128;
+  const int64_t py0 = static_cast<int64_t>(y0) * 256 + 128;
+  for (int i = 0; i < 3; ++i) {
+    const int a = (i + 1) % 3, b = (i + 2) % 3;
+    e.A[i] = static_cast<int64_t>(t.y[a]) - t.y[b];
+    e.B[i] = static_cast<int64_t>(t.x[b]) - t.x[a];
+    e.stepX[i] = e.A[i] * 256;
+    e.stepY[i] = e.B[i] * 256;
+    e.bias[i] = (t.topLeft >> i) & 1 ? 0 : -1;
+    e.row[i] = e.B[i] * (py0 - t.y[a]) + e.A[i] * (px0 - t.x[a]) + e.bias[i];
+  }
+  return e;
+}
+
 /// Narrows [xs, xe] to the pixels of a row (x0..x1, edge values row[i] at x0, steps stepX[i])
 /// where all three edge functions are >= 0: exact integer bounds; an edge that is non-negative at
 /// both ends of the row cannot cut it, by linearity. Leaves xs > xe when none is.
@@ -207,19 +230,11 @@ inline void RasterFrame::rasterizeRect(const TriangleSetup& t, int x0, int y0, i
   x1 = std::min(x1, t.maxX);
   y1 = std::min(y1, t.maxY);
   if (x0 > x1 || y0 > y1) return;
-  // edge i runs from vertex (i+1)%3 to (i+2)%3; w_i = B_i (py - ay) + A_i (px - ax)
-  int64_t stepX[3], stepY[3], row[3], bias[3];
-  const int64_t px0 = static_cast<int64_t>(x0) * 256 + 128;
-  const int64_t py0 = static_cast<int64_t>(y0) * 256 + 128;
-  for (int i = 0; i < 3; ++i) {
-    const int a = (i + 1) % 3, b = (i + 2) % 3;
-    const int64_t A = static_cast<int64_t>(t.y[a]) - t.y[b];
-    const int64_t B = static_cast<int64_t>(t.x[b]) - t.x[a];
-    stepX[i] = A * 256;
-    stepY[i] = B * 256;
-    bias[i] = (t.topLeft >> i) & 1 ? 0 : -1;
-    row[i] = B * (py0 - t.y[a]) + A * (px0 - t.x[a]) + bias[i];
-  }
+  detail::EdgeFunctions edges = detail::edgeFunctions(t, x0, y0);
+  int64_t(&row)[3] = edges.row;
+  const int64_t(&stepX)[3] = edges.stepX;
+  const int64_t(&stepY)[3] = edges.stepY;
+  const int64_t(&bias)[3] = edges.bias;
   const float dz1 = t.z[1] - t.z[0], dz2 = t.z[2] - t.z[0];
   const ShadeMaterial& material = materials_[t.material];
   Fragment f;
@@ -265,21 +280,17 @@ inline void RasterFrame::rasterizeRectSamples(const TriangleSetup& t, int x0, in
   if (x0 > x1 || y0 > y1) return;
   const int samples = samples_;
   // the centre's edge values as rasterizeRect has them, and each sample's offset from them
-  int64_t stepX[3], stepY[3], row[3], bias[3], offset[kMaxSamples][3];
-  const int64_t px0 = static_cast<int64_t>(x0) * 256 + 128;
-  const int64_t py0 = static_cast<int64_t>(y0) * 256 + 128;
+  detail::EdgeFunctions edges = detail::edgeFunctions(t, x0, y0);
+  int64_t(&row)[3] = edges.row;
+  const int64_t(&stepX)[3] = edges.stepX;
+  const int64_t(&stepY)[3] = edges.stepY;
+  const int64_t(&bias)[3] = edges.bias;
+  int64_t offset[kMaxSamples][3];
   int64_t widest[3];  // per edge, the largest sample offset: a row's pixels lie in its span
   for (int i = 0; i < 3; ++i) {
-    const int a = (i + 1) % 3, b = (i + 2) % 3;
-    const int64_t A = static_cast<int64_t>(t.y[a]) - t.y[b];
-    const int64_t B = static_cast<int64_t>(t.x[b]) - t.x[a];
-    stepX[i] = A * 256;
-    stepY[i] = B * 256;
-    bias[i] = (t.topLeft >> i) & 1 ? 0 : -1;
-    row[i] = B * (py0 - t.y[a]) + A * (px0 - t.x[a]) + bias[i];
     widest[i] = INT64_MIN;
     for (int s = 0; s < samples; ++s) {
-      offset[s][i] = A * sampleX_[s] + B * sampleY_[s];
+      offset[s][i] = edges.A[i] * sampleX_[s] + edges.B[i] * sampleY_[s];
       widest[i] = std::max(widest[i], offset[s][i]);
     }
   }
