@@ -441,6 +441,14 @@ TEST(Samples, TheCommandLineChecksItsSampleOptions) {
     EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
     EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
   }
+  const mfr::test::CliRun dataset =
+      mfr::test::runCli("dataset procedural:layers --width 16 --height 16 --samples 4 -q --out " +
+                            (dir / "d.mfrds").string(),
+                        dir);
+  EXPECT_EQ(dataset.exitCode, 1);
+  EXPECT_NE(dataset.err.find("--samples / --sample-storage: mfr dataset samples"),
+            std::string::npos)
+      << dataset.err;
   std::filesystem::remove_all(dir);
 }
 
