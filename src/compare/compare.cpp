@@ -3,7 +3,6 @@
 #include "mfr/compare/compare.hpp"
 
 #include "mfr/method/pass_plan.hpp"
-
 #include "mfr/method/peel.hpp"
 
 #include <algorithm>

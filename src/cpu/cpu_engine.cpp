@@ -38,15 +38,44 @@ const std::vector<uint8_t>& CpuView::edgePixels() const {
   return edges_;
 }
 
+const std::vector<uint32_t>& CpuView::fragmentCounts(const RasterFrame& frame) const {
+  const std::lock_guard lock(mutex_);
+  std::vector<uint32_t>& counts = &frame == &frame_ ? pixelCounts_ : sampleCounts_;
+  if (counts.empty()) counts = countFragments(frame);
+  return counts;
+}
+
 namespace {
+
+// The view a CPU engine's call receives, or the error naming the engine.
+Result<const CpuView*> cpuView(const PreparedView& view) {
+  const auto* cpu = dynamic_cast<const CpuView*>(&view);
+  if (!cpu) return makeError("engine cpu: the view was prepared by another engine");
+  return cpu;
+}
+
+// Per-sample storage back to image pixels: each run of `samples` consecutive values (one pixel's
+// samples) summed, or averaged with `mean` (the box filter), in place.
+template <class T>
+void reduceSamples(std::vector<T>& v, int samples, bool mean) {
+  for (size_t p = 0; p < v.size() / samples; ++p) {
+    T sum = T(0);
+    for (int s = 0; s < samples; ++s) sum += v[p * samples + s];
+    if (mean)
+      v[p] = sum / static_cast<float>(samples);
+    else
+      v[p] = sum;
+  }
+  v.resize(v.size() / samples);
+}
 
 // Multisampled renders: the fragments that did not get a node, at the pixels an edge crosses and
 // at the other covered pixels. n(p) and the nodes per storage pixel (RenderOutput::counts, which
 // render() leaves for a multisampled frame).
 void edgeStatistics(const CpuView& view, const RasterFrame& frame, RenderOutput& out) {
-  const std::vector<uint32_t> n = out.depthComplexity.size() == frame.pixelCount()
-                                      ? out.depthComplexity
-                                      : countFragments(frame);
+  const std::vector<uint32_t>& n = out.depthComplexity.size() == frame.pixelCount()
+                                       ? out.depthComplexity
+                                       : view.fragmentCounts(frame);
   const std::vector<uint8_t>& edges = view.edgePixels();
   const int per = frame.storagePerPixel();
   RenderStats& st = out.stats;
@@ -64,45 +93,20 @@ void edgeStatistics(const CpuView& view, const RasterFrame& frame, RenderOutput&
 // Per-sample storage: the W*S x H storage maps back to the image's W x H pixels. The image is
 // box-filtered (the mean of the samples); counts (n(p), k(p)) are summed over the samples.
 void toImagePixels(RenderOutput& out, int samples) {
-  const int w = out.image.width / samples, h = out.image.height;
-  ImageRGB image(w, h);
-  for (size_t p = 0; p < image.pixels.size(); ++p) {
-    glm::vec3 sum(0.0f);
-    for (int s = 0; s < samples; ++s) sum += out.image.pixels[p * samples + s];
-    image.pixels[p] = sum / static_cast<float>(samples);
-  }
-  out.image = std::move(image);
-  auto sumSamples = [&](std::vector<uint32_t>& v) {
-    if (v.empty()) return;
-    for (size_t p = 0; p < v.size() / samples; ++p) {
-      uint32_t sum = 0;
-      for (int s = 0; s < samples; ++s) sum += v[p * samples + s];
-      v[p] = sum;
-    }
-    v.resize(v.size() / samples);
-  };
-  sumSamples(out.kMap);
-  sumSamples(out.depthComplexity);
-  auto meanSamples = [&](std::vector<float>& v) {
-    if (v.empty()) return;
-    for (size_t p = 0; p < v.size() / samples; ++p) {
-      float sum = 0.0f;
-      for (int s = 0; s < samples; ++s) sum += v[p * samples + s];
-      v[p] = sum / static_cast<float>(samples);
-    }
-    v.resize(v.size() / samples);
-  };
-  meanSamples(out.importance.importance);
-  meanSamples(out.nearestCosine);
-  (void)h;
+  reduceSamples(out.image.pixels, samples, true);
+  out.image.width /= samples;
+  reduceSamples(out.kMap, samples, false);
+  reduceSamples(out.depthComplexity, samples, false);
+  reduceSamples(out.importance.importance, samples, true);
+  reduceSamples(out.nearestCosine, samples, true);
 }
 
 }  // namespace
 
 Result<const RasterFrame*> cpuFrame(const PreparedView& view) {
-  const auto* cpu = dynamic_cast<const CpuView*>(&view);
-  if (!cpu) return makeError("engine cpu: the view was prepared by another engine");
-  return &cpu->frame();
+  auto cpu = cpuView(view);
+  if (!cpu) return cpu.error();
+  return &(*cpu)->frame();
 }
 
 std::map<std::string, std::string> CpuEngine::describe() const {
@@ -133,8 +137,9 @@ Result<std::unique_ptr<PreparedView>> CpuEngine::prepare(const View& view) {
 
 Result<RenderOutput> CpuEngine::render(const PreparedView& view, const MethodDesc& method,
                                        const RenderOptions& options) {
-  const auto* cpu = dynamic_cast<const CpuView*>(&view);
-  if (!cpu) return makeError("engine cpu: the view was prepared by another engine");
+  auto viewed = cpuView(view);
+  if (!viewed) return viewed.error();
+  const CpuView* cpu = *viewed;
   const int samples = cpu->samples();
   auto frame = cpu->frame(sampleStorageOf(method, options));
   if (!frame) return frame.error();
@@ -162,20 +167,14 @@ Result<RenderOutput> CpuEngine::render(const PreparedView& view, const MethodDes
 }
 
 Result<std::vector<uint32_t>> CpuEngine::countFragments(const PreparedView& view) {
-  const auto* cpu = dynamic_cast<const CpuView*>(&view);
-  if (!cpu) return makeError("engine cpu: the view was prepared by another engine");
-  if (cpu->samples() == 1) return mfr::countFragments(cpu->frame());
+  auto cpu = cpuView(view);
+  if (!cpu) return cpu.error();
+  if ((*cpu)->samples() == 1) return mfr::countFragments((*cpu)->frame());
   // multisampled: the fragments of the pixel's samples (the per-sample A-buffer's nodes)
-  auto frame = cpu->frame(SampleStorage::Sample);
+  auto frame = (*cpu)->frame(SampleStorage::Sample);
   if (!frame) return frame.error();
-  std::vector<uint32_t> n = mfr::countFragments(**frame);
-  const int samples = cpu->samples();
-  for (size_t p = 0; p < n.size() / samples; ++p) {
-    uint32_t sum = 0;
-    for (int s = 0; s < samples; ++s) sum += n[p * samples + s];
-    n[p] = sum;
-  }
-  n.resize(n.size() / samples);
+  std::vector<uint32_t> n = (*cpu)->fragmentCounts(**frame);
+  reduceSamples(n, (*cpu)->samples(), false);
   return n;
 }
 

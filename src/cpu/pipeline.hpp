@@ -233,17 +233,13 @@ ImageRGB resolveSortedNodes(const RasterFrame& frame, const MethodDesc& method,
         const uint32_t n = stores.counts[p];
         if (n == 0 && (!hybrid || stores.tails[p].count == 0)) continue;
         const FragmentNode* sorted = sortNodes(nodesOf(p, n, scratch), n, small, large);
-        if (masked > 1) {
-          if (covering.size() < n) covering.resize(n);
-          image.pixels[p] = compositeSamples(
-              sorted, n, masked, covering.data(), [&](const FragmentNode* nodes, uint32_t m) {
-                return hybrid ? compositeHybrid(nodes, m, stores.tails[p], background)
-                              : compositeKBuffer(nodes, m, background);
-              });
-          continue;
-        }
-        image.pixels[p] = hybrid ? compositeHybrid(sorted, n, stores.tails[p], background)
-                                 : compositeKBuffer(sorted, n, background);
+        const auto rule = [&](const FragmentNode* nodes, uint32_t m) {
+          return hybrid ? compositeHybrid(nodes, m, stores.tails[p], background)
+                        : compositeKBuffer(nodes, m, background);
+        };
+        if (masked > 1 && covering.size() < n) covering.resize(n);
+        image.pixels[p] = masked > 1 ? compositeSamples(sorted, n, masked, covering.data(), rule)
+                                     : rule(sorted, n);
       }
   });
   return image;

@@ -30,6 +30,9 @@ class CpuView final : public PreparedView {
   /// Multisampled views: 1 where an edge crosses the image pixel (some fragment covers part of
   /// its samples), else 0 (built once, on first use).
   const std::vector<uint8_t>& edgePixels() const;
+  /// n(p) of each storage pixel of `frame` (this view's frame of that discipline), counted once:
+  /// a multisampled render's edge statistics and every countFragments of the view read it.
+  const std::vector<uint32_t>& fragmentCounts(const RasterFrame& frame) const;
 
  private:
   RasterFrame frame_;
@@ -38,6 +41,7 @@ class CpuView final : public PreparedView {
   mutable std::mutex mutex_;
   mutable std::unique_ptr<RasterFrame> sampleFrame_;
   mutable std::vector<uint8_t> edges_;
+  mutable std::vector<uint32_t> pixelCounts_, sampleCounts_;  // fragmentCounts, per discipline
 };
 
 class CpuEngine final : public Engine {
