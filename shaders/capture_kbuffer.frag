@@ -53,7 +53,7 @@ layout(std430, binding = kBindCaptureStats) buffer CaptureStats {
 // The critical section: the store update and the tail, for one pixel's fragments one at a time.
 void insertNode(const uint p, const uint first, const uint k, const uint storeKind, const bool store,
                 const uvec2 node) {
-  uint tailColor = node.y;
+  uvec2 tailNode = node;
   bool toTail = !store;
   const uvec2 maxNode = k > 0u ? nodes[first] : uvec2(kFarDepthBits, 0u);
   if (!store) {
@@ -92,17 +92,18 @@ void insertNode(const uint p, const uint first, const uint k, const uint storeKi
   }
   if (store && nodeLess(node, maxNode) && maxNode.x != kFarDepthBits) {
     toTail = true;  // evicted (an empty slot's far node is not a fragment)
-    tailColor = maxNode.y;
+    tailNode = maxNode;
   }
-  if (toTail && uHybrid != 0u) {  // mfr::HybridTail::add (method_math.h's hybridTailAdd)
+  if (toTail && uHybrid != 0u) {  // mfr::HybridTail::add (method_math.h's hybridTailAddCovered)
     const uint t = kTailWords * p;
     float r = uintBitsToFloat(tails[t]), g = uintBitsToFloat(tails[t + 1u]),
           b = uintBitsToFloat(tails[t + 2u]), sumA = uintBitsToFloat(tails[t + 3u]);
     uint count = tails[t + 4u];
+    const uint tailColor = tailNode.y;
     precise float a = float(tailColor >> 24) * uInv255;
-    hybridTailAddNode(r, g, b, sumA, count, tailColor >> 24, a, srgb8ToLinear(tailColor & 0xffu),
-                  srgb8ToLinear((tailColor >> 8) & 0xffu),
-                  srgb8ToLinear((tailColor >> 16) & 0xffu));
+    hybridTailAddCovered(r, g, b, sumA, count, tailColor >> 24, a,
+                         srgb8ToLinear(tailColor & 0xffu), srgb8ToLinear((tailColor >> 8) & 0xffu),
+                         srgb8ToLinear((tailColor >> 16) & 0xffu), coverageShare(tailNode.x));
     tails[t] = floatBitsToUint(r);
     tails[t + 1u] = floatBitsToUint(g);
     tails[t + 2u] = floatBitsToUint(b);

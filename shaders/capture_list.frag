@@ -59,9 +59,12 @@ void main() {
   } else if (uHybrid != 0u) {  // mfr::HybridTail::add's terms (method_math.h's hybridTailAdd)
     const uint t = kTailWords * f.pixel;
     // hybridTailAddNode: an additive node (alpha byte 0) adds its emission and no alpha
+    // (hybridTailAddCovered: weighted by the share of the pixel's samples the fragment covers)
     const bool additive = (rgba >> 24) == kAdditiveNode;
-    precise float a = float(rgba >> 24) * uInv255;
-    const float w = additive ? 1.0 : a;
+    const float share = coverageShare(depthBits);
+    precise float a8 = float(rgba >> 24) * uInv255;
+    precise float a = a8 * share;
+    const float w = additive ? share : a;
     precise float ar = w * srgb8ToLinear(rgba & 0xffu);
     precise float ag = w * srgb8ToLinear((rgba >> 8) & 0xffu);
     precise float ab = w * srgb8ToLinear((rgba >> 16) & 0xffu);

@@ -166,8 +166,8 @@ uint packBlended(uint mode, vec3 rgb, float alpha) {
 uint shadeWithCosine(FragmentData f, vec4 base, out float cosine) {
   const vec3 n = fragmentNormal(f);
   const float nx = n.x, ny = n.y, nz = n.z;
-  precise float dx = float(f.px.x) * uRay.x + uRay.y;
-  precise float dy = float(f.px.y) * uRay.z + uRay.w;
+  precise float dx = f.pos.x * uRay.x + uRay.y;
+  precise float dy = f.pos.y * uRay.z + uRay.w;
   precise float nn = (nx * nx + ny * ny + nz * nz) * (dx * dx + dy * dy + 1.0);
   precise float num = nz - nx * dx - ny * dy;
   precise float root = sqrt(nn);

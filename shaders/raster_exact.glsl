@@ -24,6 +24,7 @@ uniform ivec2 uSize;
 struct FragmentData {
   ivec2 px;
   int pixel;
+  vec2 pos;  // the pixel's index (its centre: one sample)
   float l0, l1, l2;
 };
 
@@ -32,6 +33,7 @@ struct FragmentData {
 bool rasterFragment(out FragmentData f) {
   f.px = ivec2(gl_FragCoord.xy);
   f.pixel = f.px.y * uSize.x + f.px.x;
+  f.pos = vec2(f.px);
   const double px0 = double(f.px.x * 256 + 128);
   const double py0 = double(f.px.y * 256 + 128);
   double w[3];
@@ -102,4 +104,9 @@ float fragmentDepth(FragmentData f) {
 // raster.geom culled the back faces at set-up, as the CPU engine does: every fragment here is kept
 bool fragmentBackFacing() {
   return false;
+}
+
+// the share of the pixel's samples a node covers: the exact raster has one sample
+float coverageShare(uint depthBits) {
+  return 1.0;
 }

@@ -4,10 +4,22 @@
 // shader. This is the part an engine replaces with its own vertex outputs: a fragment is the
 // pixel GL shades, its depth gl_FragCoord.z, its normal, uv and colour the interpolated varyings, its
 // material the triangle's (gl_PrimitiveID indexes the draw's triangles).
+//
+// Multisampling (--samples S > 1, core/samples.hpp): the framebuffer has S samples, whose
+// positions GlEngine::create checked to be the standard pattern (uSampleOffsets). GL runs this
+// shader once per pixel and triangle with the covered samples in gl_SampleMaskIn (per-pixel
+// storage: the fragment is evaluated at its first covered sample and carries the mask in its
+// depth's low bits, method_math.h's withCoverageBits), or, with sample shading at rate 1, once per
+// covered sample (per-sample storage: the fragment is the sample's, stored at storage pixel
+// (x S + s, y) of the W S x H storage).
 in vec3 vNormal;  // view space
 in vec2 vUv;
 in vec4 vColor;  // perspective-correct vertex colour
+in vec2 vClipZW;  // clip z and w: window depth at a sample as z / w (interpolateAtSample)
 
+uniform int uSamples;  // samples per pixel (1: the pixel centre)
+uniform uint uSampleStorage;  // multisampled: 1 per-sample storage, 0 per-pixel with masks
+uniform vec2 uSampleOffsets[kMaxSampleSums];  // each sample's offset from the centre, in pixels
 uniform ivec2 uSize;
 uniform uint uVertexColors;  // the scene has vertex colours (else vColor is white, not multiplied)
 
@@ -16,13 +28,27 @@ layout(std430, binding = kBindTriMaterial) readonly buffer TriMaterial {
 };
 
 struct FragmentData {
-  ivec2 px;   // pixel, rows top to bottom (raster_native.vert flips y)
-  int pixel;  // px.y * width + px.x
+  ivec2 px;   // storage pixel, rows top to bottom (raster_native.vert flips y)
+  int pixel;  // px.y * storage width + px.x
+  vec2 pos;   // where the fragment is evaluated, in pixels (the image pixel's index at its centre)
+  int sampleIndex;  // multisampled: the sample it is evaluated at
+  uint coverage;  // multisampled: the covered samples (per-pixel storage)
 };
 
-// every fragment GL generates is covered
+// every fragment GL generates is covered (at one sample at least)
 bool rasterFragment(out FragmentData f) {
-  f.px = ivec2(gl_FragCoord.xy);
+  const ivec2 px = ivec2(gl_FragCoord.xy);
+  f.px = px;
+  f.pos = vec2(px);
+  f.sampleIndex = 0;
+  f.coverage = 1u;
+  if (uSamples > 1) {
+    f.coverage = uint(gl_SampleMaskIn[0]) & sampleBits(uSamples);
+    if (f.coverage == 0u) return false;
+    f.sampleIndex = findLSB(f.coverage);  // per-sample shading: the one bit of the invocation's sample
+    f.pos = vec2(px) + uSampleOffsets[f.sampleIndex];
+    if (uSampleStorage != 0u) f.px = ivec2(px.x * uSamples + f.sampleIndex, px.y);
+  }
   f.pixel = f.px.y * uSize.x + f.px.x;
   return true;
 }
@@ -39,11 +65,11 @@ bool fragmentBackFacing() {
 }
 
 vec2 fragmentUv(FragmentData f) {
-  return vUv;
+  return uSamples > 1 ? interpolateAtSample(vUv, f.sampleIndex) : vUv;
 }
 
 vec3 fragmentNormal(FragmentData f) {
-  return vNormal;
+  return uSamples > 1 ? interpolateAtSample(vNormal, f.sampleIndex) : vNormal;
 }
 
 // vertex colours: every triangle of a scene that has them (GL's interpolation of an all-white
@@ -53,10 +79,24 @@ bool fragmentHasColor() {
 }
 
 vec4 fragmentColor(FragmentData f) {
-  return vColor;
+  return uSamples > 1 ? interpolateAtSample(vColor, f.sampleIndex) : vColor;
 }
 
-// window depth (glDepthRange 0..1: z_ndc / 2 + 1/2), clamped to [0, 1] as the exact raster does
+// window depth (glDepthRange 0..1: z_ndc / 2 + 1/2), clamped to [0, 1] as the exact raster does;
+// multisampled: at the fragment's sample (z / w of the perspective-correct clip z and w), with
+// per-pixel storage's coverage mask in the low bits
 float fragmentDepth(FragmentData f) {
-  return clamp(gl_FragCoord.z, 0.0, 1.0);
+  if (uSamples <= 1) return clamp(gl_FragCoord.z, 0.0, 1.0);
+  const vec2 zw = interpolateAtSample(vClipZW, f.sampleIndex);
+  precise float z = zw.x / zw.y * 0.5 + 0.5;
+  const float depth = clamp(z, 0.0, 1.0);
+  if (uSampleStorage != 0u) return depth;
+  return uintBitsToFloat(withCoverageBits(floatBitsToUint(depth), f.coverage, uSamples));
+}
+
+// the share of the pixel's samples a node covers (per-pixel storage: its mask's samples over
+// the pixel's, which weights it in the hybrid tail); 1 otherwise
+float coverageShare(uint depthBits) {
+  if (uSamples <= 1 || uSampleStorage != 0u) return 1.0;
+  return float(bitCount(depthBits & sampleBits(uSamples))) / float(uSamples);
 }

@@ -12,6 +12,7 @@ uniform mat3 uViewRot;
 out vec3 vNormal;  // view space
 out vec2 vUv;
 out vec4 vColor;
+out vec2 vClipZW;  // clip z and w (the multisampled depth, raster_native.glsl)
 
 void main() {
   const vec4 clip = uViewProj * vec4(inPosition, 1.0);
@@ -19,4 +20,5 @@ void main() {
   vNormal = uViewRot * inNormal;
   vUv = inUv;
   vColor = inColor;
+  vClipZW = clip.zw;
 }

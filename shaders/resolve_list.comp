@@ -38,6 +38,7 @@ uniform uint uHybrid;
 uniform uint uPixels;
 uniform vec3 uBackground;
 uniform float uInv255;
+uniform int uMaskSamples;  // per-pixel multisampled storage: the samples of the nodes' masks
 
 float srgb8ToLinear(uint code) {
   return uintBitsToFloat(colorTables[kTableLinearBase + code]);
@@ -51,7 +52,8 @@ void main() {
   const uint group = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
   const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
   if (p >= uPixels) return;
-  float r = 0.0f, g = 0.0f, b = 0.0f, tr = 1.0f, tg = 1.0f, tb = 1.0f;
+  // (one sum, or one per sample of per-pixel multisampled storage: method_math.h)
+  SampleSums sums = emptySampleSums(uMaskSamples);
   uint n = 0u;
   for (uint a = heads[p]; a != kListEnd; a = pool[kListNodeWords * a + 2u]) {
     uint best = a;
@@ -72,8 +74,8 @@ void main() {
     }
     const uint rgba = bestKey.y;
     precise float alpha = float(rgba >> 24) * uInv255;
-    blendStep(r, g, b, tr, tg, tb, rgba >> 24, alpha, srgb8ToLinear(rgba & 0xffu),
-              srgb8ToLinear((rgba >> 8) & 0xffu), srgb8ToLinear((rgba >> 16) & 0xffu));
+    blendSampleNode(sums, bestKey.x, rgba >> 24, alpha, srgb8ToLinear(rgba & 0xffu),
+                    srgb8ToLinear((rgba >> 8) & 0xffu), srgb8ToLinear((rgba >> 16) & 0xffu));
     ++n;
   }
   lengths[p] = n;
@@ -84,7 +86,7 @@ void main() {
                           uintBitsToFloat(tails[t + 2u]));
     behind = hybridBehind(sum, uintBitsToFloat(tails[t + 3u]), tails[t + 4u], uBackground);
   }
-  const vec3 result = overBackground(vec3(r, g, b), vec3(tr, tg, tb), behind);
+  const vec3 result = resolveSampleSums(sums, behind);
   image[3u * p + 0u] = result.r;
   image[3u * p + 1u] = result.g;
   image[3u * p + 2u] = result.b;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <vector>
 
@@ -449,6 +450,55 @@ TEST(Samples, TheCommandLineChecksItsSampleOptions) {
   EXPECT_NE(dataset.err.find("--samples / --sample-storage: mfr dataset samples"),
             std::string::npos)
       << dataset.err;
+  std::filesystem::remove_all(dir);
+}
+
+// compare --sample-counts: every method at each count against that count's own truth, in
+// results.json and as the report's error-vs-bytes-per-pixel figure; bad lists are one line.
+TEST(Samples, CompareRunsEverySampleCountAndPlotsThem) {
+  const std::filesystem::path dir = mfr::test::processTempDir("mfr_sample_counts");
+  const std::string common =
+      "compare procedural:bottles?count=3 --width 32 --height 24 -q "
+      "-m kplus-heap,abuffer -M 40KB,80KB -o " +
+      (dir / "out").string();
+  const mfr::test::CliRun ok = mfr::test::runCli(common + " --sample-counts 1,4", dir);
+  ASSERT_EQ(ok.exitCode, 0) << ok.err;
+  std::ifstream in(dir / "out" / "results.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["sample_counts"].size(), 2u);
+  EXPECT_EQ(j["sample_counts"][0]["samples"], 1);
+  EXPECT_EQ(j["sample_counts"][1]["samples"], 4);
+  // the 1-sample entry is the main comparison's runs (--samples 1)
+  EXPECT_EQ(j["sample_counts"][0]["budgets"][1]["methods"][0]["flip_mean"],
+            j["budgets"][1]["methods"][0]["flip_mean"]);
+  for (const nlohmann::json& count : j["sample_counts"]) {
+    ASSERT_EQ(count["budgets"].size(), 2u);
+    const nlohmann::json& heap = count["budgets"][1]["methods"][0];
+    ASSERT_EQ(heap["name"], "kplus-heap");
+    ASSERT_FALSE(heap.contains("error")) << heap;
+    EXPECT_LE(heap["bytes_used"].get<uint64_t>(), 80u << 10);
+    EXPECT_EQ(heap["samples"], count["samples"]);
+  }
+  // per-pixel masks at 4 samples: a triangle's fragment in every pixel it covers a sample of, a
+  // superset of the pixels whose centre it covers
+  const uint64_t one = j["sample_counts"][0]["budgets"][1]["methods"][0]["fragments_generated"];
+  const uint64_t four = j["sample_counts"][1]["budgets"][1]["methods"][0]["fragments_generated"];
+  EXPECT_GT(four, one);
+  std::ifstream page(dir / "out" / "report.html");
+  const std::string html((std::istreambuf_iterator<char>(page)), std::istreambuf_iterator<char>());
+  EXPECT_NE(html.find("Mean FLIP vs bytes per pixel at 1, 4 samples"), std::string::npos);
+  EXPECT_NE(html.find("data-series=\"kplus-heap, 4 samples\""), std::string::npos);
+  const std::pair<std::string, std::string> bad[] = {
+      {" --sample-counts 1,3", "--sample-counts '3': expected 1, 2, 4 or 8"},
+      {" --sample-counts 4,4", "--sample-counts '4,4': 4 listed twice"},
+      {" --sample-counts 1,4 --orbit 3", "--sample-counts: not with a temporal comparison"},
+  };
+  for (const auto& [args, message] : bad) {
+    const mfr::test::CliRun r = mfr::test::runCli(common + args, dir);
+    EXPECT_EQ(r.exitCode, 1) << args;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+  }
   std::filesystem::remove_all(dir);
 }
 

@@ -1,6 +1,7 @@
 // mfr compare: the ground truth and several methods at several budgets, written as images,
 // results.json, results.csv and a self-contained report.html (the work is in the library:
 // mfr/compare/compare.hpp).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -44,7 +45,8 @@ struct CompareArgs {
   std::optional<int64_t> maxPeels;  // --max-peels (peel, dual-peel)
   std::string capture = "tile";
   double pixelsPerDegree = kFlipDefaultPixelsPerDegree;
-  double orbitStep = 0.0;  // --orbit N without --orbit-view: degrees between frames (0: 360 / N)
+  double orbitStep = 0.0;    // --orbit N without --orbit-view: degrees between frames (0: 360 / N)
+  std::string sampleCounts;  // --sample-counts 1,4,8: the comparison at each count too
 };
 
 std::vector<std::string> splitList(const std::string& text) {
@@ -185,6 +187,18 @@ int run(const CompareArgs& a, const std::string& version) {
   if (a.orbitStep > 0.0 && !temporal)
     return fail("--orbit-step: needs --orbit N (and no --orbit-view)");
   if (a.out.empty()) return fail("--out: an output folder is required");
+  std::vector<int> sampleCounts;
+  if (!a.sampleCounts.empty()) {
+    if (temporal) return fail("--sample-counts: not with a temporal comparison (--orbit N)");
+    for (const std::string& text : splitList(a.sampleCounts)) {
+      auto count = parseSamples(text, "--sample-counts");
+      if (!count) return fail(count.error().message);
+      if (std::find(sampleCounts.begin(), sampleCounts.end(), *count) != sampleCounts.end())
+        return fail("--sample-counts " + quoteInput(a.sampleCounts) + ": " + text +
+                    " listed twice");
+      sampleCounts.push_back(*count);
+    }
+  }
   CompareOptions options;
   options.scene = a.scene.source;
   options.seed = a.scene.seed;
@@ -289,6 +303,30 @@ int run(const CompareArgs& a, const std::string& version) {
   };
   auto result = runComparison(**engine, **view, options);
   if (!result) return fail(echoPath(a.scene.source) + ": " + result.error().message);
+  // --sample-counts: the same comparison at each count, against that count's own ground truth
+  for (const int count : sampleCounts) {
+    if (count == result->samples) {
+      result->sampleCounts.push_back(sampleCountRuns(*result));
+      continue;
+    }
+    View at = sceneView(*prepared, a.scene, prepared->cameras.front());
+    at.samples = count;
+    auto counted = (*engine)->prepare(at);
+    if (!counted)
+      return fail(echoPath(a.scene.source) + ": --sample-counts " + std::to_string(count) + ": " +
+                  counted.error().message);
+    CompareOptions o = options;
+    if (o.progress) {
+      o.progress = [&progress, count](const std::string& stage, int done, int total) {
+        progress.set(std::to_string(count) + " samples: " + stage, done, total);
+      };
+    }
+    auto other = runComparison(**engine, **counted, o);
+    if (!other)
+      return fail(echoPath(a.scene.source) + ": --sample-counts " + std::to_string(count) + ": " +
+                  other.error().message);
+    result->sampleCounts.push_back(sampleCountRuns(*other));
+  }
   const CompareResult& r = result.value();
 
   // files
@@ -335,6 +373,11 @@ Runner addCompareCommand(CLI::App& app) {
   cmd->add_option("--model", args->model,
                   "Deep k-buffer model (.mfrnn, from mfr train; default: the built-in model)");
   cmd->add_option("--ppd", args->pixelsPerDegree, "FLIP pixels per degree (default 67.02)");
+  cmd->add_option("--sample-counts", args->sampleCounts,
+                  "Sample counts, comma-separated (1, 2, 4, 8): also run the comparison at each, "
+                  "against its own per-sample ground truth, and plot every method's error "
+                  "against bytes per pixel per count in the report (results.json "
+                  "sample_counts)");
   cmd->add_option("--orbit-step", args->orbitStep,
                   "With --orbit N (temporal comparison): degrees between consecutive frames "
                   "(default 360 / N)");

@@ -57,7 +57,7 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
       ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   app.add_option("--samples", samples,
                  "Samples per pixel: 1, 2, 4 or 8 at the standard Direct3D / Vulkan positions "
-                 "(antialiasing; CPU engine) (default 1)");
+                 "(antialiasing; both engines, GL on its native raster) (default 1)");
   app.add_option("--sample-storage", sampleStorage,
                  "With --samples > 1, how a method stores a pixel's samples: pixel (one node per "
                  "fragment with its coverage mask, composited per sample) or sample (nodes per "

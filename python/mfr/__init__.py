@@ -162,7 +162,7 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
     max_peels: depth peeling (peel, dual-peel): at most this many geometry passes, as
         `mfr render --max-peels` (the rest dropped, or with composite="hybrid" blended into a tail).
     samples: 1, 2, 4 or 8 samples per pixel at the standard Direct3D / Vulkan positions
-        (antialiasing, engine="cpu"), as `mfr --samples`; sample_storage: "pixel" (one node per
+        (antialiasing, both engines), as `mfr --samples`; sample_storage: "pixel" (one node per
         fragment with its coverage mask) or "sample" (nodes per sample), as `mfr
         --sample-storage` (docs/METHODS.md, multisampling). The arrays are per pixel: the image
         box-filtered, k_map and depth_complexity summed over the samples.

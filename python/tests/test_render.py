@@ -278,6 +278,31 @@ def test_samples_and_sample_storage():
         mfr.render("procedural:layers", width=W, height=H, samples=2, sample_storage="node")
 
 
+def test_samples_on_the_gl_engine():
+    # --samples 4 (what llvmpipe rasterizes) on GL's native raster: the CPU engine's fragments and
+    # a close image with both storage disciplines; the exact raster refuses it in one line
+    scene = "procedural:bottles?count=3"
+    try:
+        gl = mfr.render(scene, width=W, height=H, method="kplus-heap", k=4, engine="gl", samples=4)
+    except mfr.Error as e:  # no GL 4.5 context, or a driver without 4 standard samples
+        if os.environ.get("CI") == "true":
+            raise
+        pytest.skip(str(e))
+    for storage in ("pixel", "sample"):
+        gl = mfr.render(scene, width=W, height=H, method="kplus-heap", k=4, engine="gl",
+                        samples=4, sample_storage=storage, capture="parallel")
+        cpu = mfr.render(scene, width=W, height=H, method="kplus-heap", k=4, samples=4,
+                         sample_storage=storage, capture="parallel")
+        assert gl.image.shape == cpu.image.shape == (H, W, 3)
+        assert gl.stats["samples"] == 4 and gl.stats["sample_storage"] == storage
+        assert gl.stats["fragments_generated"] == cpu.stats["fragments_generated"]
+        assert gl.stats["edge_pixels"] == cpu.stats["edge_pixels"] > 0
+        assert np.abs(gl.image - cpu.image).mean() < 2e-3
+    with pytest.raises(mfr.Error, match=r"--gl-raster exact: --samples 4: the exact raster"):
+        mfr.render(scene, width=W, height=H, method="kplus-heap", k=4, engine="gl",
+                   gl_raster="exact", samples=4)
+
+
 def test_engine_names_and_bad_engine():
     assert mfr.engine_names()[0] == "cpu"
     with pytest.raises(mfr.Error, match=r"engine"):

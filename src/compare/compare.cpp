@@ -340,6 +340,18 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   return result;
 }
 
+SampleCountRuns sampleCountRuns(const CompareResult& result) {
+  SampleCountRuns out;
+  out.samples = result.samples;
+  out.budgets = result.budgets;
+  for (CompareBudget& cb : out.budgets)
+    for (CompareRun& run : cb.runs) {
+      run.image = run.flipMap = run.kMap = run.importanceMap = Image8{};
+      run.imageFile = run.flipFile = run.kMapFile = run.importanceFile = {};
+    }
+  return out;
+}
+
 nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersion) {
   nlohmann::json j;
   if (!mfrVersion.empty()) j["mfr_version"] = mfrVersion;
@@ -371,6 +383,24 @@ nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersi
   }
   j["methods"] = budgets.empty() ? nlohmann::json::array() : budgets[0]["methods"];
   j["budgets"] = budgets;
+  if (!r.sampleCounts.empty()) {  // --sample-counts: the metrics and statistics per count
+    nlohmann::json counts = nlohmann::json::array();
+    for (const SampleCountRuns& sc : r.sampleCounts) {
+      nlohmann::json perBudget = nlohmann::json::array();
+      for (const CompareBudget& cb : sc.budgets) {
+        nlohmann::json runs = nlohmann::json::array();
+        for (const CompareRun& run : cb.runs) {
+          nlohmann::json entry = runToJson(run);
+          entry.erase("image");  // (no images at the other counts)
+          runs.push_back(std::move(entry));
+        }
+        perBudget.push_back(
+            {{"budget_bytes", cb.budgetBytes}, {"budget_label", cb.label}, {"methods", runs}});
+      }
+      counts.push_back({{"samples", sc.samples}, {"budgets", perBudget}});
+    }
+    j["sample_counts"] = counts;
+  }
   return j;
 }
 

@@ -664,6 +664,22 @@ std::string resultsSection(const CompareResult& r) {
   return h;
 }
 
+// ticks of a bytes-per-pixel axis from lo to hi: the data's range (whole bytes) and nice values
+// between
+void bytesPerPixelTicks(double lo, double hi, std::vector<uint64_t>& ticks,
+                        std::vector<std::string>& tickLabels) {
+  const double a = std::max(1.0, std::floor(lo)), b = std::max(std::ceil(hi), a + 1.0);
+  ticks.push_back(static_cast<uint64_t>(a));
+  tickLabels.push_back(format("%g B", a));
+  for (double t : niceTicks(a, b, 4))
+    if (t > a + 0.5 && t < b - 0.5) {
+      ticks.push_back(static_cast<uint64_t>(std::llround(t)));
+      tickLabels.push_back(format("%g B", std::round(t)));
+    }
+  ticks.push_back(static_cast<uint64_t>(b));
+  tickLabels.push_back(format("%g B", b));
+}
+
 // every method's error against the bytes per pixel it was charged (bytes_used / pixels):
 // methods that do not spend the whole budget (wboit, mboit, vkb) sit where they really are; byBytes
 // holds the mean FLIP over the budgets in `order`. Empty when no run succeeded.
@@ -687,17 +703,7 @@ std::string bytesPerPixelFigure(const CompareResult& r, const std::vector<size_t
   if (std::isfinite(lo)) {
     std::vector<uint64_t> ticks;
     std::vector<std::string> tickLabels;
-    // ticks: the data's range (whole bytes) and nice values between
-    const double a = std::max(1.0, std::floor(lo)), b = std::max(std::ceil(hi), a + 1.0);
-    ticks.push_back(static_cast<uint64_t>(a));
-    tickLabels.push_back(format("%g B", a));
-    for (double t : niceTicks(a, b, 4))
-      if (t > a + 0.5 && t < b - 0.5) {
-        ticks.push_back(static_cast<uint64_t>(std::llround(t)));
-        tickLabels.push_back(format("%g B", std::round(t)));
-      }
-    ticks.push_back(static_cast<uint64_t>(b));
-    tickLabels.push_back(format("%g B", b));
+    bytesPerPixelTicks(lo, hi, ticks, tickLabels);
     h += "<figure>" +
          svgPlot("Mean FLIP vs bytes per pixel", "mean FLIP", false, true, byBytes, ticks,
                  tickLabels, "bytes per pixel charged (bytes_used / pixels)") +
@@ -706,6 +712,48 @@ std::string bytesPerPixelFigure(const CompareResult& r, const std::vector<size_t
          "</figure>\n";
   }
   return h;
+}
+
+// --sample-counts: each method's error against the bytes per pixel it was charged, one series per
+// method and sample count (colour: the method, marker: the count), each count against its own
+// ground truth. Empty without sample counts or successful runs.
+std::string sampleCountsFigure(const CompareResult& r,
+                               const std::vector<std::string>& methodNames) {
+  if (r.sampleCounts.empty()) return {};
+  const double pixels = static_cast<double>(r.width) * static_cast<double>(r.height);
+  std::vector<Series> series;
+  double lo = INFINITY, hi = 0.0;
+  for (size_t m = 0; m < methodNames.size(); ++m)
+    for (size_t c = 0; c < r.sampleCounts.size(); ++c) {
+      const SampleCountRuns& sc = r.sampleCounts[c];
+      Series s;
+      s.name = methodNames[m] + format(", %d sample%s", sc.samples, sc.samples == 1 ? "" : "s");
+      s.colour = kPalette[m % (sizeof kPalette / sizeof kPalette[0])];
+      s.marker = static_cast<int>(c);
+      for (const CompareBudget& cb : sc.budgets) {
+        if (m >= cb.runs.size() || !cb.runs[m].ok()) continue;
+        const double bpp = static_cast<double>(cb.runs[m].stats.bytesUsed) / pixels;
+        s.points.emplace_back(bpp, cb.runs[m].metrics.flipMean);
+        lo = std::min(lo, bpp);
+        hi = std::max(hi, bpp);
+      }
+      std::sort(s.points.begin(), s.points.end());
+      series.push_back(std::move(s));
+    }
+  if (!std::isfinite(lo)) return {};
+  std::vector<uint64_t> ticks;
+  std::vector<std::string> tickLabels;
+  bytesPerPixelTicks(lo, hi, ticks, tickLabels);
+  std::string counts;
+  for (const SampleCountRuns& sc : r.sampleCounts)
+    counts += (counts.empty() ? "" : ", ") + std::to_string(sc.samples);
+  return "<figure>" +
+         svgPlot("Mean FLIP vs bytes per pixel at " + counts + " samples", "mean FLIP", false, true,
+                 series, ticks, tickLabels, "bytes per pixel charged (bytes_used / pixels)") +
+         "<figcaption>Each method at each sample count (--sample-counts; marker: the count), "
+         "against that count's own ground truth (the per-sample A-buffer, box-filtered), with " +
+         escape(toString(r.sampleStorage)) +
+         " storage: what antialiasing costs each method in memory.</figcaption></figure>\n";
 }
 
 // 3 Error vs memory budget: the plots over the budgets, smallest first (two budgets or more)
@@ -837,6 +885,11 @@ std::string compareReportHtml(const CompareResult& r, const ReportInfo& info) {
   h += resultsSection(r);
   int section = 3;
   if (r.budgets.size() > 1) h += budgetPlots(r, methodNames, section++);
+  if (!r.sampleCounts.empty()) {
+    h += format("<h2 id=\"samples\">%d&ensp;Error vs bytes per pixel per sample count</h2>\n",
+                section++);
+    h += "<div class=\"plots\">\n" + sampleCountsFigure(r, methodNames) + "</div>\n";
+  }
   h += imagesSection(r, section++);
   h += notesSection(r, section);
   h += "<footer>Generated by " + escape(info.mfrVersion.empty() ? "mfr" : info.mfrVersion) +

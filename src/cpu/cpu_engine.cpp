@@ -54,51 +54,13 @@ Result<const CpuView*> cpuView(const PreparedView& view) {
   return cpu;
 }
 
-// Per-sample storage back to image pixels: each run of `samples` consecutive values (one pixel's
-// samples) summed, or averaged with `mean` (the box filter), in place.
-template <class T>
-void reduceSamples(std::vector<T>& v, int samples, bool mean) {
-  for (size_t p = 0; p < v.size() / samples; ++p) {
-    T sum = T(0);
-    for (int s = 0; s < samples; ++s) sum += v[p * samples + s];
-    if (mean)
-      v[p] = sum / static_cast<float>(samples);
-    else
-      v[p] = sum;
-  }
-  v.resize(v.size() / samples);
-}
-
-// Multisampled renders: the fragments that did not get a node, at the pixels an edge crosses and
-// at the other covered pixels. n(p) and the nodes per storage pixel (RenderOutput::counts, which
-// render() leaves for a multisampled frame).
+// Multisampled renders: edgeStatistics from n(p) and the nodes per storage pixel
+// (RenderOutput::counts, which render() leaves for a multisampled frame).
 void edgeStatistics(const CpuView& view, const RasterFrame& frame, RenderOutput& out) {
   const std::vector<uint32_t>& n = out.depthComplexity.size() == frame.pixelCount()
                                        ? out.depthComplexity
                                        : view.fragmentCounts(frame);
-  const std::vector<uint8_t>& edges = view.edgePixels();
-  const int per = frame.storagePerPixel();
-  RenderStats& st = out.stats;
-  out.lostPerPixel.assign(edges.size(), 0);
-  for (size_t q = 0; q < n.size(); ++q) {
-    const uint32_t captured = q < out.counts.size() ? std::min(out.counts[q], n[q]) : n[q];
-    const size_t pixel = q / per;
-    out.lostPerPixel[pixel] += n[q] - captured;
-    (edges[pixel] ? st.lostAtEdges : st.lostInside) += n[q] - captured;
-    (edges[pixel] ? st.fragmentsAtEdges : st.fragmentsInside) += n[q];
-  }
-  st.edgePixels = static_cast<uint64_t>(std::count(edges.begin(), edges.end(), uint8_t{1}));
-}
-
-// Per-sample storage: the W*S x H storage maps back to the image's W x H pixels. The image is
-// box-filtered (the mean of the samples); counts (n(p), k(p)) are summed over the samples.
-void toImagePixels(RenderOutput& out, int samples) {
-  reduceSamples(out.image.pixels, samples, true);
-  out.image.width /= samples;
-  reduceSamples(out.kMap, samples, false);
-  reduceSamples(out.depthComplexity, samples, false);
-  reduceSamples(out.importance.importance, samples, true);
-  reduceSamples(out.nearestCosine, samples, true);
+  mfr::edgeStatistics(n, out.counts, view.edgePixels(), frame.storagePerPixel(), out);
 }
 
 }  // namespace
@@ -173,9 +135,10 @@ Result<std::vector<uint32_t>> CpuEngine::countFragments(const PreparedView& view
   // multisampled: the fragments of the pixel's samples (the per-sample A-buffer's nodes)
   auto frame = (*cpu)->frame(SampleStorage::Sample);
   if (!frame) return frame.error();
-  std::vector<uint32_t> n = (*cpu)->fragmentCounts(**frame);
-  reduceSamples(n, (*cpu)->samples(), false);
-  return n;
+  RenderOutput counted;
+  counted.depthComplexity = (*cpu)->fragmentCounts(**frame);
+  toImagePixels(counted, (*cpu)->samples());
+  return std::move(counted.depthComplexity);
 }
 
 Result<std::vector<float>> CpuEngine::nearestCosine(const PreparedView& view) {

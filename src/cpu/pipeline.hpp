@@ -225,7 +225,7 @@ ImageRGB resolveSortedNodes(const RasterFrame& frame, const MethodDesc& method,
   frame.forEachTile([&](int tile) {
     if (frame.tileBegin(tile) == frame.tileEnd(tile)) return;
     FragmentNode small[kSortNetworkSize];
-    std::vector<FragmentNode> scratch, large, covering;  // grow once per tile
+    std::vector<FragmentNode> scratch, large;  // grow once per tile
     const TileRect r = frame.tileRect(tile);
     for (int y = r.y0; y <= r.y1; ++y)
       for (int x = r.x0; x <= r.x1; ++x) {
@@ -233,13 +233,12 @@ ImageRGB resolveSortedNodes(const RasterFrame& frame, const MethodDesc& method,
         const uint32_t n = stores.counts[p];
         if (n == 0 && (!hybrid || stores.tails[p].count == 0)) continue;
         const FragmentNode* sorted = sortNodes(nodesOf(p, n, scratch), n, small, large);
-        const auto rule = [&](const FragmentNode* nodes, uint32_t m) {
-          return hybrid ? compositeHybrid(nodes, m, stores.tails[p], background)
-                        : compositeKBuffer(nodes, m, background);
-        };
-        if (masked > 1 && covering.size() < n) covering.resize(n);
-        image.pixels[p] = masked > 1 ? compositeSamples(sorted, n, masked, covering.data(), rule)
-                                     : rule(sorted, n);
+        if (masked > 1)
+          image.pixels[p] = compositeSamples(
+              sorted, n, masked, hybrid ? tailBehind(stores.tails[p], background) : background);
+        else
+          image.pixels[p] = hybrid ? compositeHybrid(sorted, n, stores.tails[p], background)
+                                   : compositeKBuffer(sorted, n, background);
       }
   });
   return image;

@@ -15,6 +15,7 @@
 #include <utility>
 
 #include "gl/gl_state.hpp"
+#include "gl/shader_sources.hpp"
 #include "mfr/core/color.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/gl/shared_layout.h"
@@ -70,6 +71,16 @@ void GlEngine::State::setRasterUniforms(GLuint p) const {
   glProgramUniformMatrix4fv(p, loc(p, "uViewProj"), 1, GL_FALSE, &viewProj[0][0]);
   glProgramUniformMatrix3fv(p, loc(p, "uViewRot"), 1, GL_FALSE, &viewRot[0][0]);
   glProgramUniform2i(p, loc(p, "uSize"), width, height);
+  glProgramUniform1i(p, loc(p, "uSamples"), sampling.samples);
+  glProgramUniform1ui(p, loc(p, "uSampleStorage"),
+                      sampling.storage == SampleStorage::Sample ? 1u : 0u);
+  GLfloat offsets[2 * kMaxSamples] = {};
+  const auto pattern = samplePattern(sampling.samples);
+  for (size_t i = 0; i < pattern.size(); ++i) {
+    offsets[2 * i] = static_cast<float>(pattern[i].x) / 16.0f;
+    offsets[2 * i + 1] = static_cast<float>(pattern[i].y) / 16.0f;
+  }
+  glProgramUniform2fv(p, loc(p, "uSampleOffsets"), kMaxSamples, offsets);
   glProgramUniform1d(p, loc(p, "uMaxNdc"), kMaxNdc);
   glProgramUniform4f(p, loc(p, "uRay"), ray.x, ray.y, ray.z, ray.w);
   glProgramUniform1f(p, loc(p, "uAmbient"), kAmbient);
@@ -80,7 +91,14 @@ void GlEngine::State::setRasterUniforms(GLuint p) const {
 
 void GlEngine::State::drawScene() const {
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
-  glViewport(0, 0, width, height);
+  glViewport(0, 0, rasterWidth, height);
+  // per-sample storage: one invocation per covered sample, its inputs at the sample
+  if (sampling.samples > 1 && sampling.storage == SampleStorage::Sample) {
+    glEnable(GL_SAMPLE_SHADING);
+    glMinSampleShading(1.0f);
+  } else {
+    glDisable(GL_SAMPLE_SHADING);
+  }
   glDisable(GL_DEPTH_TEST);
   glDisable(GL_CULL_FACE);
   glDisable(GL_BLEND);
@@ -99,12 +117,12 @@ void GlEngine::State::drawScene() const {
 void GlEngine::State::placeCamera(const Camera& cameraIn, const Scene& scene) {
   camera = fitClipPlanes(cameraIn, sceneBounds(scene));
   const glm::mat4 view = viewMatrix(camera);
-  viewProj = projectionMatrix(camera, width, height) * view;
+  viewProj = projectionMatrix(camera, rasterWidth, height) * view;
   viewRot = glm::mat3(view);
   const float tanHalf = std::tan(glm::radians(camera.fovYDegrees) * 0.5f);
-  const float aspect = static_cast<float>(width) / static_cast<float>(height);
-  ray.x = 2.0f * tanHalf * aspect / static_cast<float>(width);
-  ray.y = (1.0f / static_cast<float>(width) - 1.0f) * tanHalf * aspect;
+  const float aspect = static_cast<float>(rasterWidth) / static_cast<float>(height);
+  ray.x = 2.0f * tanHalf * aspect / static_cast<float>(rasterWidth);
+  ray.y = (1.0f / static_cast<float>(rasterWidth) - 1.0f) * tanHalf * aspect;
   ray.z = -2.0f * tanHalf / static_cast<float>(height);
   ray.w = (1.0f - 1.0f / static_cast<float>(height)) * tanHalf;
 }
@@ -208,9 +226,100 @@ void GlEngine::State::uploadColorTables() {
 // the attachment-less framebuffer of the raster passes and the timer query
 void GlEngine::State::createFramebufferAndQuery() {
   glCreateFramebuffers(1, &fbo);
-  glNamedFramebufferParameteri(fbo, GL_FRAMEBUFFER_DEFAULT_WIDTH, width);
+  glNamedFramebufferParameteri(fbo, GL_FRAMEBUFFER_DEFAULT_WIDTH, rasterWidth);
   glNamedFramebufferParameteri(fbo, GL_FRAMEBUFFER_DEFAULT_HEIGHT, height);
+  if (sampling.samples > 1)
+    glNamedFramebufferParameteri(fbo, GL_FRAMEBUFFER_DEFAULT_SAMPLES, sampling.samples);
   glCreateQueries(GL_TIME_ELAPSED, 1, &query);
+}
+
+namespace {
+
+// The sample-pattern probe: one pixel covered whole, each sample's invocation (sample shading)
+// records its position in 1/16 pixel, every invocation its coverage mask. GL window y is the
+// image's y (raster_native.vert negates clip y), so a position is the image's offset + 8/16.
+constexpr const char* kProbeVertex = R"(#version 450 core
+void main() {
+  const vec2 corner[3] = vec2[](vec2(-1.0, -1.0), vec2(3.0, -1.0), vec2(-1.0, 3.0));
+  gl_Position = vec4(corner[gl_VertexID], 0.0, 1.0);
+}
+)";
+constexpr const char* kProbeFragment = R"(#version 450 core
+layout(std430, binding = 0) buffer Probe {
+  uint mask;
+  uint positions[];  // x | y << 8, in 1/16 pixel from the pixel's corner
+};
+void main() {
+  atomicOr(mask, uint(gl_SampleMaskIn[0]));
+  positions[gl_SampleID] =
+      uint(gl_SamplePosition.x * 16.0 + 0.5) | (uint(gl_SamplePosition.y * 16.0 + 0.5) << 8);
+}
+)";
+
+std::string offsetText(int x, int y) {
+  std::string text = std::to_string(x);
+  text += ", ";
+  text += std::to_string(y);
+  text.insert(0, 1, '(');
+  text += ")/16";
+  return text;
+}
+
+}  // namespace
+
+Result<void> GlEngine::State::checkSamplePattern() const {
+  const int samples = sampling.samples;
+  const std::string what = "--engine gl: --samples " + std::to_string(samples);
+  GLint maxSamples = 0;
+  glGetIntegerv(GL_MAX_FRAMEBUFFER_SAMPLES, &maxSamples);
+  if (samples > maxSamples)
+    return makeError(what + ": above this GL's GL_MAX_FRAMEBUFFER_SAMPLES (" +
+                     std::to_string(maxSamples) + ")");
+  auto vs = compileShaderSource(GL_VERTEX_SHADER, "sample pattern probe", kProbeVertex);
+  if (!vs) return vs.error();
+  auto fs = compileShaderSource(GL_FRAGMENT_SHADER, "sample pattern probe", kProbeFragment);
+  if (!fs) return fs.error();
+  const GLuint program = glCreateProgram();
+  glAttachShader(program, *vs);
+  glAttachShader(program, *fs);
+  glLinkProgram(program);
+  glDeleteShader(*vs);
+  glDeleteShader(*fs);
+  std::vector<uint32_t> words(1 + kMaxSamples, 0xffffffffu);
+  words[0] = 0;
+  GLuint buffer = 0;
+  glCreateBuffers(1, &buffer);
+  glNamedBufferData(buffer, static_cast<GLsizeiptr>(words.size() * 4), words.data(),
+                    GL_DYNAMIC_COPY);
+  glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffer);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo);
+  glViewport(0, 0, 1, 1);
+  glEnable(GL_SAMPLE_SHADING);
+  glMinSampleShading(1.0f);
+  glUseProgram(program);
+  glBindVertexArray(vao);
+  glDrawArrays(GL_TRIANGLES, 0, 3);
+  glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+  glGetNamedBufferSubData(buffer, 0, static_cast<GLsizeiptr>(words.size() * 4), words.data());
+  glDisable(GL_SAMPLE_SHADING);
+  glUseProgram(0);
+  glDeleteBuffers(1, &buffer);
+  glDeleteProgram(program);
+  const int got = std::popcount(words[0]);
+  if (got != samples)
+    return makeError(what + ": this GL rasterizes " + std::to_string(got) +
+                     " samples per pixel for " + std::to_string(samples) +
+                     " (GL_MAX_FRAMEBUFFER_SAMPLES " + std::to_string(maxSamples) + ")");
+  const auto pattern = samplePattern(samples);
+  for (int i = 0; i < samples; ++i) {
+    const int x = static_cast<int>(words[1 + i] & 0xffu) - 8;
+    const int y = static_cast<int>((words[1 + i] >> 8) & 0xffu) - 8;
+    if (x != pattern[i].x || y != pattern[i].y)
+      return makeError(what + ": this GL's sample " + std::to_string(i) + " lies at " +
+                       offsetText(x, y) + " from the pixel centre, not at the standard " +
+                       offsetText(pattern[i].x, pattern[i].y));
+  }
+  return {};
 }
 
 GlEngine::GlEngine(std::unique_ptr<State> state) : state_(std::move(state)) {}
@@ -242,6 +351,9 @@ int GlEngine::width() const {
 }
 int GlEngine::height() const {
   return state_->height;
+}
+const GlSampling& GlEngine::sampling() const {
+  return state_->sampling;
 }
 const Camera& GlEngine::camera() const {
   return state_->camera;
@@ -284,17 +396,31 @@ Result<void> checkGlLimits(int width, int height) {
 
 Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
                                   const Camera& cameraIn, int width, int height, bool interlock,
-                                  GlRaster raster) {
+                                  GlRaster raster, GlSampling sampling) {
   MFR_TRY(checkCreateArgs(scene, cameraIn, width, height));
+  if (samplePattern(sampling.samples).empty())
+    return makeError("--samples " + std::to_string(sampling.samples) + ": expected 1, 2, 4 or 8");
+  if (sampling.samples > 1 && raster == GlRaster::Exact)
+    return makeError("--gl-raster exact: --samples " + std::to_string(sampling.samples) +
+                     ": the exact raster emulates one sample per pixel (use --gl-raster native)");
+  if (sampling.samples == 1) sampling.storage = SampleStorage::Pixel;
+  const int per = sampling.storage == SampleStorage::Sample ? sampling.samples : 1;
+  if (static_cast<int64_t>(width) * per > kMaxImageSize)
+    return makeError("image size " + std::to_string(width) + "x" + std::to_string(height) +
+                     " with per-sample storage of " + std::to_string(per) +
+                     " samples: the storage's width must be at most " +
+                     std::to_string(kMaxImageSize));
   context.makeCurrent();
-  MFR_TRY(checkGlLimits(width, height));
+  MFR_TRY(checkGlLimits(width * per, height));
 
   auto s = std::make_unique<State>();
   GLint64 maxBlock = 0;
   glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &maxBlock);
   s->maxBlockBytes = static_cast<uint64_t>(maxBlock);
-  s->width = width;
+  s->width = width * per;
+  s->rasterWidth = width;
   s->height = height;
+  s->sampling = sampling;
   s->placeCamera(cameraIn, scene);
   s->raster = raster;
   s->vertexColors = !scene.colors.empty();
@@ -308,21 +434,44 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   s->uploadColorTables();
   s->createFramebufferAndQuery();
   if (s->uploadFailure) return *s->uploadFailure;
+  if (sampling.samples > 1) MFR_TRY(s->checkSamplePattern());
+  // the resolves of per-pixel storage composite each sample from the nodes' coverage masks
+  for (const ProgramId id : {ProgramId::Resolve, ProgramId::ListResolve}) {
+    const GLuint p = s->program(id);
+    glProgramUniform1i(p, loc(p, "uMaskSamples"), s->maskSamples());
+  }
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
     return makeError("--engine gl: scene upload failed (GL error " + glErrorText(e) + ")");
   return GlEngine(std::move(s));
 }
 
 Result<std::vector<uint32_t>> GlEngine::count() {
-  State& s = *state_;
+  return state_->countPass(false);
+}
+
+Result<std::vector<uint8_t>> GlEngine::edgePixels() {
+  if (state_->maskSamples() == 1)
+    return makeError("--engine gl: edge pixels need a multisampled view with per-pixel storage");
+  auto partial = state_->countPass(true);
+  if (!partial) return partial.error();
+  std::vector<uint8_t> edges(partial->size());
+  for (size_t p = 0; p < edges.size(); ++p) edges[p] = (*partial)[p] > 0 ? 1 : 0;
+  return edges;
+}
+
+Result<std::vector<uint32_t>> GlEngine::State::countPass(bool edges) const {
+  const State& s = *this;
   const uint64_t pixels = s.pixels();
   std::map<std::string, uint64_t> ledger;
   FrameBuffers fb(&ledger);
   const GLuint counts = fb.make("counts", pixels * 4);
   clearUint(counts, 0);
-  glUseProgram(s.program(ProgramId::Count));
+  const GLuint program = s.program(ProgramId::Count);
+  glProgramUniform1ui(program, loc(program, "uEdges"), edges ? 1u : 0u);
+  glUseProgram(program);
   fb.bindImage(counts, kBindCounts);
   s.drawScene();
+  glProgramUniform1ui(program, loc(program, "uEdges"), 0u);  // the other count passes count all
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT);
   if (fb.failure) return *fb.failure;
   std::vector<uint32_t> n(pixels);

@@ -30,16 +30,39 @@ namespace {
 
 class GlView final : public PreparedView {
  public:
-  GlView(GlEngine engine, const View& view, const GlContext& context)
-      : engine_(std::move(engine)), view_(view), context_(&context) {}
+  GlView(GlEngine engine, const View& view, const GlContext& context, bool interlock)
+      : engine_(std::move(engine)), view_(view), context_(&context), interlock_(interlock) {}
   // the view's GL objects are deleted in its own context, whichever another GL engine on this
   // thread made current since (the view must not outlive its engine)
   ~GlView() override { context_->makeCurrent(); }
   GlView(const GlView&) = delete;
   GlView& operator=(const GlView&) = delete;
-  int width() const override { return engine_.width(); }
-  int height() const override { return engine_.height(); }
+  int width() const override { return view_.width; }
+  int height() const override { return view_.height; }
+  int samples() const override { return view_.samples; }
+  /// The engine of a storage discipline: the view's own (one sample, or per-pixel storage with
+  /// coverage masks), or, multisampled with per-sample storage, a second one made on first use.
+  Result<GlEngine*> engine(SampleStorage storage) const {
+    if (view_.samples == 1 || storage == SampleStorage::Pixel) return &engine_;
+    if (!sampleEngine_) {
+      auto made = GlEngine::create(*context_, *view_.scene, view_.camera, view_.width, view_.height,
+                                   interlock_, engine_.raster(),
+                                   GlSampling{view_.samples, SampleStorage::Sample});
+      if (!made) return made.error();
+      sampleEngine_ = std::make_unique<GlEngine>(std::move(made.value()));
+    }
+    return sampleEngine_.get();
+  }
   GlEngine& engine() const { return engine_; }
+  /// Multisampled: the pixels an edge crosses (the per-pixel engine's coverage), once per view.
+  Result<const std::vector<uint8_t>*> edgePixels() const {
+    if (edges_.empty()) {
+      auto edges = engine_.edgePixels();
+      if (!edges) return edges.error();
+      edges_ = std::move(edges.value());
+    }
+    return &edges_;
+  }
   const View& view() const { return view_; }  // for the CPU oracle of the optimal k-buffer
   /// True the first time: the first render of a view warms up (shader compilation, llvmpipe's
   /// first-frame timer values), later ones are timed as they run.
@@ -47,8 +70,11 @@ class GlView final : public PreparedView {
 
  private:
   mutable GlEngine engine_;  // rendering changes GL state, not the view
+  mutable std::unique_ptr<GlEngine> sampleEngine_;
+  mutable std::vector<uint8_t> edges_;
   View view_;
   const GlContext* context_;
+  bool interlock_ = false;
   mutable bool first_ = true;
 };
 
@@ -63,6 +89,8 @@ Result<OracleChoice> cpuOracle(const View& view, const MethodDesc& method,
   RasterOptions ro;
   ro.width = view.width;
   ro.height = view.height;
+  ro.samples = view.samples;
+  ro.storage = sampleStorageOf(method, options);
   auto frame = RasterFrame::build(*view.scene, view.camera, ro);
   if (!frame) return frame.error();
   return optimalK(*frame, method, options, slots);
@@ -70,10 +98,13 @@ Result<OracleChoice> cpuOracle(const View& view, const MethodDesc& method,
 
 // dkb-curve's n(p) and k(p) from the CPU engine's passes (predictedCurveK,
 // mfr/cpu/dkb_curve_pass.hpp) on the same view.
-Result<CurveChoice> cpuCurves(const View& view, const MethodDesc& method, uint64_t slots) {
+Result<CurveChoice> cpuCurves(const View& view, const MethodDesc& method,
+                              const RenderOptions& options, uint64_t slots) {
   RasterOptions ro;
   ro.width = view.width;
   ro.height = view.height;
+  ro.samples = view.samples;
+  ro.storage = sampleStorageOf(method, options);
   auto frame = RasterFrame::build(*view.scene, view.camera, ro);
   if (!frame) return frame.error();
   return predictedCurveK(*frame, method, slots);
@@ -90,13 +121,14 @@ MemoryModel glMemoryModel(const MethodDesc& method) {
 // resolve, the statistics.
 class GlFrame {
  public:
-  GlFrame(const GlView& view, const MethodDesc& method, const PassPlan& plan,
+  GlFrame(const GlView& view, GlEngine& engine, const MethodDesc& method, const PassPlan& plan,
           const RenderOptions& options)
       : gv_(view),
+        engine_(engine),
         method_(method),
         plan_(plan),
         options_(options),
-        layout_{view.width(), view.height(), 0},  // row-major prefix sums on GL
+        layout_{engine.width(), engine.height(), 0},  // row-major prefix sums on GL; storage
         memory_(glMemoryModel(method)) {}
 
   /// Counted, dynamic and importance-map k: count, histogram, importance, k(p), prefix sum in
@@ -127,7 +159,7 @@ class GlFrame {
     if (method_.allocation == AllocationPolicy::Pool) {  // the pool: F(M), or every fragment
       if (!options_.budgetBytes) {
         MFR_TRY(budgetSlots(layout_, method_, memory_, options_.budgetBytes));
-        auto counted = gv_.engine().count();
+        auto counted = engine_.count();
         if (!counted) return counted.error();
         n_ = std::move(counted.value());
       }
@@ -155,11 +187,11 @@ class GlFrame {
     go.poolNodes = poolNodes;
     // (GL's own n(p) only: the optimal k-buffer's and dkb-curve's come from CPU passes)
     go.counts = n_.empty() || method_.allocation == AllocationPolicy::Optimal ? nullptr : &n_;
-    auto gl = gv_.engine().render(method_, go);
+    auto gl = engine_.render(method_, go);
     if (!gl) return gl.error();
     GlRenderOutput& g = gl.value();
     // the A-buffer's slots are its fragments: the budget check needs the count pass's n(p)
-    auto a = onDevice() ? gv_.engine().readDeviceAllocation()
+    auto a = onDevice() ? engine_.readDeviceAllocation()
              : perPixel
                  ? Result<Allocation>(std::move(*perPixel))
                  : allocate(layout_, method_, memory_, options_.budgetBytes, g.counts, {}, {});
@@ -171,6 +203,12 @@ class GlFrame {
     // linked lists: k(p), the nodes each list got (depth peeling's held are fragments, not k)
     if (method_.store == StoreChoice::LinkedList && !g.held.empty()) a->capacity = g.held;
     fillStats(g, a.value(), interlock);
+    if (engine_.sampling().samples > 1) {
+      auto edges = gv_.edgePixels();
+      if (!edges) return edges.error();
+      edgeStatistics(g.counts, capturedPerPixel(*technique, g, a.value()), **edges,
+                     engine_.width() / gv_.width(), out_);
+    }
     out_.image = std::move(g.image);
     out_.kMap = a->reservedK.empty() ? std::move(a->capacity) : std::move(a->reservedK);
     out_.depthComplexity = std::move(g.counts);
@@ -179,30 +217,63 @@ class GlFrame {
       out_.offsets = std::move(g.nodeOffsets);
       out_.counts = std::move(g.nodeCounts);
     }
+    const GlSampling& sampling = engine_.sampling();
+    if (sampling.samples > 1 && sampling.storage == SampleStorage::Sample)
+      toImagePixels(out_, sampling.samples);  // the W S x H storage to the W x H image
     return std::move(out_);
   }
 
  private:
+  /// The nodes each storage pixel kept of its n(p) fragments, as the CPU engine's stores count
+  /// them (edgeStatistics takes min(n(p), this)); empty: every fragment (the accumulating peers).
+  std::vector<uint32_t> capturedPerPixel(GlTechnique technique, const GlRenderOutput& g,
+                                         const Allocation& a) const {
+    switch (technique) {
+      case GlTechnique::ABuffer:
+      case GlTechnique::Wboit:
+      case GlTechnique::Mboit:
+      case GlTechnique::Aoit:
+      case GlTechnique::Dfaoit:
+        return {};
+      case GlTechnique::KBuffer:
+      case GlTechnique::Mlab:
+        if (a.capacity.size() == layout_.pixels()) return a.capacity;
+        return std::vector<uint32_t>(layout_.pixels(), method_.k.value_or(0));
+      case GlTechnique::LinkedList:
+      case GlTechnique::Peel:
+        return g.held;
+    }
+    return {};
+  }
+
   uint64_t slots() const { return memory_.fragmentSlots(*options_.budgetBytes, layout_.pixels()); }
 
-  const std::vector<float>& previousCosine(const std::vector<float>& otherwise) const {
+  const std::vector<float>& previousCosine(const std::vector<float>& otherwise) {
     const std::vector<float>* previous = options_.previousNearestCosine;
-    return previous && previous->size() == layout_.pixels() ? *previous : otherwise;
+    if (!previous) return otherwise;
+    if (previous->size() == layout_.pixels()) return *previous;
+    // per-sample storage: the previous image's |n.v| for each of its pixel's samples
+    const uint64_t per = previous->empty() ? 0 : layout_.pixels() / previous->size();
+    if (per < 2 || previous->size() * per != layout_.pixels()) return otherwise;
+    expandedCosine_.clear();
+    expandedCosine_.reserve(layout_.pixels());
+    for (float c : *previous) expandedCosine_.insert(expandedCosine_.end(), per, c);
+    return expandedCosine_;
   }
 
   /// The device allocation; the global k of a counted or dynamic k.
   Result<std::optional<uint32_t>> allocateOnDevice() {
     MFR_TRY(budgetSlots(layout_, method_, memory_, options_.budgetBytes));  // before any pass
     std::vector<GlPassTime> passes;
-    auto summary = gv_.engine().countOnDevice(&passes);
+    auto summary = engine_.countOnDevice(&passes);
     if (!summary) return summary.error();
     std::optional<uint32_t> globalK;
     if (method_.allocation == AllocationPolicy::Importance) {
       MFR_TRY(
           checkCoveredPixels(layout_, method_, memory_, options_.budgetBytes, summary->covered));
       static const std::vector<float> none;
-      auto totals = gv_.engine().allocateByImportance(method_.importance, previousCosine(none),
-                                                      slots(), method_.store, &passes);
+      auto totals = engine_.allocateByImportance(method_.importance, previousCosine(none), slots(),
+                                                 method_.store, &passes);
       if (!totals) return totals.error();
       // floor(P(p) F(M)) sums to at most F(M) with IEEE double arithmetic (as on the host);
       // a driver whose double division rounds otherwise could exceed it by a few slots
@@ -214,7 +285,7 @@ class GlFrame {
     } else {
       auto k = boundedK(layout_, method_, memory_, options_.budgetBytes, *summary);
       if (!k) return k.error();
-      auto totals = gv_.engine().allocateCapped(*k, method_.store, &passes);
+      auto totals = engine_.allocateCapped(*k, method_.store, &passes);
       if (!totals) return totals.error();
       MFR_TRY(
           checkBoundedSlots(layout_, method_, memory_, options_.budgetBytes, *k, totals->slots));
@@ -230,7 +301,7 @@ class GlFrame {
     std::vector<uint32_t> oracleK;
     auto t0 = std::chrono::steady_clock::now();
     if (plan_.predictedCurves) {  // dkb-curve: features, network and hull on the host
-      auto chosen = cpuCurves(gv_.view(), method_, slots());
+      auto chosen = cpuCurves(gv_.view(), method_, options_, slots());
       if (!chosen) return chosen.error();
       n_ = std::move(chosen->n);
       oracleK = std::move(chosen->k);
@@ -243,7 +314,7 @@ class GlFrame {
       out_.stats.oracle = std::move(chosen->report);
       hostPasses_.push_back({"oracle (cpu)", msSince(t0)});
     } else {
-      auto counted = gv_.engine().count();
+      auto counted = engine_.count();
       if (!counted) return counted.error();
       n_ = std::move(counted.value());
       hostPasses_.push_back({"count (n(p) read back)", msSince(t0)});
@@ -273,7 +344,7 @@ class GlFrame {
       weights.insert(weights.end(), b.data(), b.data() + b.size());
     }
     std::vector<GlPassTime> passes;
-    auto importance = gv_.engine().dkbImportance(weights, slots(), &passes);
+    auto importance = engine_.dkbImportance(weights, slots(), &passes);
     if (!importance) return importance.error();
     out_.importance.importance = std::move(importance.value());
     for (const GlPassTime& t : passes) hostPasses_.push_back({t.name, t.wallMs});
@@ -283,7 +354,7 @@ class GlFrame {
   /// The variable k-buffer: the nearest |n.v| on GL, the map on the host.
   Result<void> heuristicImportance() {
     auto t0 = std::chrono::steady_clock::now();
-    auto cosine = gv_.engine().nearestCosine();
+    auto cosine = engine_.nearestCosine();
     if (!cosine) return cosine.error();
     out_.nearestCosine = std::move(cosine.value());
     hostPasses_.push_back({"nearest_normal", msSince(t0)});
@@ -297,10 +368,10 @@ class GlFrame {
   /// The device allocation's importance maps, read back for the output.
   Result<void> readDeviceMaps() {
     if (method_.allocation != AllocationPolicy::Importance) return {};
-    auto maps = gv_.engine().readImportance();
+    auto maps = engine_.readImportance();
     if (!maps) return maps.error();
     out_.importance = std::move(maps.value());
-    auto cosine = gv_.engine().readNearestCosine();
+    auto cosine = engine_.readNearestCosine();
     if (!cosine) return cosine.error();
     out_.nearestCosine = std::move(cosine.value());
     return {};
@@ -324,6 +395,8 @@ class GlFrame {
     s.culledKPlus = g.culledKPlus;
     s.engine = "gl";
     s.cull = gv_.view().scene->cull;
+    s.samples = engine_.sampling().samples;
+    s.sampleStorage = engine_.sampling().storage;
     s.passes = std::move(hostPasses_);  // the host side of a variable-k allocation first
     for (const GlPassTime& t : g.passes) {
       s.passes.push_back({t.name, t.wallMs});  // llvmpipe's GL_TIME_ELAPSED is not usable
@@ -331,19 +404,21 @@ class GlFrame {
     }
     s.engineCounters["sync_interlock"] = interlock ? 1 : 0;  // the k-buffer capture's sync
     // the geometry passes: 1 GL's own pipeline (--gl-raster native), 0 the emulated (exact)
-    s.engineCounters["raster_native"] = gv_.engine().raster() == GlRaster::Native ? 1 : 0;
+    s.engineCounters["raster_native"] = engine_.raster() == GlRaster::Native ? 1 : 0;
     // the fixed-k capture with 64-bit atomicMin instead of the lock (where the driver has them)
     s.engineCounters["atomic64"] = g.atomic64 ? 1 : 0;
   }
 
   const GlView& gv_;
+  GlEngine& engine_;  // the view's engine of the method's storage discipline
   MethodDesc method_;
   const PassPlan& plan_;
   const RenderOptions& options_;
   const PixelLayout layout_;
   const MemoryModel memory_;
   std::vector<PassTime> hostPasses_;
-  std::vector<uint32_t> n_;  // host allocation: n(p) measured first, reused by the frame
+  std::vector<uint32_t> n_;            // host allocation: n(p) measured first, reused by the frame
+  std::vector<float> expandedCosine_;  // per-sample storage: the previous |n.v| per sample
   RenderOutput out_;
 };
 
@@ -381,14 +456,12 @@ class GlRenderEngine final : public Engine {
 
   Result<std::unique_ptr<PreparedView>> prepare(const View& view) override {
     if (!view.scene) return makeError("--engine gl: a view without a scene");
-    if (view.samples != 1)
-      return makeError("--engine gl: --samples " + std::to_string(view.samples) +
-                       ": multisampling runs on the CPU engine only (--engine cpu)");
+    // (multisampled: the engine of per-pixel storage; GlView makes per-sample storage's on use)
     auto engine = GlEngine::create(context_, *view.scene, view.camera, view.width, view.height,
-                                   interlock_, raster_);
+                                   interlock_, raster_, GlSampling{view.samples});
     if (!engine) return engine.error();
     return std::unique_ptr<PreparedView>(
-        std::make_unique<GlView>(std::move(engine.value()), view, context_));
+        std::make_unique<GlView>(std::move(engine.value()), view, context_, interlock_));
   }
 
   Result<RenderOutput> render(const PreparedView& view, const MethodDesc& method,
@@ -399,11 +472,16 @@ class GlRenderEngine final : public Engine {
     auto plan = planPasses(method, options);
     if (!plan) return plan.error();
     MFR_TRY(checkBlendSupport(method, gv->view().scene->blendModes()));
-    return GlFrame(*gv, method, plan.value(), options).run(interlock_);
+    auto engine = gv->engine(sampleStorageOf(method, options));
+    if (!engine) return engine.error();
+    return GlFrame(*gv, **engine, method, plan.value(), options).run(interlock_);
   }
 
   Result<std::vector<uint32_t>> countFragments(const PreparedView& view) override {
-    auto out = render(view, methodPreset("abuffer").value(), RenderOptions{});
+    // multisampled: the per-sample A-buffer's nodes, summed per pixel (as the CPU engine counts)
+    RenderOptions options;
+    options.sampleStorage = SampleStorage::Sample;
+    auto out = render(view, methodPreset("abuffer").value(), options);
     if (!out) return out.error();
     return std::move(out->depthComplexity);
   }

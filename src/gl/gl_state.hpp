@@ -37,7 +37,9 @@ struct RenderPlan {
 };
 
 struct GlEngine::State {
-  int width = 0, height = 0;
+  int width = 0, height = 0;  // the storage's (per-sample storage: W * samples x H)
+  int rasterWidth = 0;        // the framebuffer's (the image's W)
+  GlSampling sampling;
   Camera camera;
   glm::mat4 viewProj{1.0f};
   glm::mat3 viewRot{1.0f};
@@ -82,6 +84,18 @@ struct GlEngine::State {
   Result<void> uploadMaterials(const Scene& scene);
   void uploadColorTables();
   void createFramebufferAndQuery();
+  /// the count pass: n(p), or with `edges` the fragments that cover part of their pixel
+  Result<std::vector<uint32_t>> countPass(bool edges) const;
+  /// the framebuffer's samples per pixel and their positions against the standard pattern
+  Result<void> checkSamplePattern() const;
+  /// multisampled: the storage pixels one image pixel has (per-sample storage: the samples)
+  int storagePerPixel() const {
+    return sampling.storage == SampleStorage::Sample ? sampling.samples : 1;
+  }
+  /// the samples of the coverage masks in the nodes' depths (per-pixel storage), else 1
+  int maskSamples() const {
+    return sampling.storage == SampleStorage::Pixel ? sampling.samples : 1;
+  }
 
   // --- one frame (gl_frame.cpp) ---
   /// the method's technique and allocation, checked against the block size

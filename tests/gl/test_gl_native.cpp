@@ -4,7 +4,9 @@
 // snapping decide where a pixel centre lies on an edge), bytes_used identical, and the image's
 // mean LDR-FLIP against the CPU engine's image at most 2e-3. The measured figures are recorded as
 // test properties (ctest --output-junit, or the test's XML output). Without a GL 4.5 context the
-// tests skip (fail under CI=true).
+// tests skip (fail under CI=true). The multisampled cases (--samples 4, the count llvmpipe offers)
+// hold the native raster to the same bounds with per-pixel storage (coverage masks from
+// gl_SampleMaskIn, composited per sample) and per-sample storage (sample shading).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -36,6 +38,8 @@ struct NativeCase {
   const char* scene;
   int width, height;
   uint64_t budget;
+  int samples = 1;
+  SampleStorage storage = SampleStorage::Pixel;
 };
 
 class GlNative : public ::testing::TestWithParam<NativeCase> {};
@@ -47,7 +51,7 @@ TEST_P(GlNative, AgreesWithTheCpuEngineOnEveryPreset) {
   const Scene scene = loadScene(c.scene).value();
   const Camera camera =
       scene.defaultCamera ? *scene.defaultCamera : frameBounds(sceneBounds(scene));
-  const View view{&scene, camera, c.width, c.height};
+  const View view{&scene, camera, c.width, c.height, c.samples};
   CpuEngine cpu(EngineOptions{2, 16});
   auto gv = gl->prepare(view);
   auto cv = cpu.prepare(view);
@@ -68,8 +72,11 @@ TEST_P(GlNative, AgreesWithTheCpuEngineOnEveryPreset) {
   const double differFraction = static_cast<double>(differ) / static_cast<double>(gn.size());
   EXPECT_LE(differFraction, 1e-3) << differ << " of " << gn.size() << " pixels";
   RecordProperty("np_differing_fraction", std::to_string(differFraction));
-  std::printf("[ native ] %s %dx%d: n(p) differs at %zu of %zu pixels (%.4f%%)\n", c.scene, c.width,
-              c.height, differ, gn.size(), 100.0 * differFraction);
+  std::printf(
+      "[ native ] %s %dx%d, %d samples (%s storage): n(p) differs at %zu of %zu pixels "
+      "(%.4f%%)\n",
+      c.scene, c.width, c.height, c.samples, toString(c.storage), differ, gn.size(),
+      100.0 * differFraction);
 
   int checked = 0;
   double worstFlip = 0.0;
@@ -88,6 +95,7 @@ TEST_P(GlNative, AgreesWithTheCpuEngineOnEveryPreset) {
       RenderOptions options;
       if (method.allocation != AllocationPolicy::Unbounded) options.budgetBytes = c.budget;
       options.background = glm::vec3(0.2f, 0.4f, 0.6f);
+      options.sampleStorage = c.storage;
       RenderOptions cpuOptions = options;  // the GL k-buffers lock per pixel (see test_gl_seam)
       if (method.allocation != AllocationPolicy::Unbounded &&
           method.store != StoreChoice::MultiLayer)
@@ -101,6 +109,8 @@ TEST_P(GlNative, AgreesWithTheCpuEngineOnEveryPreset) {
       }
       ASSERT_TRUE(g.ok()) << g.error().message;
       EXPECT_EQ(g->stats.engineCounters.at("raster_native"), 1);
+      EXPECT_EQ(g->image.width, c.width);  // per-sample storage box-filtered to the image
+      EXPECT_EQ(g->stats.fragmentsGenerated, r->stats.fragmentsGenerated);
       // vkb and dkb: the importance reads the nearest |n.v| (vkb, quantised to 1/255) or the
       // network's features, float rounding apart on the two rasters, so k(p) = floor(I(p) F(M))
       // may move a slot at a few pixels: bytes within 0.1% (and the budget); every other preset
@@ -113,6 +123,18 @@ TEST_P(GlNative, AgreesWithTheCpuEngineOnEveryPreset) {
         const double apart = std::abs(static_cast<double>(g->stats.bytesUsed) -
                                       static_cast<double>(r->stats.bytesUsed));
         EXPECT_LE(apart, 1e-3 * static_cast<double>(r->stats.bytesUsed));
+      }
+      // multisampled: the edge pixels (from the masks), and where the fragments were lost
+      if (c.samples > 1) {
+        EXPECT_EQ(g->stats.edgePixels, r->stats.edgePixels);
+        EXPECT_GT(r->stats.edgePixels, 0u);
+        EXPECT_EQ(g->stats.fragmentsAtEdges + g->stats.fragmentsInside,
+                  r->stats.fragmentsGenerated);
+        if (!importance && method.allocation != AllocationPolicy::Pool) {
+          EXPECT_EQ(g->stats.lostAtEdges, r->stats.lostAtEdges);
+          EXPECT_EQ(g->stats.lostInside, r->stats.lostInside);
+          EXPECT_EQ(g->lostPerPixel, r->lostPerPixel);
+        }
       }
       // linked lists: once the pool overflows, GL's atomic counter admits fragments in its own
       // arrival order and the CPU engine in primitive order (by design, docs/METHODS.md): a full
@@ -154,10 +176,52 @@ TEST_P(GlNative, AgreesWithTheCpuEngineOnEveryPreset) {
 
 INSTANTIATE_TEST_SUITE_P(
     Scenes, GlNative,
-    ::testing::Values(NativeCase{"procedural:bottles?count=4", 128, 96, 600u << 10},
-                      NativeCase{"procedural:layers", 128, 96, 800u << 10},
-                      NativeCase{"procedural:hairball?strands=150", 256, 192, 2400u << 10}),
+    ::testing::Values(
+        NativeCase{"procedural:bottles?count=4", 128, 96, 600u << 10},
+        NativeCase{"procedural:layers", 128, 96, 800u << 10},
+        NativeCase{"procedural:hairball?strands=150", 256, 192, 2400u << 10},
+        NativeCase{"procedural:bottles?count=4", 64, 48, 200u << 10, 4, SampleStorage::Pixel},
+        NativeCase{"procedural:bottles?count=4", 64, 48, 1200u << 10, 4, SampleStorage::Sample}),
     [](const auto& info) { return "scene" + std::to_string(info.index); });
+
+// Multisampling on GL: the exact raster refuses it in one line; a sample count the driver does not
+// rasterize as asked (llvmpipe: 4 samples only, 2 becomes 4, 8 is above its maximum) is one line
+// naming --samples, never a render with other samples than asked.
+TEST(GlSamples, RefusedWhereTheRasterOrDriverCannotRunThem) {
+  MFR_GL_ENGINE_OR_SKIP(native, "auto", "native");
+  const Scene scene = loadScene("procedural:bottles?count=2").value();
+  const Camera camera = frameBounds(sceneBounds(scene));
+  auto exact = makeGlEngine("auto", "exact");
+  ASSERT_TRUE(exact.ok()) << exact.error().message;
+  auto refused = (*exact)->prepare(View{&scene, camera, 32, 24, 4});
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.error().message,
+            "--gl-raster exact: --samples 4: the exact raster emulates one sample per pixel (use "
+            "--gl-raster native)");
+  exact.value().reset();
+  const bool llvmpipe = native->describe().at("renderer").find("llvmpipe") != std::string::npos;
+  for (const int samples : {2, 4, 8}) {
+    SCOPED_TRACE(samples);
+    auto view = native->prepare(View{&scene, camera, 32, 24, samples});
+    if (view.ok()) {
+      EXPECT_FALSE(llvmpipe && samples != 4);
+      auto out = native->render(**view, methodPreset("abuffer").value(), RenderOptions{});
+      ASSERT_TRUE(out.ok()) << out.error().message;
+      EXPECT_EQ(out->stats.samples, samples);
+      continue;
+    }
+    const std::string& m = view.error().message;
+    EXPECT_EQ(m.rfind("--engine gl: --samples " + std::to_string(samples) + ": ", 0), 0u) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    if (llvmpipe && samples == 2) {
+      EXPECT_NE(m.find("this GL rasterizes 4 samples per pixel for 2"), std::string::npos) << m;
+    }
+    if (llvmpipe && samples == 8) {
+      EXPECT_NE(m.find("above this GL's GL_MAX_FRAMEBUFFER_SAMPLES (4)"), std::string::npos) << m;
+    }
+    EXPECT_FALSE(llvmpipe && samples == 4) << m;
+  }
+}
 
 // --gl-raster: native is the default (describe() and the stats say which ran); an unknown value is
 // one line naming the option.

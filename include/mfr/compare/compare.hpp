@@ -92,6 +92,15 @@ struct CompareBudget {
   std::vector<CompareRun> runs;   // in CompareOptions::methods order
 };
 
+/// `mfr compare --sample-counts`: the same methods and budgets at one sample count, each run
+/// against that count's own ground truth (the per-sample A-buffer, box-filtered), for the report's
+/// error against bytes per pixel per sample count. The runs keep their statistics and metrics,
+/// not their images.
+struct SampleCountRuns {
+  int samples = 1;
+  std::vector<CompareBudget> budgets;  // as CompareResult::budgets
+};
+
 struct CompareResult {
   std::string scene;
   std::string engine;  // the engine that rendered every run and the ground truth
@@ -106,7 +115,12 @@ struct CompareResult {
   std::string depthComplexityFile;
   float kMapScale = 1.0f;              // the k-maps share one colour scale, 0 .. kMapScale
   std::vector<CompareBudget> budgets;  // in CompareOptions::budgets order
+  /// --sample-counts: every count asked for, in order (the one of `samples` is these budgets' runs)
+  std::vector<SampleCountRuns> sampleCounts;
 };
+
+/// The runs of `result` without their images (what SampleCountRuns keeps).
+SampleCountRuns sampleCountRuns(const CompareResult& result);
 
 /// Renders the ground truth and every method at every budget. Errors: an empty method or budget
 /// list, an unknown or duplicated method, a duplicated or zero budget, or a failed ground truth.

@@ -30,10 +30,12 @@
 #include <string>
 
 #include "mfr/core/result.hpp"
+#include "mfr/method/method_math.h"
 
 namespace mfr {
 
 inline constexpr int kMaxSamples = 8;
+static_assert(kMaxSamples == method_math::kMaxSampleSums);
 
 /// One sample's offset from the pixel centre, in 1/16 pixel (x right, y down).
 struct SampleOffset {
@@ -58,15 +60,14 @@ Result<SampleStorage> parseSampleStorage(const std::string& text, const std::str
 /// The coverage mask of `samples` samples in the low bits of a depth (per-pixel storage): the
 /// depth's low mantissa bits replaced by `mask`, kept below 1 so the unsigned order of depths
 /// stays their order.
+/// (method_math.h's withCoverageBits, which the GL engine's native raster calls too)
 inline float withCoverage(float depth, uint32_t mask, int samples) {
-  const uint32_t low = (1u << samples) - 1u;
-  uint32_t bits = std::bit_cast<uint32_t>(depth);
-  if (bits > 0x3f7fffffu) bits = 0x3f7fffffu;  // 1.0 and above: the largest depth below 1
-  return std::bit_cast<float>((bits & ~low) | (mask & low));
+  return std::bit_cast<float>(
+      method_math::withCoverageBits(std::bit_cast<uint32_t>(depth), mask, samples));
 }
 /// The coverage mask withCoverage put in a depth.
 inline uint32_t coverageOf(float depth, int samples) {
-  return std::bit_cast<uint32_t>(depth) & ((1u << samples) - 1u);
+  return std::bit_cast<uint32_t>(depth) & method_math::sampleBits(samples);
 }
 
 }  // namespace mfr

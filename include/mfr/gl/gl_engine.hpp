@@ -21,6 +21,7 @@
 
 #include "mfr/core/image.hpp"
 #include "mfr/core/result.hpp"
+#include "mfr/core/samples.hpp"
 #include "mfr/gl/gl_context.hpp"
 #include "mfr/method/allocation.hpp"
 #include "mfr/method/fragment_node.hpp"
@@ -93,6 +94,16 @@ const char* toString(GlRaster raster);
 /// "native" or "exact"; anything else is one line naming --gl-raster.
 Result<GlRaster> parseGlRaster(std::string_view text);
 
+/// Multisampling of an engine's geometry passes (core/samples.hpp): `samples` per pixel on a
+/// multisampled attachment-less framebuffer, whose sample positions must be the standard pattern
+/// (GlEngine::create checks them), and the storage discipline: per-pixel nodes carrying coverage
+/// masks (gl_SampleMaskIn), or per-sample storage (sample shading at rate 1; the engine's width()
+/// is then the storage's W * samples).
+struct GlSampling {
+  int samples = 1;
+  SampleStorage storage = SampleStorage::Pixel;
+};
+
 /// One scene and view uploaded to GL once; render() runs a method on it any number of times.
 /// Supported methods: `abuffer` (unbounded, append), fixed-k max-array or max-heap
 /// k-buffers with an explicit k, and any k-buffer with a per-pixel allocation
@@ -108,9 +119,11 @@ class GlEngine {
   /// `interlock`: the k-buffer capture orders a pixel's fragments with the driver's fragment
   /// shader interlock (interlockExtension(context) must name one) instead of the spin-lock.
   /// `raster`: GL's own pipeline (native) or the CPU engine's emulated (exact), see GlRaster.
+  /// `sampling`: more than one sample needs the native raster, a framebuffer of that many samples
+  /// and the standard sample positions (else one line naming --samples and what this GL offers).
   static Result<GlEngine> create(const GlContext& context, const Scene& scene, const Camera& camera,
                                  int width, int height, bool interlock = false,
-                                 GlRaster raster = GlRaster::Native);
+                                 GlRaster raster = GlRaster::Native, GlSampling sampling = {});
 
   GlEngine(GlEngine&&) noexcept;
   GlEngine& operator=(GlEngine&&) noexcept;
@@ -120,6 +133,9 @@ class GlEngine {
 
   /// The count pass alone: n(p), rows top to bottom (what a variable-k allocation needs first).
   Result<std::vector<uint32_t>> count();
+  /// Multisampled with per-pixel storage: 1 at the pixels some fragment covers only in part (an
+  /// edge crosses them), else 0 (the count pass counting those fragments).
+  Result<std::vector<uint8_t>> edgePixels();
   /// The nearest fragment's |n.v| per pixel, quantised to unorm8 / 255 like mfr::nearestCosine
   /// (0 where nothing is covered).
   Result<std::vector<float>> nearestCosine();
@@ -154,8 +170,10 @@ class GlEngine {
   Result<std::vector<float>> readNearestCosine();
 
   GlRaster raster() const;
+  /// The storage's size: the image's, or W * samples x H under per-sample storage.
   int width() const;
   int height() const;
+  const GlSampling& sampling() const;
   /// The camera with the fitted clip planes (what RasterFrame::build uses).
   const Camera& camera() const;
 

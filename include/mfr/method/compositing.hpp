@@ -51,12 +51,7 @@ struct HybridTail {
     const float share = static_cast<float>(std::popcount(coverageOf(nodeDepth(node), samples))) /
                         static_cast<float>(samples);
     const glm::vec4 c = unpackFragmentColor(rgba);
-    const uint32_t kind = rgba >> 24;
-    if (kind == method_math::kAdditiveNode)
-      method_math::hybridTailAddNode(r, g, b, alpha, count, kind, c.a, c.r * share, c.g * share,
-                                     c.b * share);
-    else
-      method_math::hybridTailAddNode(r, g, b, alpha, count, kind, c.a * share, c.r, c.g, c.b);
+    method_math::hybridTailAddCovered(r, g, b, alpha, count, rgba >> 24, c.a, c.r, c.g, c.b, share);
   }
 };
 static_assert(sizeof(HybridTail) == 20);
@@ -79,20 +74,29 @@ inline glm::vec3 compositeCore(const FragmentNode* sorted, uint32_t n, glm::vec3
   return {r, g, b};
 }
 
+/// What lies behind the sorted core under the hybrid rule: the pixel's tail over the background.
+inline glm::vec3 tailBehind(const HybridTail& tail, glm::vec3 background) {
+  return method_math::hybridBehind(glm::vec3(tail.r, tail.g, tail.b), tail.alpha, tail.count,
+                                   background);
+}
+
 /// A multisampled pixel of per-pixel storage (core/samples.hpp): each sample composited from the
-/// sorted nodes whose coverage mask holds it (kbuffer, or hybrid over the pixel's one tail), then
-/// the samples averaged (the box filter). `scratch` holds at least n nodes.
-template <class Rule>
-glm::vec3 compositeSamples(const FragmentNode* sorted, uint32_t n, int samples,
-                           FragmentNode* scratch, Rule&& rule) {
-  glm::vec3 sum(0.0f);
-  for (int s = 0; s < samples; ++s) {
-    uint32_t m = 0;
-    for (uint32_t i = 0; i < n; ++i)
-      if ((coverageOf(nodeDepth(sorted[i]), samples) >> s) & 1u) scratch[m++] = sorted[i];
-    sum += rule(scratch, m);
+/// sorted nodes whose coverage mask holds it over `behind` (the background, or the hybrid tail over
+/// it), then the samples averaged (the box filter): method_math.h's SampleSums, which the GL
+/// engine's resolve runs too.
+inline glm::vec3 compositeSamples(const FragmentNode* sorted, uint32_t n, int samples,
+                                  glm::vec3 behind) {
+  const ColorTables& t = ColorTables::get();
+  method_math::SampleSums sums = method_math::emptySampleSums(samples);
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint32_t rgba = nodeColor(sorted[i]);
+    const float a = static_cast<float>(rgba >> 24) * (1.0f / 255.0f);
+    method_math::blendSampleNode(sums, std::bit_cast<uint32_t>(nodeDepth(sorted[i])), rgba >> 24, a,
+                                 t.srgb8ToLinear[rgba & 0xffu],
+                                 t.srgb8ToLinear[(rgba >> 8) & 0xffu],
+                                 t.srgb8ToLinear[(rgba >> 16) & 0xffu]);
   }
-  return sum / static_cast<float>(samples);
+  return method_math::resolveSampleSums(sums, behind);
 }
 
 inline glm::vec3 compositeKBuffer(const FragmentNode* sorted, uint32_t n, glm::vec3 background) {
@@ -105,9 +109,7 @@ inline glm::vec3 compositeHybrid(const FragmentNode* sorted, uint32_t n, const H
                                  glm::vec3 background) {
   glm::vec3 T;
   const glm::vec3 core = compositeCore(sorted, n, T);
-  return method_math::overBackground(core, T,
-                                     method_math::hybridBehind(glm::vec3(tail.r, tail.g, tail.b),
-                                                               tail.alpha, tail.count, background));
+  return method_math::overBackground(core, T, tailBehind(tail, background));
 }
 
 }  // namespace mfr

@@ -78,6 +78,11 @@ using std::sqrt;
 
 // ---- constants ---------------------------------------------------------------------------------
 
+// Multisampling's per-pixel storage (core/samples.hpp): a node's coverage mask rides in the low
+// `samples` bits of its depth word; depths at and above 1 become the largest float below 1 first,
+// so that the unsigned order of the words stays the order of the depths
+MFR_MATH_CONST(uint, kLargestDepthBelowOne, 0x3f7fffffu)
+
 // WBOIT (McGuire and Bavoil 2013): Eq. 10's clamps of the depth weight, the resolve's clamp of the
 // weighted alpha sum (the denominator)
 MFR_MATH_CONST(float, kWboitMinWeight, 1e-2f)
@@ -273,6 +278,19 @@ bool isFiniteDouble(double x) {
 
 // ---- k-buffer family: front-to-back "over" and the hybrid tail ---------------------------------
 
+/// The low `samples` bits of a word (a coverage mask of that many samples).
+MFR_MATH_FN uint sampleBits(int samples) {
+  return (1u << uint(samples)) - 1u;
+}
+
+/// A depth word (the float's bits) carrying the coverage mask `mask` of `samples` samples in its
+/// low bits (per-pixel multisampled storage; see kLargestDepthBelowOne).
+MFR_MATH_FN uint withCoverageBits(uint depthBits, uint mask, int samples) {
+  const uint low = sampleBits(samples);
+  const uint bits = depthBits > kLargestDepthBelowOne ? kLargestDepthBelowOne : depthBits;
+  return (bits & ~low) | (mask & low);
+}
+
 /// One front-to-back "over" step of a sorted fragment (linear colour c, alpha a) onto the colour
 /// sum (r, g, b) and the transmittance T in front of it:
 ///   w = a T,  (r, g, b) += c w,  T *= 1 - a.
@@ -400,6 +418,56 @@ MFR_MATH_FN vec3 overBackground(vec3 color, vec3 T, vec3 behind) {
   return result;
 }
 
+// ---- multisampled per-pixel storage: each sample from the nodes that cover it ------------------
+
+/// The front-to-back sums of a pixel's samples (per-pixel multisampled storage, core/samples.hpp):
+/// sample i composites the sorted nodes whose coverage mask holds bit i; one sum (every node)
+/// with `samples` 1.
+MFR_MATH_CONST(int, kMaxSampleSums, 8)
+struct SampleSums {
+  float r[kMaxSampleSums], g[kMaxSampleSums], b[kMaxSampleSums];
+  float tr[kMaxSampleSums], tg[kMaxSampleSums], tb[kMaxSampleSums];
+  int samples;
+};
+
+MFR_MATH_FN SampleSums emptySampleSums(int samples) {
+  SampleSums s;
+  s.samples = samples > 1 ? samples : 1;
+  for (int i = 0; i < kMaxSampleSums; ++i) {
+    s.r[i] = 0.0f;
+    s.g[i] = 0.0f;
+    s.b[i] = 0.0f;
+    s.tr[i] = 1.0f;
+    s.tg[i] = 1.0f;
+    s.tb[i] = 1.0f;
+  }
+  return s;
+}
+
+/// blendStep of the next sorted node (its depth word, which carries the mask, and its colour)
+/// onto each sample it covers.
+MFR_MATH_FN void blendSampleNode(MFR_INOUT(SampleSums) s, uint depthBits, uint a8, float a,
+                                 float cr, float cg, float cb) {
+  for (int i = 0; i < s.samples; ++i)
+    if (s.samples == 1 || ((depthBits >> uint(i)) & 1u) != 0u)
+      blendStep(s.r[i], s.g[i], s.b[i], s.tr[i], s.tg[i], s.tb[i], a8, a, cr, cg, cb);
+}
+
+/// Each sample's sum over what lies behind (the background, or the hybrid tail over it), then the
+/// mean of the samples (the box filter).
+MFR_MATH_FN vec3 resolveSampleSums(SampleSums s, vec3 behind) {
+  if (s.samples == 1)
+    return overBackground(vec3(s.r[0], s.g[0], s.b[0]), vec3(s.tr[0], s.tg[0], s.tb[0]), behind);
+  vec3 sum = vec3(0.0f);
+  for (int i = 0; i < s.samples; ++i) {
+    MFR_PRECISE vec3 next =
+        sum + overBackground(vec3(s.r[i], s.g[i], s.b[i]), vec3(s.tr[i], s.tg[i], s.tb[i]), behind);
+    sum = next;
+  }
+  MFR_PRECISE vec3 mean = sum / float(s.samples);
+  return mean;
+}
+
 /// mfr::HybridTail::add: a fragment (linear colour c, alpha a) not kept by the store joins the
 /// pixel's order-independent tail: sums of a c and a, and the count t.
 MFR_MATH_FN void hybridTailAdd(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(float) b,
@@ -432,6 +500,23 @@ MFR_MATH_FN void hybridTailAddNode(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_I
     count = count + 1u;
   } else {
     hybridTailAdd(r, g, b, alphaSum, count, a, cr, cg, cb);
+  }
+}
+
+/// hybridTailAddNode of a node of per-pixel multisampled storage (core/samples.hpp), whose
+/// triangle covers `share` of the pixel's samples (the covered count over the sample count): its
+/// alpha, or an additive node's emission, weighted by that share, into the pixel's one tail.
+MFR_MATH_FN void hybridTailAddCovered(MFR_INOUT(float) r, MFR_INOUT(float) g, MFR_INOUT(float) b,
+                                      MFR_INOUT(float) alphaSum, MFR_INOUT(uint) count, uint a8,
+                                      float a, float cr, float cg, float cb, float share) {
+  if (a8 == kAdditiveNode) {
+    MFR_PRECISE float sr = cr * share;
+    MFR_PRECISE float sg = cg * share;
+    MFR_PRECISE float sb = cb * share;
+    hybridTailAddNode(r, g, b, alphaSum, count, a8, a, sr, sg, sb);
+  } else {
+    MFR_PRECISE float sa = a * share;
+    hybridTailAddNode(r, g, b, alphaSum, count, a8, sa, cr, cg, cb);
   }
 }
 

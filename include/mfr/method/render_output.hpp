@@ -142,4 +142,18 @@ struct RenderOutput {
   std::vector<uint32_t> counts;
 };
 
+/// Per-sample storage (core/samples.hpp) back to image pixels, for any engine: the W*S x H
+/// storage's image box-filtered to W x H (the mean of each pixel's S samples), the importance
+/// and |n.v| maps averaged, the counts (n(p), k(p)) summed over the samples. Stores (nodes,
+/// offsets, counts) stay per storage pixel.
+void toImagePixels(RenderOutput& out, int samples);
+
+/// Multisampled renders, for any engine: the fragments that got no node at the pixels an edge
+/// crosses (`edges`, per image pixel) and at the other covered pixels, into the statistics and
+/// RenderOutput::lostPerPixel. `n` and `captured` are per storage pixel (`perPixel` storage pixels
+/// an image pixel: the samples under per-sample storage, else 1); a storage pixel holds
+/// min(captured, n) of its n fragments (every one where `captured` is empty).
+void edgeStatistics(const std::vector<uint32_t>& n, const std::vector<uint32_t>& captured,
+                    const std::vector<uint8_t>& edges, int perPixel, RenderOutput& out);
+
 }  // namespace mfr
