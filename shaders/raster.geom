@@ -212,6 +212,7 @@ void setupAndEmit(int i0, int i1, int i2, uint material, bool hasColor) {
     gInvArea = invArea;
     gTopLeft = topLeft;
     gMaterial = material;
+    gl_PrimitiveID = gl_PrimitiveIDIn;  // the scene triangle's index (hashed alpha's prim)
     EmitVertex();
   }
   EndPrimitive();

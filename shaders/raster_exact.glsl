@@ -110,3 +110,9 @@ bool fragmentBackFacing() {
 float coverageShare(uint depthBits) {
   return 1.0;
 }
+
+// the scene triangle's index: raster.geom passes its input primitive's on (a clipped piece keeps
+// its parent's, as the CPU engine's)
+uint fragmentPrimitive() {
+  return uint(gl_PrimitiveID);
+}

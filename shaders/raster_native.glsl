@@ -100,3 +100,8 @@ float coverageShare(uint depthBits) {
   if (uSamples <= 1 || uSampleStorage != 0u) return 1.0;
   return float(bitCount(depthBits & sampleBits(uSamples))) / float(uSamples);
 }
+
+// the scene triangle's index (the draw's triangles are the scene's, in order)
+uint fragmentPrimitive() {
+  return uint(gl_PrimitiveID);
+}

@@ -141,13 +141,10 @@ class SurfacePoints {
 
   void locate(PeerFragment& f) const {
     const glm::vec2 at = frame_.shadedPosition(f.pixel);
-    const float x = at.x, y = at.y;
-    const float ndcZ = 2.0f * f.depth - 1.0f;
-    const float viewDepth = 2.0f * near_ * far_ / (far_ + near_ - ndcZ * (far_ - near_));
-    const glm::vec3 view(x * rays_.rayScaleX + rays_.rayBiasX, y * rays_.rayScaleY + rays_.rayBiasY,
-                         -1.0f);
-    f.position = glm::vec3(inverseView_ * glm::vec4(view * viewDepth, 1.0f));
-    f.footprint = viewDepth * std::abs(rays_.rayScaleX);
+    f.position = method_math::surfacePoint(
+        at.x, at.y, f.depth, near_, far_,
+        glm::vec4(rays_.rayScaleX, rays_.rayBiasX, rays_.rayScaleY, rays_.rayBiasY), inverseView_,
+        f.footprint);
   }
 
  private:

@@ -16,10 +16,19 @@
 #include "mfr/method/aoit.hpp"
 #include "mfr/method/dfaoit.hpp"
 #include "mfr/method/mboit.hpp"
+#include "mfr/method/hashed_alpha.hpp"
+#include "mfr/method/method_math.h"
 #include "mfr/method/pass_plan.hpp"
+#include "mfr/method/stochastic.hpp"
+#include "mfr/scene/camera.hpp"
 
 namespace mfr::gl {
 namespace {
+
+static_assert(kStochasticSamples == Stochastic8Method::kSamples &&
+              kStochasticSamples == StochasticStrat8Method::kSamples &&
+              kStochasticWords * 4 == sizeof(StochasticPixel<kStochasticSamples>));
+static_assert(kHashedAlphaWords * 4 == sizeof(HashedAlphaPixel));
 
 // n(p) before the capture: the A-buffer sizes its slots by it; the others count n(p) in their
 // capture when no count came before (no pass of its own)
@@ -35,6 +44,8 @@ bool countPassFirst(GlTechnique t) {
     case GlTechnique::LinkedList:
     case GlTechnique::Peel:
     case GlTechnique::Dfaoit:
+    case GlTechnique::Stochastic:
+    case GlTechnique::HashedAlpha:
       return false;
   }
   return false;
@@ -53,6 +64,8 @@ bool fragmentNodes(GlTechnique t) {
     case GlTechnique::LinkedList:  // (read by walking the lists: readLists)
     case GlTechnique::Peel:
     case GlTechnique::Dfaoit:
+    case GlTechnique::Stochastic:
+    case GlTechnique::HashedAlpha:
       return false;
   }
   return false;
@@ -100,6 +113,10 @@ uint64_t largestPerPixelBytes(const RenderPlan& p) {
       return std::max<uint64_t>({12, peelWords(p.method) * 4, p.hybrid ? kTailWords * 4 : 0});
     case GlTechnique::Dfaoit:
       return std::max<uint64_t>(12, kDfaoitWords * 4);
+    case GlTechnique::Stochastic:
+      return std::max<uint64_t>(12, kStochasticWords * 4);
+    case GlTechnique::HashedAlpha:
+      return std::max<uint64_t>(12, kHashedAlphaWords * 4);
   }
   return 12;
 }
@@ -198,6 +215,69 @@ struct GlEngine::State::FrameRun {
     pass("capture", [&] {
       const GLuint p = s.program(ProgramId::Dfaoit);
       useCapture(p);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+      fb.bindImage(locks, kBindLocks);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    });
+  }
+
+  // stochastic, stochastic-strat: the sample depths (kStochasticFarDepth), T = 1, the sums 0;
+  // three passes of stochastic.frag
+  void captureStochastic() {
+    const uint32_t pixels = plan.pixels;
+    accum = fb.make("accumulators", uint64_t{pixels} * kStochasticWords * 4);
+    {
+      std::vector<uint32_t> init(uint64_t{pixels} * kStochasticWords, 0u);
+      for (uint32_t p = 0; p < pixels; ++p) {
+        for (int j = 0; j < kStochasticSamples; ++j)
+          init[uint64_t{p} * kStochasticWords + j] =
+              std::bit_cast<uint32_t>(method_math::kStochasticFarDepth);
+        init[uint64_t{p} * kStochasticWords + kStochasticSamples] = std::bit_cast<uint32_t>(1.0f);
+      }
+      glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
+    }
+    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+    clearUint(locks, kLockFree);
+    const bool stratified = plan.method.compositing == Compositing::StochasticStrat8;
+    const auto draw = [&](GLuint passIndex) {
+      const GLuint p = s.program(ProgramId::Stochastic);
+      // every pass binds the counts image, though only the capture (uPass 2) counts: bound for
+      // pass 2 alone, its imageAtomicAdd never reached the buffer on llvmpipe (Mesa 22.3.6; the
+      // unit's binding and the uniforms queried right, n(p) read back 0, the sums intact)
+      useCapture(p);
+      glProgramUniform1ui(p, loc(p, "uPass"), passIndex);
+      glProgramUniform1ui(p, loc(p, "uStratified"), stratified ? 1u : 0u);
+      glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
+      fb.bindImage(locks, kBindLocks);
+      s.drawScene();
+      glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    };
+    pass("total-alpha", [&] { draw(0); });
+    pass("stochastic-depth", [&] { draw(1); });
+    pass("capture", [&] { draw(2); });
+  }
+
+  // hashed-alpha: the z-buffer of the kept fragments (kStochasticFarDepth: none kept)
+  void captureHashedAlpha() {
+    const uint32_t pixels = plan.pixels;
+    accum = fb.make("accumulators", uint64_t{pixels} * kHashedAlphaWords * 4);
+    {
+      std::vector<uint32_t> init(uint64_t{pixels} * kHashedAlphaWords, 0u);
+      for (uint32_t p = 0; p < pixels; ++p)
+        init[uint64_t{p} * kHashedAlphaWords] =
+            std::bit_cast<uint32_t>(method_math::kStochasticFarDepth);
+      glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
+    }
+    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
+    clearUint(locks, kLockFree);
+    pass("capture", [&] {
+      const GLuint p = s.program(ProgramId::HashedAlpha);
+      useCapture(p);
+      // the CPU engine's SurfacePoints: the fitted camera's inverse view, near and far
+      const glm::mat4 inverseView = glm::inverse(viewMatrix(s.camera));
+      glProgramUniformMatrix4fv(p, loc(p, "uInverseView"), 1, GL_FALSE, &inverseView[0][0]);
+      glProgramUniform2f(p, loc(p, "uNearFar"), s.camera.zNear, s.camera.zFar);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       fb.bindImage(locks, kBindLocks);
       s.drawScene();
@@ -620,6 +700,8 @@ struct GlEngine::State::FrameRun {
                             static_cast<GLuint>(aoitNodeCount(plan.method.compositing)));
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
+      if (program == ProgramId::HashedAlphaResolve)
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindColorTables, s.colorTables);
       dispatchPixels();
     });
   }
@@ -753,6 +835,8 @@ Result<RenderPlan> GlEngine::State::planRender(const MethodDesc& method,
     case GlTechnique::Mboit:
     case GlTechnique::Aoit:
     case GlTechnique::Dfaoit:
+    case GlTechnique::Stochastic:
+    case GlTechnique::HashedAlpha:
       break;
     case GlTechnique::LinkedList:
       plan.allocSlots = options.poolNodes;
@@ -839,6 +923,14 @@ Result<GlRenderOutput> GlEngine::render(const MethodDesc& method, const GlRender
       case GlTechnique::Dfaoit:
         frame.captureDfaoit();
         MFR_TRY(frame.resolveDfaoit());
+        break;
+      case GlTechnique::Stochastic:
+        frame.captureStochastic();
+        frame.resolveAccumulators(ProgramId::StochasticResolve);
+        break;
+      case GlTechnique::HashedAlpha:
+        frame.captureHashedAlpha();
+        frame.resolveAccumulators(ProgramId::HashedAlphaResolve);
         break;
     }
     MFR_TRY(frame.checkErrors());

@@ -118,6 +118,10 @@ constexpr ProgramRow kPrograms[] = {
     {ProgramId::Peel, "peel.frag", Stages::Raster, Prelude::None},
     {ProgramId::PeelStep, "peel_step.comp", Stages::Compute, Prelude::None},
     {ProgramId::PeelResolve, "peel_resolve.comp", Stages::Compute, Prelude::None},
+    {ProgramId::Stochastic, "stochastic.frag", Stages::Raster, Prelude::None},
+    {ProgramId::StochasticResolve, "stochastic_resolve.comp", Stages::Compute, Prelude::None},
+    {ProgramId::HashedAlpha, "hashed_alpha.frag", Stages::Raster, Prelude::None},
+    {ProgramId::HashedAlphaResolve, "hashed_alpha_resolve.comp", Stages::Compute, Prelude::None},
 };
 constexpr bool rowsInIdOrder() {
   if (std::size(kPrograms) != kProgramCount) return false;

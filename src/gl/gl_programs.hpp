@@ -54,8 +54,12 @@ enum class ProgramId : uint8_t {
   Peel,             // peel.frag (depth peeling's passes and tail pass)
   PeelStep,         // peel_step.comp (between peel passes)
   PeelResolve,      // peel_resolve.comp
+  Stochastic,       // stochastic.frag (its three passes, uPass)
+  StochasticResolve,   // stochastic_resolve.comp
+  HashedAlpha,         // hashed_alpha.frag
+  HashedAlphaResolve,  // hashed_alpha_resolve.comp
 };
-inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::PeelResolve) + 1;
+inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::HashedAlphaResolve) + 1;
 
 /// The linked programs of one engine, deleted with it (in the context current then).
 class Programs {

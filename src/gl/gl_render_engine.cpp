@@ -234,6 +234,8 @@ class GlFrame {
       case GlTechnique::Mboit:
       case GlTechnique::Aoit:
       case GlTechnique::Dfaoit:
+      case GlTechnique::Stochastic:
+      case GlTechnique::HashedAlpha:
         return {};
       case GlTechnique::KBuffer:
       case GlTechnique::Mlab:

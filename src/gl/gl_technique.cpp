@@ -51,6 +51,16 @@ constexpr GlTechniqueInfo kTechniques[] = {
      "composite)",
      "dfaoit.frag", "dfaoit_resolve.comp",
      "accumulators 52 B + lock 4 B; per image: the network's 1,571 weights", "dfaoit"},
+    {GlTechnique::Stochastic, "stochastic",
+     "total alpha (T under the lock) -> stochastic depth (8 sample depths, atomicMin) -> capture "
+     "(visibility-weighted sums under the lock) -> resolve (alpha-corrected composite)",
+     "stochastic.frag", "stochastic_resolve.comp", "8 depths, T and sums 52 B + lock 4 B",
+     "stochastic, stochastic-strat"},
+    {GlTechnique::HashedAlpha, "hashed-alpha",
+     "capture (alpha against the surface point's hash; the nearest kept under the lock) -> "
+     "resolve",
+     "hashed_alpha.frag", "hashed_alpha_resolve.comp", "depth and colour 8 B + lock 4 B",
+     "hashed-alpha"},
 };
 
 constexpr bool rowsInEnumOrder() {
@@ -145,10 +155,14 @@ std::optional<GlTechnique> techniqueOf(const MethodDesc& m) {
           m.occupancyWords != 0)
         return std::nullopt;
       return GlTechnique::Peel;
-    case Compositing::Stochastic8:  // not in the GL engine (stochastic.hpp, hashed_alpha.hpp)
+    case Compositing::Stochastic8:
     case Compositing::StochasticStrat8:
     case Compositing::HashedAlpha:
-      return std::nullopt;
+      if (m.allocation != AllocationPolicy::NoNodes || m.store != StoreChoice::None ||
+          m.occupancyWords != 0)
+        return std::nullopt;
+      return m.compositing == Compositing::HashedAlpha ? GlTechnique::HashedAlpha
+                                                       : GlTechnique::Stochastic;
   }
   return std::nullopt;
 }
@@ -175,7 +189,7 @@ Result<GlTechnique> classifyGl(const MethodDesc& method) {
         " is not in the GL engine (it runs the A-buffer; the k-buffer family with a "
         "fixed k or a per-pixel k(p), max-array or max-heap stores, occupancy culling "
         "and kbuffer or hybrid compositing; wboit; mboit; mlab; aoit; linked-list; peel, "
-        "dual-peel; dfaoit)");
+        "dual-peel; dfaoit; stochastic, stochastic-strat; hashed-alpha)");
   return *t;
 }
 

@@ -164,8 +164,6 @@ TEST(GlSeamEveryPreset, SharedStatisticsEqualTheCpuEngines) {
   for (const std::string& base : presetNames())
     for (const std::string& name : {base, base + "+occupancy"}) {
       auto preset = methodPreset(name);
-      // (the CPU engine's stochastic presets are refused on GL:
-      // GlTechnique.EveryPresetRunsAsItsTechnique)
       if (!preset || !gl::classifyGl(preset.value()).ok()) continue;
       SCOPED_TRACE(name);
       const MethodDesc& method = preset.value();

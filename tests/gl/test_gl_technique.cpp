@@ -35,30 +35,21 @@ GlTechnique expectedTechnique(const std::string& preset) {
                                                            {"linked-list", GlTechnique::LinkedList},
                                                            {"peel", GlTechnique::Peel},
                                                            {"dual-peel", GlTechnique::Peel},
-                                                           {"dfaoit", GlTechnique::Dfaoit}};
+                                                           {"dfaoit", GlTechnique::Dfaoit},
+                                                           {"stochastic", GlTechnique::Stochastic},
+                                                           {"stochastic-strat",
+                                                            GlTechnique::Stochastic},
+                                                           {"hashed-alpha",
+                                                            GlTechnique::HashedAlpha}};
   const auto it = peers.find(preset);
   return it == peers.end() ? GlTechnique::KBuffer : it->second;  // the k-buffer family
 }
 
-// the presets of the CPU engine only: the GL engine's one-line refusal
-bool cpuOnly(const std::string& preset) {
-  return preset == "stochastic" || preset == "stochastic-strat" || preset == "hashed-alpha";
-}
-
 TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
-  int presets = 0, occupancyForms = 0, refused = 0;
+  int presets = 0, occupancyForms = 0;
   for (const std::string& name : presetNames()) {
     const MethodDesc method = methodPreset(name).value();
     auto t = classifyGl(method);
-    if (cpuOnly(name)) {
-      ASSERT_FALSE(t.ok()) << name << " ran as " << toString(*t);
-      EXPECT_NE(t.error().message.find("--engine gl: method " + name + " is not in the GL engine"),
-                std::string::npos)
-          << t.error().message;
-      EXPECT_EQ(t.error().message.find('\n'), std::string::npos);
-      ++refused;
-      continue;
-    }
     ASSERT_TRUE(t.ok()) << name << ": " << t.error().message;
     EXPECT_EQ(*t, expectedTechnique(name)) << name << " runs as " << toString(*t);
     ++presets;
@@ -69,9 +60,9 @@ TEST(GlTechnique, EveryPresetRunsAsItsTechnique) {
     EXPECT_EQ(*tc, GlTechnique::KBuffer) << name << "+occupancy";
     ++occupancyForms;
   }
-  EXPECT_EQ(presets, 33);  // 13 of the k-buffer family, the A-buffer, linked-list, 18 peers
+  // every preset: 13 of the k-buffer family, the A-buffer, linked-list, 21 peers
+  EXPECT_EQ(presets, 36);
   EXPECT_EQ(occupancyForms, 13);
-  EXPECT_EQ(refused, 3);  // stochastic, stochastic-strat, hashed-alpha
 }
 
 TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
@@ -88,7 +79,7 @@ TEST(GlTechnique, EitherCompositingOfTheKBufferFamily) {
 
 TEST(GlTechnique, TableRowsFollowTheEnum) {
   const auto rows = glTechniques();
-  ASSERT_EQ(rows.size(), 9u);
+  ASSERT_EQ(rows.size(), 11u);
   for (size_t i = 0; i < rows.size(); ++i) {
     EXPECT_EQ(static_cast<size_t>(rows[i].technique), i);
     EXPECT_EQ(&techniqueInfo(rows[i].technique), &rows[i]);

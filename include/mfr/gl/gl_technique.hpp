@@ -32,6 +32,9 @@ enum class GlTechnique : uint8_t {
   Peel,    // depth peeling and dual depth peeling: peel passes (geometry + per-pixel step) until
            // none remains or --max-peels, [tail pass], composite
   Dfaoit,  // deep and fast approximate OIT: one accumulation pass, the network in the resolve
+  Stochastic,   // stochastic transparency (plain, stratified): total alpha, stochastic depth,
+                // visibility-weighted capture, alpha-corrected resolve
+  HashedAlpha,  // hashed alpha testing: one pass into a z-buffer of the kept fragments
 };
 
 /// One row of the technique table.

@@ -79,6 +79,12 @@ MFR_GL_CONST(uint, kAoitColorWords, 3u)
 // T, n, farthest depth, nearest depth bits, nearest RGBA8 (mfr::DfaoitPixel); the resolve's
 // network weights (mfr::dfaoitWeights)
 MFR_GL_CONST(uint, kDfaoitWords, 13u)
+// stochastic transparency per pixel (mfr::StochasticPixel<8>): 8 sample depths (float bits), T,
+// sum vis a c (r, g, b), sum vis a
+MFR_GL_CONST(int, kStochasticSamples, 8)
+MFR_GL_CONST(uint, kStochasticWords, 13u)
+// hashed alpha per pixel (mfr::HashedAlphaPixel): the nearest kept depth (float bits), its colour
+MFR_GL_CONST(uint, kHashedAlphaWords, 2u)
 MFR_GL_CONST(uint, kBindDfaoitWeights, 1u)
 // multi-layer alpha blending: per node depth, premultiplied r, g, b, transmittance (mfr::MlabNode)
 MFR_GL_CONST(uint, kMlabWords, 5u)
@@ -171,6 +177,8 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //   occupancy_fill.frag: kBindOccupancy kBindOccBits
 //   wboit.frag: kBindAccum kBindLocks(image)
 //   dfaoit.frag: kBindAccum kBindLocks(image)
+//   stochastic.frag: kBindAccum kBindLocks(image)
+//   hashed_alpha.frag: kBindAccum kBindLocks(image)
 //   peel.frag: kBindAccum kBindCaptureStats kBindTails kBindLocks(image)
 //   alloc_histogram.comp: kBindAllocCounts kBindAllocSummary
 //   alloc_k.comp: kBindAllocCounts kBindAllocSummary kBindAllocK kBindAllocReserved kBindImportance
@@ -190,6 +198,8 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //   swap_node_words.comp: kBindNodes
 //   wboit_resolve.comp: kBindAccum kBindImage
 //   dfaoit_resolve.comp: kBindAccum kBindDfaoitWeights kBindImage kBindColorTables
+//   stochastic_resolve.comp: kBindAccum kBindImage
+//   hashed_alpha_resolve.comp: kBindAccum kBindImage kBindColorTables
 //   peel_step.comp: kBindAccum kBindCaptureStats kBindOffsets kBindColorTables
 //   peel_resolve.comp: kBindAccum kBindResolveTails kBindImage
 //   raster_common.glsl: kBindMaterials kBindColorTables kBindTexels kBindCounts(image)

@@ -56,55 +56,19 @@
 
 namespace mfr {
 
-/// Cells per pixel footprint (the paper's g_HashScale).
-inline constexpr float kHashedAlphaScale = 1.0f;
-/// The smallest threshold: alpha 0 is never kept.
-inline constexpr float kHashedAlphaMinThreshold = 1e-6f;
+// The threshold's maths are method_math.h's, which the GL engine's shaders share.
+using method_math::hashedAlphaCell;
+using method_math::hashedAlphaThreshold;
+using method_math::kHashedAlphaMinThreshold;
+using method_math::kHashedAlphaScale;
 /// The depth of a pixel no kept fragment reached.
-inline constexpr float kHashedAlphaFarDepth = 3.0e38f;
-
-/// The hash in [0, 1) of the cell of `p` at `scale` cells per world unit, for primitive `prim`.
-inline float hashedAlphaCell(uint32_t prim, glm::vec3 p, float scale) {
-  const auto coordinate = [&](float x) {
-    // the cell's integer coordinate (clamped to the int32 range; far beyond any scene's)
-    const float c = std::floor(x * scale);
-    const float bounded = c < -2.0e9f ? -2.0e9f : c > 2.0e9f ? 2.0e9f : c;
-    return static_cast<uint32_t>(static_cast<int32_t>(bounded));
-  };
-  uint32_t h = pcgHash(prim);
-  h = hashCombine(h, coordinate(p.x));
-  h = hashCombine(h, coordinate(p.y));
-  h = hashCombine(h, coordinate(p.z));
-  return hashToUnit(h);
-}
-
-/// The alpha threshold in [1e-6, 1] of the surface point `p` of primitive `prim` whose pixel
-/// covers `footprint` world units: uniformly distributed over the points, constant on cells
-/// about a pixel wide whose scale follows the footprint continuously.
-inline float hashedAlphaThreshold(uint32_t prim, glm::vec3 p, float footprint) {
-  // log2 of the cells per world unit, bounded so a degenerate footprint stays finite
-  float level = -std::log2(kHashedAlphaScale * footprint);
-  level = !(level > -60.0f) ? -60.0f : level > 60.0f ? 60.0f : level;
-  const float lower = std::floor(level);
-  const float f = level - lower;
-  const float x0 = hashedAlphaCell(prim, p, std::exp2(lower));
-  const float x1 = hashedAlphaCell(prim, p, std::exp2(lower + 1.0f));
-  const float x = (1.0f - f) * x0 + f * x1;
-  const float a = f < 1.0f - f ? f : 1.0f - f;
-  float h;
-  if (x < a)
-    h = x * x / (2.0f * a * (1.0f - a));
-  else if (x < 1.0f - a)
-    h = (x - 0.5f * a) / (1.0f - a);
-  else
-    h = 1.0f - (1.0f - x) * (1.0f - x) / (2.0f * a * (1.0f - a));
-  return h < kHashedAlphaMinThreshold ? kHashedAlphaMinThreshold : h > 1.0f ? 1.0f : h;
-}
+inline constexpr float kHashedAlphaFarDepth = method_math::kStochasticFarDepth;
 
 /// Whether a fragment of alpha `alpha8` (0..255) at that point is kept.
 inline bool hashedAlphaKeeps(uint32_t alpha8, uint32_t prim, glm::vec3 p, float footprint) {
   // the same alpha as the capture's (unpackFragmentColor): x * (1 / 255)
-  return static_cast<float>(alpha8) * (1.0f / 255.0f) >= hashedAlphaThreshold(prim, p, footprint);
+  return method_math::hashedAlphaKeeps(static_cast<float>(alpha8) * (1.0f / 255.0f), prim, p,
+                                       footprint);
 }
 
 /// One pixel's z-buffer: 8 bytes.

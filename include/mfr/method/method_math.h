@@ -51,11 +51,15 @@ namespace mfr::method_math {
 using uint = uint32_t;
 using vec2 = glm::vec2;
 using vec3 = glm::vec3;
+using vec4 = glm::vec4;
+using mat4 = glm::mat4;
 using dvec2 = glm::dvec2;
 using std::abs;
 using std::clamp;
 using std::exp;
+using std::exp2;
 using std::floor;
+using std::log2;
 using std::log;
 using std::max;
 using std::min;
@@ -251,6 +255,10 @@ inline double doubleExp(double x) {
 inline bool isFiniteDouble(double x) {
   return std::isfinite(x);
 }
+/// The high word of the 64-bit product a b (GLSL: umulExtended).
+inline uint mulHigh32(uint a, uint b) {
+  return static_cast<uint>((static_cast<uint64_t>(a) * b) >> 32);
+}
 /// A 64-bit constant from its (lo, hi) words.
 constexpr uint64_t words64(uint lo, uint hi) {
   return (uint64_t{hi} << 32) | lo;
@@ -273,6 +281,11 @@ double doubleExp(double x) {
 }
 bool isFiniteDouble(double x) {
   return !isinf(x) && !isnan(x);
+}
+uint mulHigh32(uint a, uint b) {
+  uint hi, lo;
+  umulExtended(a, b, hi, lo);
+  return hi;
 }
 #endif
 
@@ -1400,6 +1413,166 @@ MFR_MATH_FN void mboitDequantizeMoments(int count, bool trigonometric, float b0,
       moments[2 * row + parity] = m;
     }
   }
+}
+
+// ---- stochastic transparency and hashed alpha testing -----------------------------------------
+// The integer hash both draw their random numbers from (fragment_hash.hpp): PCG's output
+// permutation over one LCG step (Jarzynski & Olano, "Hash Functions for GPU Rendering", JCGT 9(3),
+// 2020), 32-bit multiplies, shifts and xors only. Stochastic transparency: Enderton, Sintorn,
+// Shirley, Luebke, I3D 2010, and Laine & Karras' stratified alpha, EGSR 2011 (stochastic.hpp);
+// hashed alpha testing: Wyman & McGuire, I3D 2017, the isotropic threshold of its Listing 3
+// (hashed_alpha.hpp).
+
+/// PCG hash of one 32-bit word.
+MFR_MATH_FN uint pcgHash(uint v) {
+  const uint state = v * 747796405u + 2891336453u;
+  const uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
+  return (word >> 22u) ^ word;
+}
+
+/// Folds `word` into the running hash `h`.
+MFR_MATH_FN uint hashCombine(uint h, uint word) {
+  return pcgHash(h ^ pcgHash(word));
+}
+
+/// A hash as a float in [0, 1): its top 24 bits over 2^24 (exact in float).
+MFR_MATH_FN float hashToUnit(uint h) {
+  return float(h >> 8u) * (1.0f / 16777216.0f);
+}
+
+/// A hash as an integer uniform in [0, n): the top of the 64-bit product h n (Lemire's
+/// multiply-shift; the bias is below n / 2^32).
+MFR_MATH_FN uint hashBelow(uint h, uint n) {
+  return mulHigh32(h, n);
+}
+
+/// The depth of a stochastic sample no fragment covered, and of a hashed-alpha pixel no kept
+/// fragment reached.
+MFR_MATH_CONST(float, kStochasticFarDepth, 3.0e38f)
+MFR_MATH_CONST(int, kStochasticMaxSamples, 32)
+MFR_MATH_CONST(uint, kStochasticStrataWord, 0x9e3779b9u)  // the stratified count's hash word
+
+/// What identifies a fragment, hashed: its pixel, the depth's bits and the colour word.
+MFR_MATH_FN uint stochasticKey(uint pixel, uint depthBits, uint rgba) {
+  return hashCombine(hashCombine(pcgHash(pixel), depthBits), rgba);
+}
+
+/// The samples (bits 0..S-1) a fragment of alpha `alpha8` (0..255) covers; `key` its
+/// stochasticKey. Unstratified: each sample independently with probability alpha8 / 255.
+/// Stratified: floor(a S) or floor(a S) + 1 samples (mean a S), a uniformly random subset (the
+/// first n of a random permutation, partial Fisher-Yates).
+MFR_MATH_FN uint stochasticMask(int samples, bool stratified, uint key, uint alpha8) {
+  const uint s = uint(samples);
+  uint mask = 0u;
+  if (!stratified) {
+    for (uint j = 0u; j < s; ++j)
+      if (hashBelow(hashCombine(key, j), 255u) < alpha8) mask |= 1u << j;
+    return mask;
+  }
+  // the count: #{m < S : 255 m + v < alpha8 S}, v uniform over [0, 255)
+  const uint v = hashBelow(hashCombine(key, kStochasticStrataWord), 255u);
+  const uint scaled = alpha8 * s;
+  const uint n = scaled > v ? min(s, (scaled - v + 254u) / 255u) : 0u;
+  uint order[kStochasticMaxSamples];
+  for (uint j = 0u; j < s; ++j) order[j] = j;
+  for (uint i = 0u; i < n; ++i) {
+    const uint pick = i + hashBelow(hashCombine(key, i + 1u), s - i);
+    const uint t = order[i];
+    order[i] = order[pick];
+    order[pick] = t;
+    mask |= 1u << order[i];
+  }
+  return mask;
+}
+
+/// The fraction of the S samples nothing nearer covered (`seen` of them at or behind the depth).
+MFR_MATH_FN float stochasticVisibility(int seen, int samples) {
+  MFR_PRECISE float v = float(seen) * (1.0f / float(samples));
+  return v;
+}
+
+/// The alpha-corrected composite: the colours' visibility-weighted mean C / A scaled to the exact
+/// total opacity 1 - T, over the background (A = 0: the background).
+MFR_MATH_FN vec3 stochasticComposite(vec3 sum, float sumA, float trans, vec3 background) {
+  if (sumA <= 0.0f) return background;
+  MFR_PRECISE vec3 c = sum / sumA * (1.0f - trans) + trans * background;
+  return c;
+}
+
+/// Hashed alpha: cells per pixel footprint (the paper's g_HashScale) and the smallest threshold
+/// (alpha 0 is never kept).
+MFR_MATH_CONST(float, kHashedAlphaScale, 1.0f)
+MFR_MATH_CONST(float, kHashedAlphaMinThreshold, 1e-6f)
+MFR_MATH_CONST(float, kHashedAlphaMaxCell, 2.0e9f)  // cell coordinates clamped to int32's range
+MFR_MATH_CONST(float, kHashedAlphaMaxLevel, 60.0f)  // |log2 cells per unit| bound
+
+/// The cell's integer coordinate of x at `scale` cells per unit (clamped to the int32 range).
+MFR_MATH_FN uint hashedAlphaCoordinate(float x, float scale) {
+  const float c = floor(x * scale);
+  const float bounded = c < -kHashedAlphaMaxCell ? -kHashedAlphaMaxCell
+                        : c > kHashedAlphaMaxCell ? kHashedAlphaMaxCell
+                                                  : c;
+  return uint(int(bounded));
+}
+
+/// The hash in [0, 1) of the cell of `p` at `scale` cells per world unit, for primitive `prim`.
+MFR_MATH_FN float hashedAlphaCell(uint prim, vec3 p, float scale) {
+  uint h = pcgHash(prim);
+  h = hashCombine(h, hashedAlphaCoordinate(p.x, scale));
+  h = hashCombine(h, hashedAlphaCoordinate(p.y, scale));
+  h = hashCombine(h, hashedAlphaCoordinate(p.z, scale));
+  return hashToUnit(h);
+}
+
+/// The alpha threshold in [1e-6, 1] of the surface point `p` of primitive `prim` whose pixel
+/// covers `footprint` world units: uniform over the points, constant on cells about a pixel wide
+/// whose scale follows the footprint continuously (log2, exp2: std:: on the host, GLSL's on the
+/// GPU, so a point within rounding of a level or cell boundary may differ between the engines).
+MFR_MATH_FN float hashedAlphaThreshold(uint prim, vec3 p, float footprint) {
+  float level = -log2(kHashedAlphaScale * footprint);
+  level = !(level > -kHashedAlphaMaxLevel) ? -kHashedAlphaMaxLevel
+          : level > kHashedAlphaMaxLevel   ? kHashedAlphaMaxLevel
+                                           : level;
+  const float lower = floor(level);
+  MFR_PRECISE float f = level - lower;
+  const float x0 = hashedAlphaCell(prim, p, exp2(lower));
+  const float x1 = hashedAlphaCell(prim, p, exp2(lower + 1.0f));
+  MFR_PRECISE float x = (1.0f - f) * x0 + f * x1;
+  const float a = f < 1.0f - f ? f : 1.0f - f;
+  float h;
+  if (x < a) {
+    MFR_PRECISE float q = x * x / (2.0f * a * (1.0f - a));
+    h = q;
+  } else if (x < 1.0f - a) {
+    MFR_PRECISE float q = (x - 0.5f * a) / (1.0f - a);
+    h = q;
+  } else {
+    MFR_PRECISE float q = 1.0f - (1.0f - x) * (1.0f - x) / (2.0f * a * (1.0f - a));
+    h = q;
+  }
+  return h < kHashedAlphaMinThreshold ? kHashedAlphaMinThreshold : h > 1.0f ? 1.0f : h;
+}
+
+/// Whether a fragment of alpha `a` (as the capture decodes it, alpha8 * (1 / 255)) at that point
+/// is kept.
+MFR_MATH_FN bool hashedAlphaKeeps(float a, uint prim, vec3 p, float footprint) {
+  return a >= hashedAlphaThreshold(prim, p, footprint);
+}
+
+/// The world-space point seen at image position (x, y) (pixels, the centre at the index) at
+/// window depth `depth`, and the world width of a pixel there (`footprint`): the view ray (the
+/// shading's rays: x rayScaleX + rayBiasX, y rayScaleY + rayBiasY, -1) times the view depth
+/// (from the perspective depth with near and far), through the inverse view matrix.
+MFR_MATH_FN vec3 surfacePoint(float x, float y, float depth, float zNear, float zFar,
+                              vec4 rays, mat4 inverseView, MFR_INOUT(float) footprint) {
+  MFR_PRECISE float ndcZ = 2.0f * depth - 1.0f;
+  MFR_PRECISE float viewDepth = 2.0f * zNear * zFar / (zFar + zNear - ndcZ * (zFar - zNear));
+  MFR_PRECISE float vx = x * rays.x + rays.y;
+  MFR_PRECISE float vy = y * rays.z + rays.w;
+  MFR_PRECISE vec4 view = vec4(vx * viewDepth, vy * viewDepth, -1.0f * viewDepth, 1.0f);
+  MFR_PRECISE vec4 world = inverseView * view;
+  footprint = viewDepth * abs(rays.x);
+  return vec3(world.x, world.y, world.z);
 }
 
 // ---- importance (variable k-buffer) ------------------------------------------------------------

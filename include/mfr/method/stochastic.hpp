@@ -64,41 +64,15 @@
 
 namespace mfr {
 
-/// The depth of a sample no fragment covered.
-inline constexpr float kStochasticFarDepth = 3.0e38f;
-inline constexpr int kStochasticMaxSamples = 32;
+// The maths (the key, the masks, the visibility, the composite) are method_math.h's, which the
+// GL engine's shaders share.
+using method_math::kStochasticFarDepth;
+using method_math::kStochasticMaxSamples;
+using method_math::stochasticMask;
 
 /// What identifies a fragment, hashed: its pixel, the depth's bits and the colour word.
 inline uint32_t stochasticKey(uint32_t pixel, float depth, uint32_t rgba) {
-  return hashCombine(hashCombine(pcgHash(pixel), std::bit_cast<uint32_t>(depth)), rgba);
-}
-
-/// The samples (bits 0..S-1) a fragment of alpha `alpha8` (0..255) covers; `key` its
-/// stochasticKey. Unstratified: each sample independently with probability alpha8 / 255.
-/// Stratified: floor(a S) or floor(a S) + 1 samples (mean a S), a uniformly random subset.
-inline uint32_t stochasticMask(int samples, bool stratified, uint32_t key, uint32_t alpha8) {
-  const uint32_t s = static_cast<uint32_t>(samples);
-  uint32_t mask = 0u;
-  if (!stratified) {
-    for (uint32_t j = 0u; j < s; ++j)
-      if (hashBelow(hashCombine(key, j), 255u) < alpha8) mask |= 1u << j;
-    return mask;
-  }
-  // the count: #{m < S : 255 m + v < alpha8 S}, v uniform over [0, 255)
-  const uint32_t v = hashBelow(hashCombine(key, 0x9e3779b9u), 255u);
-  const uint32_t scaled = alpha8 * s;
-  const uint32_t n = scaled > v ? std::min(s, (scaled - v + 254u) / 255u) : 0u;
-  // which samples: the first n of a random permutation (partial Fisher-Yates)
-  uint32_t order[kStochasticMaxSamples];
-  for (uint32_t j = 0u; j < s; ++j) order[j] = j;
-  for (uint32_t i = 0u; i < n; ++i) {
-    const uint32_t pick = i + hashBelow(hashCombine(key, i + 1u), s - i);
-    const uint32_t t = order[i];
-    order[i] = order[pick];
-    order[pick] = t;
-    mask |= 1u << order[i];
-  }
-  return mask;
+  return method_math::stochasticKey(pixel, std::bit_cast<uint32_t>(depth), rgba);
 }
 
 /// One pixel's buffers with S samples: 4 S + 20 bytes.
@@ -123,11 +97,10 @@ struct StochasticPixel {
   float visibility(float z) const {
     int seen = 0;
     for (int j = 0; j < S; ++j) seen += depth[j] >= z ? 1 : 0;
-    return static_cast<float>(seen) * (1.0f / static_cast<float>(S));
+    return method_math::stochasticVisibility(seen, S);
   }
   glm::vec3 composite(glm::vec3 background) const {
-    if (a <= 0.0f) return background;
-    return glm::vec3(r, g, b) / a * (1.0f - trans) + trans * background;
+    return method_math::stochasticComposite(glm::vec3(r, g, b), a, trans, background);
   }
 };
 static_assert(sizeof(StochasticPixel<8>) == 52 && sizeof(StochasticPixel<16>) == 84 &&
