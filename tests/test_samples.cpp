@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <span>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -415,6 +416,18 @@ TEST(Samples, PeersAndTheOracleStorePerSample) {
   EXPECT_LT(mfr::test::largestDifference(peel.image, truth.image), 1e-5f);
 }
 
+// Each (arguments, message) after `common`: exit code 1 and the message on one line of stderr.
+void expectOneLineErrors(const std::string& common,
+                         std::span<const std::pair<std::string, std::string>> bad,
+                         const std::filesystem::path& dir) {
+  for (const auto& [args, message] : bad) {
+    const mfr::test::CliRun r = mfr::test::runCli(common + args, dir);
+    EXPECT_EQ(r.exitCode, 1) << args;
+    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
+  }
+}
+
 TEST(Samples, TheCommandLineChecksItsSampleOptions) {
   const std::filesystem::path dir = mfr::test::processTempDir("mfr_samples");
   const std::string out = (dir / "ms.png").string(), stats = (dir / "ms.json").string();
@@ -436,12 +449,7 @@ TEST(Samples, TheCommandLineChecksItsSampleOptions) {
       {" --samples 2 --sample-storage node", "--sample-storage 'node': expected pixel or sample"},
       {" --overflow-map x.png", "--overflow-map: needs --samples 2, 4 or 8"},
   };
-  for (const auto& [args, message] : bad) {
-    const mfr::test::CliRun r = mfr::test::runCli(common + args, dir);
-    EXPECT_EQ(r.exitCode, 1) << args;
-    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
-  }
+  expectOneLineErrors(common, bad, dir);
   const mfr::test::CliRun dataset =
       mfr::test::runCli("dataset procedural:layers --width 16 --height 16 --samples 4 -q --out " +
                             (dir / "d.mfrds").string(),
@@ -493,12 +501,7 @@ TEST(Samples, CompareRunsEverySampleCountAndPlotsThem) {
       {" --sample-counts 4,4", "--sample-counts '4,4': 4 listed twice"},
       {" --sample-counts 1,4 --orbit 3", "--sample-counts: not with a temporal comparison"},
   };
-  for (const auto& [args, message] : bad) {
-    const mfr::test::CliRun r = mfr::test::runCli(common + args, dir);
-    EXPECT_EQ(r.exitCode, 1) << args;
-    EXPECT_NE(r.err.find(message), std::string::npos) << r.err;
-    EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << "one line: " << r.err;
-  }
+  expectOneLineErrors(common, bad, dir);
   std::filesystem::remove_all(dir);
 }
 

@@ -59,8 +59,8 @@ using std::clamp;
 using std::exp;
 using std::exp2;
 using std::floor;
-using std::log2;
 using std::log;
+using std::log2;
 using std::max;
 using std::min;
 using std::pow;
@@ -1509,7 +1509,7 @@ MFR_MATH_CONST(float, kHashedAlphaMaxLevel, 60.0f)  // |log2 cells per unit| bou
 /// The cell's integer coordinate of x at `scale` cells per unit (clamped to the int32 range).
 MFR_MATH_FN uint hashedAlphaCoordinate(float x, float scale) {
   const float c = floor(x * scale);
-  const float bounded = c < -kHashedAlphaMaxCell ? -kHashedAlphaMaxCell
+  const float bounded = c < -kHashedAlphaMaxCell  ? -kHashedAlphaMaxCell
                         : c > kHashedAlphaMaxCell ? kHashedAlphaMaxCell
                                                   : c;
   return uint(int(bounded));
@@ -1563,8 +1563,8 @@ MFR_MATH_FN bool hashedAlphaKeeps(float a, uint prim, vec3 p, float footprint) {
 /// window depth `depth`, and the world width of a pixel there (`footprint`): the view ray (the
 /// shading's rays: x rayScaleX + rayBiasX, y rayScaleY + rayBiasY, -1) times the view depth
 /// (from the perspective depth with near and far), through the inverse view matrix.
-MFR_MATH_FN vec3 surfacePoint(float x, float y, float depth, float zNear, float zFar,
-                              vec4 rays, mat4 inverseView, MFR_INOUT(float) footprint) {
+MFR_MATH_FN vec3 surfacePoint(float x, float y, float depth, float zNear, float zFar, vec4 rays,
+                              mat4 inverseView, MFR_INOUT(float) footprint) {
   MFR_PRECISE float ndcZ = 2.0f * depth - 1.0f;
   MFR_PRECISE float viewDepth = 2.0f * zNear * zFar / (zFar + zNear - ndcZ * (zFar - zNear));
   MFR_PRECISE float vx = x * rays.x + rays.y;
