@@ -1,7 +1,6 @@
 // mfr compare: the ground truth and several methods at several budgets, written as images,
 // results.json, results.csv and a self-contained report.html (the work is in the library:
 // mfr/compare/compare.hpp).
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -190,14 +189,9 @@ int run(const CompareArgs& a, const std::string& version) {
   std::vector<int> sampleCounts;
   if (!a.sampleCounts.empty()) {
     if (temporal) return fail("--sample-counts: not with a temporal comparison (--orbit N)");
-    for (const std::string& text : splitList(a.sampleCounts)) {
-      auto count = parseSamples(text, "--sample-counts");
-      if (!count) return fail(count.error().message);
-      if (std::find(sampleCounts.begin(), sampleCounts.end(), *count) != sampleCounts.end())
-        return fail("--sample-counts " + quoteInput(a.sampleCounts) + ": " + text +
-                    " listed twice");
-      sampleCounts.push_back(*count);
-    }
+    auto counts = parseSampleCounts(a.sampleCounts, "--sample-counts");
+    if (!counts) return fail(counts.error().message);
+    sampleCounts = std::move(counts.value());
   }
   CompareOptions options;
   options.scene = a.scene.source;
@@ -304,29 +298,11 @@ int run(const CompareArgs& a, const std::string& version) {
   auto result = runComparison(**engine, **view, options);
   if (!result) return fail(echoPath(a.scene.source) + ": " + result.error().message);
   // --sample-counts: the same comparison at each count, against that count's own ground truth
-  for (const int count : sampleCounts) {
-    if (count == result->samples) {
-      result->sampleCounts.push_back(sampleCountRuns(*result));
-      continue;
-    }
-    View at = sceneView(*prepared, a.scene, prepared->cameras.front());
-    at.samples = count;
-    auto counted = (*engine)->prepare(at);
-    if (!counted)
-      return fail(echoPath(a.scene.source) + ": --sample-counts " + std::to_string(count) + ": " +
-                  counted.error().message);
-    CompareOptions o = options;
-    if (o.progress) {
-      o.progress = [&progress, count](const std::string& stage, int done, int total) {
-        progress.set(std::to_string(count) + " samples: " + stage, done, total);
-      };
-    }
-    auto other = runComparison(**engine, **counted, o);
-    if (!other)
-      return fail(echoPath(a.scene.source) + ": --sample-counts " + std::to_string(count) + ": " +
-                  other.error().message);
-    result->sampleCounts.push_back(sampleCountRuns(*other));
-  }
+  if (auto counted =
+          addSampleCounts(**engine, sceneView(*prepared, a.scene, prepared->cameras.front()),
+                          options, sampleCounts, *result);
+      !counted)
+    return fail(echoPath(a.scene.source) + ": " + counted.error().message);
   const CompareResult& r = result.value();
 
   // files

@@ -192,7 +192,7 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
             alpha=None, background=None, transmission_floor=0.1, shuffle_draw_order=None,
             gltf_scene=None, cull=None, blend=None, engine="cpu", gl_sync="auto",
             gl_raster="native", memory_limit=None, allow_outside_references=False, samples=1,
-            sample_storage="pixel") -> dict:
+            sample_storage="pixel", sample_counts=None) -> dict:
     """Writes the folder `mfr compare --out OUT` writes for the same options and returns its
     results.json as a dict.
 
@@ -208,7 +208,10 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
     is compared. scene, camera, view, zoom, width, height, threads, seed, alpha, background,
     transmission_floor, shuffle_draw_order, gltf_scene, cull, blend, engine, gl_sync, gl_raster,
     memory_limit, allow_outside_references, samples, sample_storage: as in mfr.render (the
-    ground truth of a multisampled comparison is the per-sample A-buffer, box-filtered). A method that fails at a budget is
+    ground truth of a multisampled comparison is the per-sample A-buffer, box-filtered).
+    sample_counts: sample counts (e.g. [1, 4, 8]) to run the comparison at too, each against its
+    own ground truth, as `mfr compare --sample-counts` (results.json "sample_counts", the
+    report's error-vs-bytes-per-pixel figure per count). A method that fails at a budget is
     recorded with its error; bad input raises mfr.Error.
     """
     if isinstance(budgets, (str, int)):
@@ -235,7 +238,8 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                                  ("memory_limit", memory_limit, None),
                                  ("allow_outside_references", allow_outside_references, False),
                                  ("samples", samples, 1), ("sample_storage", sample_storage,
-                                                           "pixel")):
+                                                           "pixel"),
+                                 ("sample_counts", sample_counts, None)):
         if value != default:
             call.append(f"{name}={value!r}")
     if model is not None:
@@ -249,7 +253,10 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                     shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
                     blend=blend, engine=engine, gl_sync=gl_sync, gl_raster=gl_raster,
                     memory_limit=memory_limit, allow_outside_references=allow_outside_references,
-                    samples=str(samples), sample_storage=sample_storage, command_line="mfr.compare(" + ", ".join(call) + ")")
+                    samples=str(samples), sample_storage=sample_storage,
+                    sample_counts="" if sample_counts is None else
+                    ",".join(str(c) for c in sample_counts),
+                    command_line="mfr.compare(" + ", ".join(call) + ")")
 
 
 # --- the deep k-buffer's models ----------------------------------------------------------------

@@ -86,9 +86,12 @@ py::object compare(const py::object& sceneArg, const std::string& out,
                    const std::string& glSync, const std::string& glRaster,
                    const py::object& memoryLimitArg, bool allowOutsideReferences,
                    const std::string& samplesArg, const std::string& sampleStorage,
-                   const std::string& commandLine) {
+                   const std::string& sampleCountsArg, const std::string& commandLine) {
   if (out.empty()) throw LibraryError("out: an output folder is required");
   const int samples = unwrap(parseSamples(samplesArg, "samples"));
+  std::vector<int> sampleCounts;
+  if (!sampleCountsArg.empty())
+    sampleCounts = unwrap(parseSampleCounts(sampleCountsArg, "sample_counts"));
   const bool temporal = orbit != 0 && orbitView.is_none();  // every view of the orbit
   if (temporal && orbit < 2)
     throw LibraryError("orbit " + std::to_string(orbit) +
@@ -97,6 +100,8 @@ py::object compare(const py::object& sceneArg, const std::string& out,
     throw LibraryError("orbit_step: must be in (0, 360] degrees");
   if (orbitStep > 0.0 && !temporal)
     throw LibraryError("orbit_step: needs orbit N (and no orbit_view)");
+  if (!sampleCounts.empty() && temporal)
+    throw LibraryError("sample_counts: not with a temporal comparison (orbit N)");
   CompareOptions options;
   options.seed = seed;
   options.flipPixelsPerDegree = pixelsPerDegree(ppd);
@@ -192,6 +197,11 @@ py::object compare(const py::object& sceneArg, const std::string& out,
           previousViewCosine(*engine, *scene.scene, scene.source, views, width, height, samples));
       auto result = runComparison(*engine, **view, options);
       if (!result) throw named(result.error());
+      if (auto counted = addSampleCounts(
+              *engine, View{&*scene.scene, views.cameras.front(), width, height, samples}, options,
+              sampleCounts, result.value());
+          !counted)
+        throw named(counted.error());
       jsonText = unwrap(writeComparison(result.value(), folder.staging(), MFR_VERSION, info));
     }
     unwrap(folder.commit());
@@ -218,8 +228,8 @@ flip_map (LDR-FLIP per pixel, float32 (h, w) in [0, 1]).)");
         py::arg("transmission_floor"), py::arg("shuffle_draw_order"), py::arg("gltf_scene"),
         py::arg("cull"), py::arg("blend"), py::arg("engine"), py::arg("gl_sync"),
         py::arg("gl_raster"), py::arg("memory_limit"), py::arg("allow_outside_references"),
-        py::arg("samples"), py::arg("sample_storage"), py::arg("command_line"),
-        "mfr.compare's work (see python/mfr/__init__.py).");
+        py::arg("samples"), py::arg("sample_storage"), py::arg("sample_counts"),
+        py::arg("command_line"), "mfr.compare's work (see python/mfr/__init__.py).");
 }
 
 }  // namespace mfr::python

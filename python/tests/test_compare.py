@@ -171,3 +171,27 @@ def test_temporal_orbit_and_orbit_view_match_the_cli(tmp_path, cli):
     with pytest.raises(mfr.Error, match=r"^orbit_step: needs orbit N"):
         mfr.compare(SCENE, tmp_path / "x", "50%", methods=["fkb"], width=24, height=20,
                     orbit_step=5)
+
+
+def test_sample_counts_as_the_cli_runs_them(tmp_path, cli):
+    # sample_counts: the comparison at each count against its own truth, the same figures as
+    # `mfr compare --sample-counts` (metrics and statistics but timings)
+    import subprocess
+    subprocess.run([cli, "compare", SCENE, "--width", str(SIZE), "--height", str(SIZE),
+                    "--budget", "80KB", "--methods", "kplus-heap", "--sample-counts", "1,4",
+                    "--threads", "2", "--out", str(tmp_path / "cli"), "--quiet"], check=True)
+    r = mfr.compare(SCENE, tmp_path / "py", "80KB", methods=["kplus-heap"], width=SIZE,
+                    height=SIZE, threads=2, sample_counts=[1, 4])
+    cli_counts = read_json(tmp_path / "cli" / "results.json")["sample_counts"]
+    assert [c["samples"] for c in r["sample_counts"]] == [1, 4]
+    for py_count, cli_count in zip(r["sample_counts"], cli_counts):
+        py_run = py_count["budgets"][0]["methods"][0]
+        cli_run = cli_count["budgets"][0]["methods"][0]
+        assert without_times(py_run) == without_times(cli_run)
+        assert py_run["samples"] == py_count["samples"]
+    with pytest.raises(mfr.Error, match=r"^sample_counts '4,4': 4 listed twice$"):
+        mfr.compare(SCENE, tmp_path / "x", "80KB", methods=["kplus-heap"], width=SIZE,
+                    height=SIZE, sample_counts=[4, 4])
+    with pytest.raises(mfr.Error, match=r"^sample_counts '3': expected 1, 2, 4 or 8$"):
+        mfr.compare(SCENE, tmp_path / "x", "80KB", methods=["kplus-heap"], width=SIZE,
+                    height=SIZE, sample_counts=[1, 3])

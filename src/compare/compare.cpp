@@ -352,6 +352,29 @@ SampleCountRuns sampleCountRuns(const CompareResult& result) {
   return out;
 }
 
+Result<void> addSampleCounts(Engine& engine, View view, const CompareOptions& options,
+                             const std::vector<int>& counts, CompareResult& result) {
+  for (const int count : counts) {
+    if (count == result.samples) {
+      result.sampleCounts.push_back(sampleCountRuns(result));
+      continue;
+    }
+    const std::string what = "--sample-counts " + std::to_string(count) + ": ";
+    view.samples = count;
+    auto prepared = engine.prepare(view);
+    if (!prepared) return makeError(what + prepared.error().message);
+    CompareOptions o = options;
+    if (options.progress)
+      o.progress = [&options, count](const std::string& stage, int done, int total) {
+        options.progress(std::to_string(count) + " samples: " + stage, done, total);
+      };
+    auto other = runComparison(engine, **prepared, o);
+    if (!other) return makeError(what + other.error().message);
+    result.sampleCounts.push_back(sampleCountRuns(*other));
+  }
+  return {};
+}
+
 nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersion) {
   nlohmann::json j;
   if (!mfrVersion.empty()) j["mfr_version"] = mfrVersion;

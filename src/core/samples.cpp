@@ -1,5 +1,7 @@
 #include "mfr/core/samples.hpp"
 
+#include <algorithm>
+
 #include "mfr/core/quote.hpp"
 
 namespace mfr {
@@ -31,6 +33,24 @@ Result<int> parseSamples(const std::string& text, const std::string& name) {
   for (int s : {1, 2, 4, 8})
     if (text == std::to_string(s)) return s;
   return makeError(name + " " + quoteInput(text) + ": expected 1, 2, 4 or 8");
+}
+
+Result<std::vector<int>> parseSampleCounts(const std::string& list, const std::string& name) {
+  std::vector<int> counts;
+  size_t begin = 0;
+  while (begin <= list.size()) {
+    const size_t end = std::min(list.find(',', begin), list.size());
+    std::string text = list.substr(begin, end - begin);
+    const size_t b = text.find_first_not_of(" \t"), e = text.find_last_not_of(" \t");
+    text = b == std::string::npos ? std::string() : text.substr(b, e - b + 1);
+    auto count = parseSamples(text, name);
+    if (!count) return count.error();
+    if (std::find(counts.begin(), counts.end(), *count) != counts.end())
+      return makeError(name + " " + quoteInput(list) + ": " + text + " listed twice");
+    counts.push_back(*count);
+    begin = end + 1;
+  }
+  return counts;
 }
 
 const char* toString(SampleStorage storage) {

@@ -122,6 +122,14 @@ struct CompareResult {
 /// The runs of `result` without their images (what SampleCountRuns keeps).
 SampleCountRuns sampleCountRuns(const CompareResult& result);
 
+/// `--sample-counts`: `result` (a comparison of `view`) again at each of `counts` (1, 2, 4, 8, no
+/// repeats: the CLI and Python check them), each against that count's own ground truth, into
+/// result.sampleCounts in order; the count result.samples has reuses result's runs. Errors: the
+/// engine cannot prepare a count (e.g. the GL engine on a driver without it) or a failed ground
+/// truth, naming the count.
+Result<void> addSampleCounts(Engine& engine, View view, const CompareOptions& options,
+                             const std::vector<int>& counts, CompareResult& result);
+
 /// Renders the ground truth and every method at every budget. Errors: an empty method or budget
 /// list, an unknown or duplicated method, a duplicated or zero budget, or a failed ground truth.
 /// A method failing at a budget is not an error: its run carries the message.

@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 #include "mfr/core/result.hpp"
 #include "mfr/method/method_math.h"
@@ -47,6 +48,9 @@ std::span<const SampleOffset> samplePattern(int samples);
 
 /// Parses a sample count: 1, 2, 4 or 8; the error names the input as `name`.
 Result<int> parseSamples(const std::string& text, const std::string& name);
+/// Parses a comma-separated list of distinct sample counts ("1,4,8"); the error names the input as
+/// `name` (a bad count, a count listed twice).
+Result<std::vector<int>> parseSampleCounts(const std::string& list, const std::string& name);
 
 enum class SampleStorage : uint8_t {
   Pixel,   // one node per fragment with a coverage mask
