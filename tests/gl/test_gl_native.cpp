@@ -250,6 +250,52 @@ TEST(GlSamples, RefusedWhereTheRasterOrDriverCannotRunThem) {
   }
 }
 
+// The variable k-buffer's previous-frame |n.v| (one value per image pixel, as compare --orbit-view
+// passes it) under per-sample storage: each sample of a pixel takes the pixel's value, on both
+// engines (the GL frame expands it as CpuEngine::render does), so the importance maps agree and
+// differ from this frame's own |n.v|'s.
+TEST(GlSamples, PreviousFrameCosinePerSample) {
+  MFR_GL_ENGINE_OR_SKIP(gl, "auto", "native");
+  const Scene scene = loadScene("procedural:bottles?count=3").value();
+  const Camera camera = frameBounds(sceneBounds(scene));
+  const int w = 48, h = 40;
+  const View view{&scene, camera, w, h, 4};
+  CpuEngine cpu(EngineOptions{2, 16});
+  auto gv = gl->prepare(view);
+  auto cv = cpu.prepare(view);
+  ASSERT_TRUE(gv.ok()) << gv.error().message;
+  ASSERT_TRUE(cv.ok()) << cv.error().message;
+  std::vector<float> previous;
+  for (int p = 0; p < w * h; ++p) previous.push_back(static_cast<float>(p % 251) / 250.0f);
+  MethodDesc method = methodPreset("vkb").value();
+  method.importance.useNoise = false;
+  RenderOptions options;
+  options.budgetBytes = 600u << 10;
+  options.sampleStorage = SampleStorage::Sample;
+  RenderOptions own = options;  // this frame's |n.v|
+  options.previousNearestCosine = &previous;
+  RenderOptions cpuOptions = options;
+  cpuOptions.capture = CaptureMode::FragmentParallel;
+  auto g = gl->render(**gv, method, options);
+  auto r = cpu.render(**cv, method, cpuOptions);
+  auto gOwn = gl->render(**gv, method, own);
+  ASSERT_TRUE(g.ok() && r.ok() && gOwn.ok());
+  const std::vector<float>&gi = g->importance.importance, &ri = r->importance.importance,
+        &oi = gOwn->importance.importance;
+  ASSERT_EQ(gi.size(), static_cast<size_t>(w * h));
+  ASSERT_EQ(ri.size(), gi.size());
+  double apart = 0.0, fromOwn = 0.0;
+  for (size_t p = 0; p < gi.size(); ++p) {
+    apart = std::max(apart, static_cast<double>(std::abs(gi[p] - ri[p])));
+    fromOwn = std::max(fromOwn, static_cast<double>(std::abs(gi[p] - oi[p])));
+  }
+  EXPECT_LT(apart, 1e-4 * fromOwn) << apart << " against " << fromOwn;
+  EXPECT_GT(fromOwn, 0.0);
+  EXPECT_LE(
+      std::abs(static_cast<double>(g->stats.bytesUsed) - static_cast<double>(r->stats.bytesUsed)),
+      1e-3 * static_cast<double>(r->stats.bytesUsed));
+}
+
 // --gl-raster: native is the default (describe() and the stats say which ran); an unknown value is
 // one line naming the option.
 TEST(GlRaster, NativeIsTheDefaultAndUnknownValuesAreErrors) {
