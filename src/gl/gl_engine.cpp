@@ -93,7 +93,7 @@ void GlEngine::State::drawScene() const {
   glBindFramebuffer(GL_FRAMEBUFFER, fbo);
   glViewport(0, 0, rasterWidth, height);
   // per-sample storage: one invocation per covered sample, its inputs at the sample
-  if (sampling.samples > 1 && sampling.storage == SampleStorage::Sample) {
+  if (sampling.storagePerPixel() > 1) {
     glEnable(GL_SAMPLE_SHADING);
     glMinSampleShading(1.0f);
   } else {
@@ -404,7 +404,7 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
     return makeError("--gl-raster exact: --samples " + std::to_string(sampling.samples) +
                      ": the exact raster emulates one sample per pixel (use --gl-raster native)");
   if (sampling.samples == 1) sampling.storage = SampleStorage::Pixel;
-  const int per = sampling.storage == SampleStorage::Sample ? sampling.samples : 1;
+  const int per = sampling.storagePerPixel();
   if (static_cast<int64_t>(width) * per > kMaxImageSize)
     return makeError("image size " + std::to_string(width) + "x" + std::to_string(height) +
                      " with per-sample storage of " + std::to_string(per) +
@@ -438,7 +438,7 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   // the resolves of per-pixel storage composite each sample from the nodes' coverage masks
   for (const ProgramId id : {ProgramId::Resolve, ProgramId::ListResolve}) {
     const GLuint p = s->program(id);
-    glProgramUniform1i(p, loc(p, "uMaskSamples"), s->maskSamples());
+    glProgramUniform1i(p, loc(p, "uMaskSamples"), sampling.maskSamples());
   }
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
     return makeError("--engine gl: scene upload failed (GL error " + glErrorText(e) + ")");
@@ -450,7 +450,7 @@ Result<std::vector<uint32_t>> GlEngine::count() {
 }
 
 Result<std::vector<uint8_t>> GlEngine::edgePixels() {
-  if (state_->maskSamples() == 1)
+  if (state_->sampling.maskSamples() == 1)
     return makeError("--engine gl: edge pixels need a multisampled view with per-pixel storage");
   auto partial = state_->countPass(true);
   if (!partial) return partial.error();

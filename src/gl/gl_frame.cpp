@@ -4,8 +4,10 @@
 #include <epoxy/gl.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <optional>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -15,8 +17,8 @@
 #include "mfr/gl/shared_layout.h"
 #include "mfr/method/aoit.hpp"
 #include "mfr/method/dfaoit.hpp"
-#include "mfr/method/mboit.hpp"
 #include "mfr/method/hashed_alpha.hpp"
+#include "mfr/method/mboit.hpp"
 #include "mfr/method/method_math.h"
 #include "mfr/method/pass_plan.hpp"
 #include "mfr/method/stochastic.hpp"
@@ -140,6 +142,20 @@ struct GlEngine::State::FrameRun {
     fb.bindImage(counts, kBindCounts);
   }
 
+  // the per-pixel accumulators (accum), every pixel starting as the words `pixel`, and the
+  // pixels' spin-locks, free; returns the locks
+  GLuint makeAccumulators(std::span<const uint32_t> pixel) {
+    const uint64_t pixels = plan.pixels;
+    std::vector<uint32_t> init(pixels * pixel.size());
+    for (uint64_t p = 0; p < pixels; ++p)
+      std::copy(pixel.begin(), pixel.end(),
+                init.begin() + static_cast<ptrdiff_t>(p * pixel.size()));
+    accum = fb.make("accumulators", init.size() * 4, init.data());
+    const GLuint locks = fb.make("locks", pixels * 4);
+    clearUint(locks, kLockFree);
+    return locks;
+  }
+
   FrameRun(State& state, const RenderPlan& p, GlRenderOutput& output)
       : s(state), plan(p), out(output), fb(&output.bufferBytes) {}
 
@@ -199,19 +215,12 @@ struct GlEngine::State::FrameRun {
 
   // dfaoit: the per-pixel sums (dfaoit.frag)
   void captureDfaoit() {
-    const uint32_t pixels = plan.pixels;
-    accum = fb.make("accumulators", uint64_t{pixels} * kDfaoitWords * 4);
-    {  // T = 1 and the nearest node empty (kFarDepthBits); the rest 0
-      static_assert(kDfaoitWords == 13);
-      std::vector<uint32_t> init(uint64_t{pixels} * kDfaoitWords, 0u);
-      for (uint32_t p = 0; p < pixels; ++p) {
-        init[uint64_t{p} * kDfaoitWords + 8] = std::bit_cast<uint32_t>(1.0f);
-        init[uint64_t{p} * kDfaoitWords + 11] = kFarDepthBits;
-      }
-      glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
-    }
-    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
-    clearUint(locks, kLockFree);
+    // T = 1 and the nearest node empty (kFarDepthBits); the rest 0
+    static_assert(kDfaoitWords == 13);
+    std::array<uint32_t, kDfaoitWords> pixel{};
+    pixel[8] = std::bit_cast<uint32_t>(1.0f);
+    pixel[11] = kFarDepthBits;
+    const GLuint locks = makeAccumulators(pixel);
     pass("capture", [&] {
       const GLuint p = s.program(ProgramId::Dfaoit);
       useCapture(p);
@@ -225,20 +234,11 @@ struct GlEngine::State::FrameRun {
   // stochastic, stochastic-strat: the sample depths (kStochasticFarDepth), T = 1, the sums 0;
   // three passes of stochastic.frag
   void captureStochastic() {
-    const uint32_t pixels = plan.pixels;
-    accum = fb.make("accumulators", uint64_t{pixels} * kStochasticWords * 4);
-    {
-      std::vector<uint32_t> init(uint64_t{pixels} * kStochasticWords, 0u);
-      for (uint32_t p = 0; p < pixels; ++p) {
-        for (int j = 0; j < kStochasticSamples; ++j)
-          init[uint64_t{p} * kStochasticWords + j] =
-              std::bit_cast<uint32_t>(method_math::kStochasticFarDepth);
-        init[uint64_t{p} * kStochasticWords + kStochasticSamples] = std::bit_cast<uint32_t>(1.0f);
-      }
-      glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
-    }
-    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
-    clearUint(locks, kLockFree);
+    std::array<uint32_t, kStochasticWords> pixel{};
+    for (int j = 0; j < kStochasticSamples; ++j)
+      pixel[j] = std::bit_cast<uint32_t>(method_math::kStochasticFarDepth);
+    pixel[kStochasticSamples] = std::bit_cast<uint32_t>(1.0f);
+    const GLuint locks = makeAccumulators(pixel);
     const bool stratified = plan.method.compositing == Compositing::StochasticStrat8;
     const auto draw = [&](GLuint passIndex) {
       const GLuint p = s.program(ProgramId::Stochastic);
@@ -260,17 +260,9 @@ struct GlEngine::State::FrameRun {
 
   // hashed-alpha: the z-buffer of the kept fragments (kStochasticFarDepth: none kept)
   void captureHashedAlpha() {
-    const uint32_t pixels = plan.pixels;
-    accum = fb.make("accumulators", uint64_t{pixels} * kHashedAlphaWords * 4);
-    {
-      std::vector<uint32_t> init(uint64_t{pixels} * kHashedAlphaWords, 0u);
-      for (uint32_t p = 0; p < pixels; ++p)
-        init[uint64_t{p} * kHashedAlphaWords] =
-            std::bit_cast<uint32_t>(method_math::kStochasticFarDepth);
-      glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
-    }
-    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
-    clearUint(locks, kLockFree);
+    const std::array<uint32_t, kHashedAlphaWords> pixel{
+        std::bit_cast<uint32_t>(method_math::kStochasticFarDepth), 0u};
+    const GLuint locks = makeAccumulators(pixel);
     pass("capture", [&] {
       const GLuint p = s.program(ProgramId::HashedAlpha);
       useCapture(p);
@@ -308,28 +300,21 @@ struct GlEngine::State::FrameRun {
 
   // wboit, mboit, aoit: the per-pixel accumulators (mboit: its moments first; aoit: its nodes)
   void captureAccumulators() {
-    const uint32_t pixels = plan.pixels;
     const bool isWboit = plan.technique == GlTechnique::Wboit;
     const bool isAoit = plan.technique == GlTechnique::Aoit;
     const uint32_t aoitNodes = static_cast<uint32_t>(aoitNodeCount(plan.method.compositing));
     const uint32_t accumWords = isWboit  ? kWboitWords
                                 : isAoit ? aoitWords(plan.method)
                                          : mboitWords(plan.method);
-    accum = fb.make("accumulators", uint64_t{pixels} * accumWords * 4);
-    {  // wboit: revealage 1; aoit: unused nodes (kAoitEmptyDepth, transmittance 1); the rest 0
-      std::vector<float> init(uint64_t{pixels} * accumWords, 0.0f);
-      if (isWboit)
-        for (uint32_t p = 0; p < pixels; ++p) init[uint64_t{p} * accumWords + 4] = 1.0f;
-      if (isAoit)
-        for (uint32_t p = 0; p < pixels; ++p)
-          for (uint32_t j = 0; j < aoitNodes; ++j) {
-            init[uint64_t{p} * accumWords + kAoitNodeWords * j] = kAoitEmptyDepth;
-            init[uint64_t{p} * accumWords + kAoitNodeWords * j + 1] = 1.0f;
-          }
-      glNamedBufferSubData(accum, 0, static_cast<GLsizeiptr>(init.size() * 4), init.data());
-    }
-    const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
-    clearUint(locks, kLockFree);
+    // wboit: revealage 1; aoit: unused nodes (kAoitEmptyDepth, transmittance 1); the rest 0
+    std::vector<uint32_t> pixel(accumWords, 0u);
+    if (isWboit) pixel[4] = std::bit_cast<uint32_t>(1.0f);
+    if (isAoit)
+      for (uint32_t j = 0; j < aoitNodes; ++j) {
+        pixel[kAoitNodeWords * j] = std::bit_cast<uint32_t>(kAoitEmptyDepth);
+        pixel[kAoitNodeWords * j + 1] = std::bit_cast<uint32_t>(1.0f);
+      }
+    const GLuint locks = makeAccumulators(pixel);
     auto accumulate = [&](GLuint program, bool capture) {
       if (capture) {
         useCapture(program);

@@ -18,43 +18,43 @@ namespace mfr::gl {
 
 /// Every program of the engine; kPrograms (gl_programs.cpp) has one row per value, in this order.
 enum class ProgramId : uint8_t {
-  Count,            // count.frag: n(p)
-  ABuffer,          // capture_abuffer.frag
-  KBuffer,          // capture_kbuffer.frag (lock or interlock)
-  KBufferAtomic64,  // capture_kbuffer_atomic64.frag (fixed k, 64-bit atomicMin)
-  SwapNodeWords,    // swap_node_words.comp (the atomic capture's words back to node order)
-  DepthRange,       // depth_range.frag (occupancy: the pixel's depth range)
-  OccupancyFill,    // occupancy_fill.frag
-  NearestCosine,    // nearest_cosine.frag (vkb: the nearest fragment's |n.v|)
-  Wboit,            // wboit.frag
-  WboitResolve,     // wboit_resolve.comp
-  Dfaoit,           // dfaoit.frag
-  DfaoitResolve,    // dfaoit_resolve.comp
-  MboitMoments,     // mboit_moments.frag
-  MboitColor,       // mboit_color.frag
-  MboitResolve,     // mboit_resolve.comp
-  Mlab,             // mlab.frag
-  MlabResolve,      // mlab_resolve.comp
-  DkbFeatures,      // dkb_features.frag
-  DkbInfer,         // dkb_infer.comp
-  OccupancyCount,   // occupancy_count.comp (the k-th occupied bucket)
-  PrefixSum,        // prefix_sum.comp
-  PrefixSumAdd,     // prefix_sum_add.comp
-  Resolve,          // resolve.comp (A-buffer and k-buffer family)
-  AllocHistogram,   // alloc_histogram.comp
-  Importance,       // importance.comp
-  ImportanceTotal,  // importance_total.comp
-  AllocK,           // alloc_k.comp
-  AllocPack,        // alloc_pack.comp
-  AoitVisibility,   // aoit_visibility.frag
-  AoitColor,        // aoit_color.frag
-  AoitResolve,      // aoit_resolve.comp
-  ListCapture,      // capture_list.frag (per-pixel linked lists)
-  ListResolve,      // resolve_list.comp
-  Peel,             // peel.frag (depth peeling's passes and tail pass)
-  PeelStep,         // peel_step.comp (between peel passes)
-  PeelResolve,      // peel_resolve.comp
-  Stochastic,       // stochastic.frag (its three passes, uPass)
+  Count,               // count.frag: n(p)
+  ABuffer,             // capture_abuffer.frag
+  KBuffer,             // capture_kbuffer.frag (lock or interlock)
+  KBufferAtomic64,     // capture_kbuffer_atomic64.frag (fixed k, 64-bit atomicMin)
+  SwapNodeWords,       // swap_node_words.comp (the atomic capture's words back to node order)
+  DepthRange,          // depth_range.frag (occupancy: the pixel's depth range)
+  OccupancyFill,       // occupancy_fill.frag
+  NearestCosine,       // nearest_cosine.frag (vkb: the nearest fragment's |n.v|)
+  Wboit,               // wboit.frag
+  WboitResolve,        // wboit_resolve.comp
+  Dfaoit,              // dfaoit.frag
+  DfaoitResolve,       // dfaoit_resolve.comp
+  MboitMoments,        // mboit_moments.frag
+  MboitColor,          // mboit_color.frag
+  MboitResolve,        // mboit_resolve.comp
+  Mlab,                // mlab.frag
+  MlabResolve,         // mlab_resolve.comp
+  DkbFeatures,         // dkb_features.frag
+  DkbInfer,            // dkb_infer.comp
+  OccupancyCount,      // occupancy_count.comp (the k-th occupied bucket)
+  PrefixSum,           // prefix_sum.comp
+  PrefixSumAdd,        // prefix_sum_add.comp
+  Resolve,             // resolve.comp (A-buffer and k-buffer family)
+  AllocHistogram,      // alloc_histogram.comp
+  Importance,          // importance.comp
+  ImportanceTotal,     // importance_total.comp
+  AllocK,              // alloc_k.comp
+  AllocPack,           // alloc_pack.comp
+  AoitVisibility,      // aoit_visibility.frag
+  AoitColor,           // aoit_color.frag
+  AoitResolve,         // aoit_resolve.comp
+  ListCapture,         // capture_list.frag (per-pixel linked lists)
+  ListResolve,         // resolve_list.comp
+  Peel,                // peel.frag (depth peeling's passes and tail pass)
+  PeelStep,            // peel_step.comp (between peel passes)
+  PeelResolve,         // peel_resolve.comp
+  Stochastic,          // stochastic.frag (its three passes, uPass)
   StochasticResolve,   // stochastic_resolve.comp
   HashedAlpha,         // hashed_alpha.frag
   HashedAlphaResolve,  // hashed_alpha_resolve.comp

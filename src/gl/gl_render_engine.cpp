@@ -82,16 +82,23 @@ double msSince(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-// The optimal k-buffer's k(p) from the CPU engine's oracle (optimalK, mfr/cpu/optimal_oracle.hpp)
-// on the same view.
-Result<OracleChoice> cpuOracle(const View& view, const MethodDesc& method,
-                               const RenderOptions& options, uint64_t slots) {
+// The CPU engine's frame of the view, for the passes the GL engine leaves to the host: the
+// view's samples, in the method's storage discipline.
+Result<RasterFrame> cpuFrameOf(const View& view, const MethodDesc& method,
+                               const RenderOptions& options) {
   RasterOptions ro;
   ro.width = view.width;
   ro.height = view.height;
   ro.samples = view.samples;
   ro.storage = sampleStorageOf(method, options);
-  auto frame = RasterFrame::build(*view.scene, view.camera, ro);
+  return RasterFrame::build(*view.scene, view.camera, ro);
+}
+
+// The optimal k-buffer's k(p) from the CPU engine's oracle (optimalK, mfr/cpu/optimal_oracle.hpp)
+// on the same view.
+Result<OracleChoice> cpuOracle(const View& view, const MethodDesc& method,
+                               const RenderOptions& options, uint64_t slots) {
+  auto frame = cpuFrameOf(view, method, options);
   if (!frame) return frame.error();
   return optimalK(*frame, method, options, slots);
 }
@@ -100,12 +107,7 @@ Result<OracleChoice> cpuOracle(const View& view, const MethodDesc& method,
 // mfr/cpu/dkb_curve_pass.hpp) on the same view.
 Result<CurveChoice> cpuCurves(const View& view, const MethodDesc& method,
                               const RenderOptions& options, uint64_t slots) {
-  RasterOptions ro;
-  ro.width = view.width;
-  ro.height = view.height;
-  ro.samples = view.samples;
-  ro.storage = sampleStorageOf(method, options);
-  auto frame = RasterFrame::build(*view.scene, view.camera, ro);
+  auto frame = cpuFrameOf(view, method, options);
   if (!frame) return frame.error();
   return predictedCurveK(*frame, method, slots);
 }
@@ -203,11 +205,12 @@ class GlFrame {
     // linked lists: k(p), the nodes each list got (depth peeling's held are fragments, not k)
     if (method_.store == StoreChoice::LinkedList && !g.held.empty()) a->capacity = g.held;
     fillStats(g, a.value(), interlock);
-    if (engine_.sampling().samples > 1) {
+    const GlSampling& sampling = engine_.sampling();
+    if (sampling.samples > 1) {
       auto edges = gv_.edgePixels();
       if (!edges) return edges.error();
       edgeStatistics(g.counts, capturedPerPixel(*technique, g, a.value()), **edges,
-                     engine_.width() / gv_.width(), out_);
+                     sampling.storagePerPixel(), out_);
     }
     out_.image = std::move(g.image);
     out_.kMap = a->reservedK.empty() ? std::move(a->capacity) : std::move(a->reservedK);
@@ -217,9 +220,8 @@ class GlFrame {
       out_.offsets = std::move(g.nodeOffsets);
       out_.counts = std::move(g.nodeCounts);
     }
-    const GlSampling& sampling = engine_.sampling();
-    if (sampling.samples > 1 && sampling.storage == SampleStorage::Sample)
-      toImagePixels(out_, sampling.samples);  // the W S x H storage to the W x H image
+    if (sampling.storagePerPixel() > 1)  // the W S x H storage to the W x H image
+      toImagePixels(out_, sampling.storagePerPixel());
     return std::move(out_);
   }
 

@@ -88,14 +88,6 @@ struct GlEngine::State {
   Result<std::vector<uint32_t>> countPass(bool edges) const;
   /// the framebuffer's samples per pixel and their positions against the standard pattern
   Result<void> checkSamplePattern() const;
-  /// multisampled: the storage pixels one image pixel has (per-sample storage: the samples)
-  int storagePerPixel() const {
-    return sampling.storage == SampleStorage::Sample ? sampling.samples : 1;
-  }
-  /// the samples of the coverage masks in the nodes' depths (per-pixel storage), else 1
-  int maskSamples() const {
-    return sampling.storage == SampleStorage::Pixel ? sampling.samples : 1;
-  }
 
   // --- one frame (gl_frame.cpp) ---
   /// the method's technique and allocation, checked against the block size

@@ -102,6 +102,11 @@ Result<GlRaster> parseGlRaster(std::string_view text);
 struct GlSampling {
   int samples = 1;
   SampleStorage storage = SampleStorage::Pixel;
+
+  /// The storage pixels of one image pixel: the samples under per-sample storage, else 1.
+  int storagePerPixel() const { return storage == SampleStorage::Sample ? samples : 1; }
+  /// The samples of the coverage masks in the nodes' depths (per-pixel storage), else 1.
+  int maskSamples() const { return storage == SampleStorage::Pixel ? samples : 1; }
 };
 
 /// One scene and view uploaded to GL once; render() runs a method on it any number of times.
