@@ -9,6 +9,8 @@ void main() {
   if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, true, base)) discard;
-  const bool partial = coverageShare(floatBitsToUint(fragmentDepth(f))) < 1.0;
-  imageAtomicAdd(uCounts, f.pixel, uEdges == 0u || partial ? 1u : 0u);
+  // (the edge pass: only the fragments that cover part of their pixel; the depth word carries the
+  // mask, so the other count passes skip reading it)
+  if (uEdges != 0u && coverageShare(floatBitsToUint(fragmentDepth(f))) >= 1.0) return;
+  imageAtomicAdd(uCounts, f.pixel, 1u);
 }
