@@ -16,11 +16,11 @@
 // [+ 12 + 4 d occupancy], plus the count pass's 4-byte counter.
 //
 // Fixed-k k-buffer capture with the k+ culling test (Vasilakis and Fudos, k+-buffer), max-array or
-// max-heap store (uStore): pixel p owns the k nodes nodes[p * k .. p * k + k), initialised to the
+// max-heap store (MFR_STORE): pixel p owns the k nodes nodes[p * k .. p * k + k), initialised to the
 // far node (so the store is always full), with the maximum always in slot 0. Max-array: the
 // maximum is replaced and the new maximum found by a linear scan (O(k)); max-heap: the root is
 // replaced and sifted down (O(log k)), as mfr::maxArrayInsert / maxHeapInsert do once full.
-// Hybrid compositing (uHybrid): fragments culled by the occupancy or k+ test, rejected by the
+// Hybrid compositing (MFR_HYBRID): fragments culled by the occupancy or k+ test, rejected by the
 // store or evicted from it are added to the pixel's tail under the lock (mfr::HybridTail, in
 // arrival order). A fragment not nearer than that maximum is culled before the critical section
 // (its depth word alone is compared there: slot 0's depth word only decreases, so a stale read is
@@ -28,17 +28,36 @@
 // the critical section, not a spin inside it, so lanes of one SIMD group cannot deadlock. With
 // MFR_INTERLOCK (--gl-sync interlock, the engine's prelude defines it with the extension's
 // begin/end), the fragment shader interlock orders the critical section instead of the lock.
+// Compile-time switches (gl_frame.cpp's kbufferSwitches; the engine's in shared_layout.h):
+//   MFR_PER_PIXEL  1: variable k, pixel p owns k(p) nodes from its own first slot, its store
+//                  per pixel (uAlloc); 0: fixed k (uK), one store for all (MFR_STORE)
+//   MFR_STORE      kStoreMaxArray or kStoreMaxHeap (fixed k)
+//   MFR_OCCUPANCY  1: occupancy culling (uOccupancyWords words of bitmap per pixel)
+//   MFR_HYBRID     1: rejected, culled and evicted fragments go to the pixel's tail
+#ifndef MFR_PER_PIXEL
+#define MFR_PER_PIXEL 0
+#endif
+#ifndef MFR_STORE
+#define MFR_STORE kStoreMaxArray
+#endif
+#ifndef MFR_OCCUPANCY
+#define MFR_OCCUPANCY 0
+#endif
+#ifndef MFR_HYBRID
+#define MFR_HYBRID 0
+#endif
+const bool kPerPixel = MFR_PER_PIXEL != 0;
+const uint kFixedStore = MFR_STORE;
+const bool kOccupancy = MFR_OCCUPANCY != 0;
+const bool kHybrid = MFR_HYBRID != 0;
+
 layout(std430, binding = kBindNodes) coherent buffer Nodes {
   uvec2 nodes[];
 };
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
-uniform uint uK;
-uniform uint uStore;  // kStoreMaxArray or kStoreMaxHeap
-// 1: variable k, pixel p owns k(p) nodes from its own first slot, store per pixel (uAlloc)
-uniform uint uPerPixel;
+uniform uint uK;  // fixed k
 layout(binding = kBindAllocation) uniform usamplerBuffer uAlloc;
-uniform uint uOccupancyWords;  // 0: no occupancy culling
-uniform uint uHybrid;  // 1: rejected, culled and evicted fragments go to the pixel's tail
+uniform uint uOccupancyWords;  // occupancy: bitmap words per pixel
 layout(std430, binding = kBindOccupancy) readonly buffer Occupancy {
   uint occupancy[];  // kOccupancyWords per pixel: zn, zf, j_k
 };
@@ -94,7 +113,7 @@ void insertNode(const uint p, const uint first, const uint k, const uint storeKi
     toTail = true;  // evicted (an empty slot's far node is not a fragment)
     tailNode = maxNode;
   }
-  if (toTail && uHybrid != 0u) {  // mfr::HybridTail::add (method_math.h's hybridTailAddCovered)
+  if (kHybrid && toTail) {  // mfr::HybridTail::add (method_math.h's hybridTailAddCovered)
     const uint t = kTailWords * p;
     float r = uintBitsToFloat(tails[t]), g = uintBitsToFloat(tails[t + 1u]),
           b = uintBitsToFloat(tails[t + 2u]), sumA = uintBitsToFloat(tails[t + 3u]);
@@ -122,31 +141,31 @@ void main() {
   const uint p = uint(f.pixel);
   bool store = true;  // false: culled, to the tail (hybrid) or dropped
   bool drop = false;  // true: nothing to write (no early return: the interlock forbids it)
-  if (uOccupancyWords > 0u) {  // occupancy test: behind the pixel's k-th occupied bucket
+  if (kOccupancy) {  // occupancy test: behind the pixel's k-th occupied bucket
     const uint t = occupancy[kOccupancyWords * p + 2u];
     if (t != kOccupancyNoCulling &&
         occupancyBucket(depth, uintBitsToFloat(occupancy[kOccupancyWords * p]),
                         uintBitsToFloat(occupancy[kOccupancyWords * p + 1u]),
                         32u * uOccupancyWords) > t) {
       atomicAdd(culledOccupancy, 1u);
-      if (uHybrid == 0u) drop = true;
+      if (!kHybrid) drop = true;
       store = false;
     }
   }
   const uint depthBits = floatBitsToUint(depth);
-  uint first = p * uK, k = uK, storeKind = uStore;
-  if (uPerPixel != 0u) {
+  uint first = p * uK, k = uK, storeKind = kFixedStore;
+  if (kPerPixel) {
     const uvec2 a = texelFetch(uAlloc, f.pixel).xy;
     first = a.x;
     k = a.y & ~kAllocHeapBit;
     storeKind = (a.y & kAllocHeapBit) != 0u ? kStoreMaxHeap : kStoreMaxArray;
   }
   if (store && k == 0u) {  // no slot: rejected
-    if (uHybrid == 0u) drop = true;
+    if (!kHybrid) drop = true;
     store = false;
   } else if (store && depthBits > nodes[first].x) {  // k+ test
     atomicAdd(culledKPlus, 1u);
-    if (uHybrid == 0u) drop = true;
+    if (!kHybrid) drop = true;
     store = false;
   }
   // shaded only when something keeps its colour (the store or the tail): a culled fragment

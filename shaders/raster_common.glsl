@@ -83,7 +83,7 @@ vec4 sampleTexture(uint first, int width, int height, uint flags, vec2 uv) {
 bool surface(FragmentData f, bool coverageOnly, out vec4 base) {
   const uint m = fragmentMaterial() * kMaterialWords;
   const uint mode = materials[m + 7u];
-  const bool needsAlphaTest = mode == kAlphaMask;
+  const bool needsAlphaTest = kSceneAlphaMask && mode == kAlphaMask;
   base = vec4(0.0);
   if (fragmentBackFacing() && (materials[m + kMaterialFlagsWord] & kMaterialCullBack) != 0u)
     return false;
@@ -91,13 +91,13 @@ bool surface(FragmentData f, bool coverageOnly, out vec4 base) {
   base = vec4(uintBitsToFloat(materials[m + 0u]), uintBitsToFloat(materials[m + 1u]),
               uintBitsToFloat(materials[m + 2u]), uintBitsToFloat(materials[m + 3u]));
   const uint texture = materials[m + 4u];
-  if (texture != kNoTexture) {
+  if (kSceneTextures && texture != kNoTexture) {
     const vec2 uv = fragmentUv(f);
     precise vec4 b = base * sampleTexture(texture, int(materials[m + 5u]), int(materials[m + 6u]),
                                           materials[m + kMaterialFlagsWord], uv);
     base = b;
   }
-  if (fragmentHasColor()) {  // the vertex colour, after the texture (RasterFrame::surface)
+  if (kSceneVertexColors && fragmentHasColor()) {  // the vertex colour, after the texture
     precise vec4 c = base * fragmentColor(f);
     base = c;
   }
@@ -142,20 +142,22 @@ uint overNodeWord(uint word) {
   return word;
 }
 
-// packBlendedColor: the node word of the material's blend mode (mfr::BlendMode)
+// packBlendedColor: the node word of the material's blend mode (mfr::BlendMode); only the scene's
+// modes are compiled in (kSceneBlendModes)
 uint packBlended(uint mode, vec3 rgb, float alpha) {
+  if (kSceneBlendModes == (1u << kBlendOver)) return overNodeWord(packColor(rgb, alpha));
   const float a = clampUnit(alpha);
-  if (mode == kBlendPremultiplied) {
+  if ((kSceneBlendModes & (1u << kBlendPremultiplied)) != 0u && mode == kBlendPremultiplied) {
     precise float scaledA = a * 255.0 + 0.5;
     if (int(scaledA) == 0) return packColor(rgb, 0.0) & 0x00ffffffu;
     precise vec3 straight = rgb / a;
     return overNodeWord(packColor(straight, a));
   }
-  if (mode == kBlendAdditive) {
+  if ((kSceneBlendModes & (1u << kBlendAdditive)) != 0u && mode == kBlendAdditive) {
     precise vec3 emission = rgb * a;
     return packColor(emission, 0.0) & 0x00ffffffu;
   }
-  if (mode == kBlendMultiply) {
+  if ((kSceneBlendModes & (1u << kBlendMultiply)) != 0u && mode == kBlendMultiply) {
     precise vec3 factor = (1.0 - a) + a * rgb;
     return (packColor(factor, 0.0) & 0x00ffffffu) | (kMultiplyNode << 24);
   }

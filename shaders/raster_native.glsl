@@ -17,11 +17,8 @@ in vec2 vUv;
 in vec4 vColor;  // perspective-correct vertex colour
 in vec2 vClipZW;  // clip z and w: window depth at a sample as z / w (interpolateAtSample)
 
-uniform int uSamples;  // samples per pixel (1: the pixel centre)
-uniform uint uSampleStorage;  // multisampled: 1 per-sample storage, 0 per-pixel with masks
 uniform vec2 uSampleOffsets[kMaxSampleSums];  // each sample's offset from the centre, in pixels
 uniform ivec2 uSize;
-uniform uint uVertexColors;  // the scene has vertex colours (else vColor is white, not multiplied)
 
 layout(std430, binding = kBindTriMaterial) readonly buffer TriMaterial {
   uint triMaterial[];
@@ -42,12 +39,12 @@ bool rasterFragment(out FragmentData f) {
   f.pos = vec2(px);
   f.sampleIndex = 0;
   f.coverage = 1u;
-  if (uSamples > 1) {
-    f.coverage = uint(gl_SampleMaskIn[0]) & sampleBits(uSamples);
+  if (kViewSamples > 1) {
+    f.coverage = uint(gl_SampleMaskIn[0]) & sampleBits(kViewSamples);
     if (f.coverage == 0u) return false;
     f.sampleIndex = findLSB(f.coverage);  // per-sample shading: the one bit of the invocation's sample
     f.pos = vec2(px) + uSampleOffsets[f.sampleIndex];
-    if (uSampleStorage != 0u) f.px = ivec2(px.x * uSamples + f.sampleIndex, px.y);
+    if (kViewSampleStorage) f.px = ivec2(px.x * kViewSamples + f.sampleIndex, px.y);
   }
   f.pixel = f.px.y * uSize.x + f.px.x;
   return true;
@@ -65,40 +62,41 @@ bool fragmentBackFacing() {
 }
 
 vec2 fragmentUv(FragmentData f) {
-  return uSamples > 1 ? interpolateAtSample(vUv, f.sampleIndex) : vUv;
+  return kViewSamples > 1 ? interpolateAtSample(vUv, f.sampleIndex) : vUv;
 }
 
 vec3 fragmentNormal(FragmentData f) {
-  return uSamples > 1 ? interpolateAtSample(vNormal, f.sampleIndex) : vNormal;
+  return kViewSamples > 1 ? interpolateAtSample(vNormal, f.sampleIndex) : vNormal;
 }
 
-// vertex colours: every triangle of a scene that has them (GL's interpolation of an all-white
-// triangle is white up to rounding; the exact raster decides per triangle, as the CPU engine)
+// vertex colours: every triangle of a scene that has them (kSceneVertexColors: GL's
+// interpolation of an all-white triangle is white up to rounding; the exact raster decides per
+// triangle, as the CPU engine)
 bool fragmentHasColor() {
-  return uVertexColors != 0u;
+  return true;
 }
 
 vec4 fragmentColor(FragmentData f) {
-  return uSamples > 1 ? interpolateAtSample(vColor, f.sampleIndex) : vColor;
+  return kViewSamples > 1 ? interpolateAtSample(vColor, f.sampleIndex) : vColor;
 }
 
 // window depth (glDepthRange 0..1: z_ndc / 2 + 1/2), clamped to [0, 1] as the exact raster does;
 // multisampled: at the fragment's sample (z / w of the perspective-correct clip z and w), with
 // per-pixel storage's coverage mask in the low bits
 float fragmentDepth(FragmentData f) {
-  if (uSamples <= 1) return clamp(gl_FragCoord.z, 0.0, 1.0);
+  if (kViewSamples <= 1) return clamp(gl_FragCoord.z, 0.0, 1.0);
   const vec2 zw = interpolateAtSample(vClipZW, f.sampleIndex);
   precise float z = zw.x / zw.y * 0.5 + 0.5;
   const float depth = clamp(z, 0.0, 1.0);
-  if (uSampleStorage != 0u) return depth;
-  return uintBitsToFloat(withCoverageBits(floatBitsToUint(depth), f.coverage, uSamples));
+  if (kViewSampleStorage) return depth;
+  return uintBitsToFloat(withCoverageBits(floatBitsToUint(depth), f.coverage, kViewSamples));
 }
 
 // the share of the pixel's samples a node covers (per-pixel storage: its mask's samples over
 // the pixel's, which weights it in the hybrid tail); 1 otherwise
 float coverageShare(uint depthBits) {
-  if (uSamples <= 1 || uSampleStorage != 0u) return 1.0;
-  return float(bitCount(depthBits & sampleBits(uSamples))) / float(uSamples);
+  if (kViewSamples <= 1 || kViewSampleStorage) return 1.0;
+  return float(bitCount(depthBits & sampleBits(kViewSamples))) / float(kViewSamples);
 }
 
 // the scene triangle's index (the draw's triangles are the scene's, in order)

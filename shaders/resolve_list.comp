@@ -38,7 +38,6 @@ uniform uint uHybrid;
 uniform uint uPixels;
 uniform vec3 uBackground;
 uniform float uInv255;
-uniform int uMaskSamples;  // per-pixel multisampled storage: the samples of the nodes' masks
 
 float srgb8ToLinear(uint code) {
   return uintBitsToFloat(colorTables[kTableLinearBase + code]);
@@ -55,7 +54,7 @@ void main() {
   // one sum in registers while sorting; per-pixel multisampled storage composites each sample
   // after the sort (method_math.h's SampleSums, whose arrays in this loop cost llvmpipe 13% at one
   // sample)
-  const bool masked = uMaskSamples > 1;
+  const bool masked = kViewMaskSamples > 1;
   float r = 0.0f, g = 0.0f, b = 0.0f, tr = 1.0f, tg = 1.0f, tb = 1.0f;
   uint n = 0u;
   for (uint a = heads[p]; a != kListEnd; a = pool[kListNodeWords * a + 2u]) {
@@ -92,7 +91,7 @@ void main() {
   }
   vec3 result;
   if (masked) {  // the list is sorted now: each sample from the nodes whose mask holds it
-    SampleSums sums = emptySampleSums(uMaskSamples);
+    SampleSums sums = emptySampleSums(kViewMaskSamples);
     for (uint a = heads[p]; a != kListEnd; a = pool[kListNodeWords * a + 2u]) {
       const uvec2 key = keyOf(a);
       precise float alpha = float(key.y >> 24) * uInv255;

@@ -8,21 +8,51 @@
 
 namespace mfr::gl {
 
+void BufferPool::release() {
+  for (const auto& [bytes, b] : free) glDeleteBuffers(1, &b);
+  free.clear();
+}
+
 FrameBuffers::~FrameBuffers() {
-  if (!buffers.empty()) glDeleteBuffers(static_cast<GLsizei>(buffers.size()), buffers.data());
+  if (pool) {  // this frame's buffers are the pool's now; those it did not take go
+    pool->release();
+    for (GLuint b : buffers) {
+      GLint64 size = 0;
+      glGetNamedBufferParameteri64v(b, GL_BUFFER_SIZE, &size);
+      pool->free.emplace(static_cast<uint64_t>(size), b);
+    }
+  } else if (!buffers.empty()) {
+    glDeleteBuffers(static_cast<GLsizei>(buffers.size()), buffers.data());
+  }
   if (!textures.empty()) glDeleteTextures(static_cast<GLsizei>(textures.size()), textures.data());
 }
 
 GLuint FrameBuffers::make(const std::string& name, uint64_t bytes, const void* data) {
   if (failure) return 0;
-  auto b = createCheckedBuffer(name, bytes, data);
-  if (!b) {
-    failure = b.error();
-    return 0;
+  const uint64_t size = std::max<uint64_t>(bytes, 16);
+  GLuint b = 0;
+  if (pool) {
+    if (const auto it = pool->free.find(size); it != pool->free.end()) {
+      b = it->second;
+      pool->free.erase(it);
+      if (data && bytes > 0) glNamedBufferSubData(b, 0, static_cast<GLsizeiptr>(bytes), data);
+    }
   }
-  buffers.push_back(*b);
+  if (!b) {
+    auto created = createCheckedBuffer(name, bytes, data);
+    if (!created && pool && !pool->free.empty()) {  // the kept buffers' memory, then again
+      pool->release();
+      created = createCheckedBuffer(name, bytes, data);
+    }
+    if (!created) {
+      failure = created.error();
+      return 0;
+    }
+    b = *created;
+  }
+  buffers.push_back(b);
   (*ledger)[name] += bytes;
-  return *b;
+  return b;
 }
 
 void FrameBuffers::bindImage(GLuint buffer, GLuint unit) {
@@ -66,9 +96,12 @@ Result<unsigned> createCheckedBuffer(const std::string& name, uint64_t bytes, co
                      " B, beyond GL's buffer sizes");
   GLuint b = 0;
   glCreateBuffers(1, &b);
-  glNamedBufferData(b, static_cast<GLsizeiptr>(size), data,
+  // (the data's own bytes: a buffer rounded up to 16 B reads no further than they go)
+  glNamedBufferData(b, static_cast<GLsizeiptr>(size), size == bytes ? data : nullptr,
                     staticDraw ? GL_STATIC_DRAW : GL_DYNAMIC_COPY);
-  const GLenum e = glGetError();
+  GLenum e = glGetError();
+  if (e == GL_NO_ERROR && data && size != bytes && bytes > 0)
+    glNamedBufferSubData(b, 0, static_cast<GLsizeiptr>(bytes), data);
   if (e == GL_NO_ERROR && b != 0) return b;
   glDeleteBuffers(1, &b);
   while (glGetError() != GL_NO_ERROR) {

@@ -23,17 +23,37 @@ inline GLint loc(GLuint program, const char* name) {
 /// "0x..." for a GL error code.
 std::string glErrorText(GLenum e);
 
-/// Buffers of one frame, deleted with it; their sizes go to the ledger. The first buffer GL could
-/// not allocate is `failure` (later makes return 0; the frame's passes are skipped).
+/// The buffers of an engine's last frame, kept for its next: a renderer reuses its frame's
+/// buffers instead of allocating them anew each frame (a driver that backs a fresh buffer with
+/// new pages pays for their first touch in the frame's clears: about 40 ms for a 1024x1024
+/// k = 8 k-buffer on llvmpipe). Deleted with the engine (its context current).
+struct BufferPool {
+  std::multimap<uint64_t, GLuint> free;  // by size in bytes
+
+  BufferPool() = default;
+  BufferPool(const BufferPool&) = delete;
+  BufferPool& operator=(const BufferPool&) = delete;
+  ~BufferPool() { release(); }
+  /// deletes the kept buffers
+  void release();
+};
+
+/// Buffers of one frame, deleted with it, or with a pool kept for the next frame (the pool's
+/// buffers this frame did not take are deleted then); their sizes go to the ledger. The first
+/// buffer GL could not allocate is `failure` (later makes return 0; the frame's passes are
+/// skipped).
 struct FrameBuffers {
   std::vector<GLuint> buffers, textures;
   std::map<std::string, uint64_t>* ledger = nullptr;
   std::optional<Error> failure;
+  BufferPool* pool = nullptr;
 
-  explicit FrameBuffers(std::map<std::string, uint64_t>* l) : ledger(l) {}
+  explicit FrameBuffers(std::map<std::string, uint64_t>* l, BufferPool* p = nullptr)
+      : ledger(l), pool(p) {}
   FrameBuffers(const FrameBuffers&) = delete;
   FrameBuffers& operator=(const FrameBuffers&) = delete;
   ~FrameBuffers();
+  /// a buffer of `bytes` (at least 16), its contents `data` or undefined
   GLuint make(const std::string& name, uint64_t bytes, const void* data = nullptr);
   /// an r32ui imageBuffer view of a buffer, bound to an image unit
   void bindImage(GLuint buffer, GLuint unit);

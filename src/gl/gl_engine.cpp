@@ -30,6 +30,10 @@ static_assert(kNodeHiIndex == 0u);
 static_assert((static_cast<uint64_t>(kFarDepthBits) << 32) == kFarNode);
 static_assert(static_cast<uint32_t>(AlphaMode::Opaque) == kAlphaOpaque);
 static_assert(static_cast<uint32_t>(AlphaMode::Mask) == kAlphaMask);
+static_assert(blendBit(BlendMode::Over) == 1u << kBlendOver &&
+              blendBit(BlendMode::Premultiplied) == 1u << kBlendPremultiplied &&
+              blendBit(BlendMode::Additive) == 1u << kBlendAdditive &&
+              blendBit(BlendMode::Multiply) == 1u << kBlendMultiply);
 static_assert(kTableWords == kTableBoundBase + 257u && kTableBoundBase == kTableCoarseBase + 4096u);
 static_assert(kAllocHistogramBins == kHistogramBins && kAllocSummaryWords == kHistogramBins + 1);
 
@@ -71,9 +75,6 @@ void GlEngine::State::setRasterUniforms(GLuint p) const {
   glProgramUniformMatrix4fv(p, loc(p, "uViewProj"), 1, GL_FALSE, &viewProj[0][0]);
   glProgramUniformMatrix3fv(p, loc(p, "uViewRot"), 1, GL_FALSE, &viewRot[0][0]);
   glProgramUniform2i(p, loc(p, "uSize"), width, height);
-  glProgramUniform1i(p, loc(p, "uSamples"), sampling.samples);
-  glProgramUniform1ui(p, loc(p, "uSampleStorage"),
-                      sampling.storage == SampleStorage::Sample ? 1u : 0u);
   GLfloat offsets[2 * kMaxSamples] = {};
   const auto pattern = samplePattern(sampling.samples);
   for (size_t i = 0; i < pattern.size(); ++i) {
@@ -86,7 +87,6 @@ void GlEngine::State::setRasterUniforms(GLuint p) const {
   glProgramUniform1f(p, loc(p, "uAmbient"), kAmbient);
   glProgramUniform1f(p, loc(p, "uDiffuse"), 1.0f - kAmbient);
   glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
-  glProgramUniform1ui(p, loc(p, "uVertexColors"), vertexColors ? 1u : 0u);
 }
 
 void GlEngine::State::drawScene() const {
@@ -392,6 +392,22 @@ Result<void> checkGlLimits(int width, int height) {
   return {};
 }
 
+// what the engine's shaders compile in: the view's sampling and the scene's material features
+EngineSwitches engineSwitches(const Scene& scene, GlSampling sampling) {
+  EngineSwitches e;
+  e.samples = sampling.samples;
+  e.sampleStorage = sampling.storage == SampleStorage::Sample;
+  e.vertexColors = !scene.colors.empty();
+  e.textures = false;
+  e.alphaMask = false;
+  for (const Material& m : scene.materials) {
+    e.textures = e.textures || m.baseColorTexture >= 0;
+    e.alphaMask = e.alphaMask || m.alphaMode == AlphaMode::Mask;
+  }
+  e.blendModes = scene.blendModes();
+  return e;
+}
+
 }  // namespace
 
 Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
@@ -427,7 +443,7 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   auto kbufferPrelude = kbufferInterlockPrelude(context, interlock);
   if (!kbufferPrelude) return kbufferPrelude.error();
   State& st = *s;
-  MFR_TRY(st.programs.link(context, raster, *kbufferPrelude,
+  MFR_TRY(st.programs.link(context, raster, *kbufferPrelude, engineSwitches(scene, sampling),
                            [&st](GLuint p) { st.setRasterUniforms(p); }));
   s->uploadGeometry(scene);
   MFR_TRY(s->uploadMaterials(scene));
@@ -435,11 +451,6 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   s->createFramebufferAndQuery();
   if (s->uploadFailure) return *s->uploadFailure;
   if (sampling.samples > 1) MFR_TRY(s->checkSamplePattern());
-  // the resolves of per-pixel storage composite each sample from the nodes' coverage masks
-  for (const ProgramId id : {ProgramId::Resolve, ProgramId::ListResolve}) {
-    const GLuint p = s->program(id);
-    glProgramUniform1i(p, loc(p, "uMaskSamples"), sampling.maskSamples());
-  }
   if (const GLenum e = glGetError(); e != GL_NO_ERROR)
     return makeError("--engine gl: scene upload failed (GL error " + glErrorText(e) + ")");
   return GlEngine(std::move(s));

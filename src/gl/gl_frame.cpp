@@ -135,6 +135,15 @@ struct GlEngine::State::FrameRun {
   uint64_t nodeCount = 0;
   bool countInCapture = false;  // the capture adds n(p) (no count pass ran)
 
+  // program `id` with its switches `defines` (Programs::variant); 0 and the frame's failure when
+  // it does not link
+  GLuint variant(ProgramId id, const std::string& defines) {
+    auto p = s.programs.variant(id, defines);
+    if (p) return *p;
+    if (!fb.failure) fb.failure = p.error();
+    return 0;
+  }
+
   // a capture program: whether it counts n(p), and the counts' image unit
   void useCapture(GLuint program) {
     glUseProgram(program);
@@ -157,7 +166,7 @@ struct GlEngine::State::FrameRun {
   }
 
   FrameRun(State& state, const RenderPlan& p, GlRenderOutput& output)
-      : s(state), plan(p), out(output), fb(&output.bufferBytes) {}
+      : s(state), plan(p), out(output), fb(&output.bufferBytes, &state.framePool) {}
 
   // one timed pass: GL's elapsed time and the wall time around it
   template <class Body>
@@ -470,13 +479,15 @@ struct GlEngine::State::FrameRun {
     // on the capture's synchronisation)
     const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
     clearUint(locks, kLockFree);
-    const GLuint p = s.program(atomic ? ProgramId::KBufferAtomic64 : ProgramId::KBuffer);
+    const GLuint p =
+        atomic ? s.program(ProgramId::KBufferAtomic64)
+               : variant(ProgramId::KBuffer,
+                         kbufferSwitches(
+                             perPixel,
+                             method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray,
+                             words > 0, hybrid));
     glProgramUniform1ui(p, loc(p, "uK"), k);
-    glProgramUniform1ui(p, loc(p, "uStore"),
-                        method.store == StoreChoice::MaxHeap ? kStoreMaxHeap : kStoreMaxArray);
     glProgramUniform1ui(p, loc(p, "uOccupancyWords"), words);
-    glProgramUniform1ui(p, loc(p, "uPerPixel"), perPixel ? 1u : 0u);
-    glProgramUniform1ui(p, loc(p, "uHybrid"), hybrid ? 1u : 0u);
     pass("capture", [&] {
       useCapture(p);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
@@ -695,12 +706,17 @@ struct GlEngine::State::FrameRun {
   // (kbuffer or hybrid with the pixel's tail)
   void resolveNodes() {
     image = fb.make("image", uint64_t{plan.pixels} * 12);
+    const bool fixedK = !plan.perPixel && plan.technique == GlTechnique::KBuffer;
+    const uint32_t layout = plan.perPixel ? kResolvePerPixel
+                            : fixedK      ? kResolveFixedK
+                                          : kResolveABuffer;
+    const GLuint p =
+        variant(ProgramId::Resolve,
+                resolveSwitches(layout, plan.hybrid, fixedK && plan.k <= kResolveLocalNodes,
+                                plan.options.readNodes));
     pass("resolve", [&] {
-      const GLuint p = s.program(ProgramId::Resolve);
       useResolve(p);
       glProgramUniform1ui(p, loc(p, "uK"), plan.k);
-      glProgramUniform1ui(p, loc(p, "uHybrid"), plan.hybrid ? 1u : 0u);
-      glProgramUniform1ui(p, loc(p, "uPerPixel"), plan.perPixel ? 1u : 0u);
       glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : counts);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCounts, counts);

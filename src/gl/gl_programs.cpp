@@ -1,12 +1,14 @@
 // The GL engine's program table and shader composition (gl_programs.hpp, shader_sources.hpp).
 #include "gl/gl_programs.hpp"
 
+#include <set>
 #include <string_view>
 #include <utility>
 #include <vector>
 
 #include "gl/shader_sources.hpp"
 #include "mfr/core/result.hpp"
+#include "mfr/gl/shared_layout.h"
 
 namespace mfr::gl {
 namespace {
@@ -157,8 +159,9 @@ std::string interlockPrelude(const std::string& ext) {
   return prelude;
 }
 
-// `prelude`: lines after "#version" in the fragment shader (the interlock's #extension, #define);
-// `raster`: the fragment stage's raster part (nullptr: none)
+// `prelude`: lines after "#version" in the program's own stage, the fragment or compute shader
+// (the interlock's #extension, the switches' #defines); `raster`: the fragment stage's raster part
+// (nullptr: none)
 Result<GLuint> linkProgram(const std::string& name, const std::vector<StageFile>& stages,
                            const std::string& prelude = "", const char* raster = nullptr) {
   std::vector<GLuint> shaders;
@@ -166,9 +169,10 @@ Result<GLuint> linkProgram(const std::string& name, const std::vector<StageFile>
     for (GLuint s : shaders) glDeleteShader(s);
   };
   for (const StageFile& sf : stages) {
-    const bool fragment = sf.stage == GL_FRAGMENT_SHADER;
-    auto shader = compileShader(sf.stage, sf.file, fragment ? raster : nullptr,
-                                fragment ? prelude : std::string());
+    const bool own = sf.stage == GL_FRAGMENT_SHADER || sf.stage == GL_COMPUTE_SHADER;
+    auto shader =
+        compileShader(sf.stage, sf.file, sf.stage == GL_FRAGMENT_SHADER ? raster : nullptr,
+                      own ? prelude : std::string());
     if (!shader) {
       cleanup();
       return shader.error();
@@ -192,6 +196,15 @@ Result<GLuint> linkProgram(const std::string& name, const std::vector<StageFile>
   return program;
 }
 
+// "#define NAME VALUE\n"
+std::string defineLine(const char* name, uint32_t value) {
+  return "#define " + std::string(name) + " " + std::to_string(value) + "\n";
+}
+
+const ProgramRow& rowOf(ProgramId id) {
+  return kPrograms[static_cast<size_t>(id)];
+}
+
 }  // namespace
 
 std::string oneLine(std::string text) {
@@ -206,41 +219,74 @@ std::string oneLine(std::string text) {
   return out;
 }
 
+std::string EngineSwitches::prelude() const {
+  return defineLine("MFR_SAMPLES", static_cast<uint32_t>(samples)) +
+         defineLine("MFR_SAMPLE_STORAGE", sampleStorage ? 1 : 0) +
+         defineLine("MFR_VERTEX_COLORS", vertexColors ? 1 : 0) +
+         defineLine("MFR_TEXTURES", textures ? 1 : 0) +
+         defineLine("MFR_ALPHA_MASK", alphaMask ? 1 : 0) + "#define MFR_BLEND_MODES " +
+         std::to_string(blendModes) + "u\n";
+}
+
+std::string kbufferSwitches(bool perPixel, uint32_t store, bool occupancy, bool hybrid) {
+  return defineLine("MFR_PER_PIXEL", perPixel ? 1 : 0) +
+         defineLine("MFR_STORE", perPixel ? kStoreMaxArray : store) +
+         defineLine("MFR_OCCUPANCY", occupancy ? 1 : 0) + defineLine("MFR_HYBRID", hybrid ? 1 : 0);
+}
+
+std::string resolveSwitches(uint32_t nodes, bool hybrid, bool localSort, bool writeSorted) {
+  return defineLine("MFR_RESOLVE_NODES", nodes) + defineLine("MFR_HYBRID", hybrid ? 1 : 0) +
+         defineLine("MFR_LOCAL_SORT", localSort ? 1 : 0) +
+         defineLine("MFR_WRITE_SORTED", writeSorted ? 1 : 0);
+}
+
 Programs::~Programs() {
   for (GLuint p : ids_)
     if (p) glDeleteProgram(p);
+  for (const auto& [key, p] : variants_) glDeleteProgram(p);
+}
+
+Result<GLuint> Programs::linkRow(ProgramId id, const std::string& defines) const {
+  const ProgramRow& row = rowOf(id);
+  std::string prelude;
+  switch (row.prelude) {  // the #extension lines first
+    case Prelude::None:
+      break;
+    case Prelude::KBufferSync:
+      prelude = kbufferPrelude_;
+      break;
+    case Prelude::Atomic64:
+      prelude = kAtomic64Prelude;
+      break;
+  }
+  prelude += enginePrelude_ + defines;
+  const bool isRaster = row.stages == Stages::Raster;
+  std::vector<StageFile> stages = isRaster ? rasterStages(raster_) : std::vector<StageFile>{};
+  stages.push_back(
+      {static_cast<GLenum>(isRaster ? GL_FRAGMENT_SHADER : GL_COMPUTE_SHADER), row.file});
+  auto linked = linkProgram(row.file, stages, prelude, isRaster ? rasterPart(raster_) : nullptr);
+  if (linked && isRaster) rasterUniforms_(*linked);
+  return linked;
 }
 
 Result<void> Programs::link(const GlContext& context, GlRaster raster,
-                            const std::string& kbufferPrelude,
+                            const std::string& kbufferPrelude, const EngineSwitches& switches,
                             const std::function<void(GLuint)>& rasterUniforms) {
+  raster_ = raster;
+  kbufferPrelude_ = kbufferPrelude;
+  enginePrelude_ = switches.prelude();
+  rasterUniforms_ = rasterUniforms;
   const bool atomic64 = hasAtomic64(context);
   bool atomic64Linked = atomic64;
   for (const ProgramRow& row : kPrograms) {
     if (row.prelude == Prelude::Atomic64 && !atomic64) continue;
-    std::string prelude;
-    switch (row.prelude) {
-      case Prelude::None:
-        break;
-      case Prelude::KBufferSync:
-        prelude = kbufferPrelude;
-        break;
-      case Prelude::Atomic64:
-        prelude = kAtomic64Prelude;
-        break;
-    }
-    const bool isRaster = row.stages == Stages::Raster;
-    std::vector<StageFile> stages = isRaster ? rasterStages(raster) : std::vector<StageFile>{};
-    stages.push_back(
-        {static_cast<GLenum>(isRaster ? GL_FRAGMENT_SHADER : GL_COMPUTE_SHADER), row.file});
-    auto linked = linkProgram(row.file, stages, prelude, isRaster ? rasterPart(raster) : nullptr);
+    auto linked = linkRow(row.id, "");
     if (!linked && row.prelude == Prelude::Atomic64) {
       atomic64Linked = false;
       continue;
     }
     if (!linked) return linked.error();
     ids_[static_cast<size_t>(row.id)] = *linked;
-    if (isRaster) rasterUniforms(*linked);
   }
   if (!atomic64Linked)  // both atomic programs or neither
     for (ProgramId id : {ProgramId::KBufferAtomic64, ProgramId::SwapNodeWords}) {
@@ -249,6 +295,16 @@ Result<void> Programs::link(const GlContext& context, GlRaster raster,
       p = 0;
     }
   return {};
+}
+
+Result<GLuint> Programs::variant(ProgramId id, const std::string& defines) {
+  if (defines.empty()) return (*this)[id];
+  const auto key = std::make_pair(id, defines);
+  if (const auto it = variants_.find(key); it != variants_.end()) return it->second;
+  auto linked = linkRow(id, defines);
+  if (!linked) return linked.error();
+  variants_.emplace(key, *linked);
+  return *linked;
 }
 
 Result<std::string> kbufferInterlockPrelude(const GlContext& context, bool interlock) {
@@ -293,11 +349,61 @@ std::string interlockExtension(const GlContext& context) {
   return {};
 }
 
+namespace {
+
+// The engine switches a raster validates under: the defaults (one sample, every feature), none
+// of the scene's features, and, natively, four samples in each storage discipline.
+std::vector<EngineSwitches> engineSwitchSets(GlRaster raster) {
+  EngineSwitches none;
+  none.vertexColors = none.textures = none.alphaMask = false;
+  none.blendModes = 1u << kBlendOver;
+  std::vector<EngineSwitches> sets = {EngineSwitches{}, none};
+  if (raster == GlRaster::Native)
+    for (const bool storage : {false, true}) {
+      EngineSwitches multi;
+      multi.samples = 4;
+      multi.sampleStorage = storage;
+      sets.push_back(multi);
+    }
+  return sets;
+}
+
+// Each program's own switch sets (its Programs::variant defines), every combination: the
+// k-buffer capture's and the resolve's; one empty set for the others.
+std::vector<std::string> programSwitchSets(ProgramId id) {
+  std::vector<std::string> sets;
+  switch (id) {
+    case ProgramId::KBuffer:
+      for (const bool occupancy : {false, true})
+        for (const bool hybrid : {false, true}) {
+          sets.push_back(kbufferSwitches(true, kStoreMaxArray, occupancy, hybrid));
+          for (const uint32_t store : {kStoreMaxArray, kStoreMaxHeap})
+            sets.push_back(kbufferSwitches(false, store, occupancy, hybrid));
+        }
+      break;
+    case ProgramId::Resolve:
+      for (const uint32_t nodes : {kResolveFixedK, kResolveABuffer, kResolvePerPixel})
+        for (const bool hybrid : {false, true})
+          for (const bool local : {false, true})
+            for (const bool write : {false, true})
+              sets.push_back(resolveSwitches(nodes, hybrid, local, write));
+      break;
+    default:
+      sets.push_back("");
+  }
+  return sets;
+}
+
+}  // namespace
+
 std::vector<ShaderVariant> shaderVariants() {
   std::vector<ShaderVariant> out;
+  std::set<std::string> seen;  // stages without a prelude are the same text in every variant
   const auto add = [&](const std::string& program, const std::string& file, const char* stage,
                        const char* raster, const std::string& prelude) {
-    out.push_back({program, file, stage, composeSource(file, raster, prelude)});
+    std::string source = composeSource(file, raster, prelude);
+    if (!seen.insert(std::string(stage) + "\n" + source).second) return;
+    out.push_back({program, file, stage, std::move(source)});
   };
   for (const ProgramRow& row : kPrograms) {
     std::vector<std::pair<std::string, std::string>> preludes;  // variant name, prelude
@@ -316,17 +422,22 @@ std::vector<ShaderVariant> shaderVariants() {
         preludes = {{" (64-bit atomics)", kAtomic64Prelude}};
         break;
     }
+    const std::vector<std::string> switchSets = programSwitchSets(row.id);
     for (const auto& [variant, prelude] : preludes) {
       const std::string program = std::string(row.file) + variant;
       if (row.stages == Stages::Compute) {
-        add(program, row.file, "comp", nullptr, prelude);
+        for (const EngineSwitches& engine : engineSwitchSets(GlRaster::Native))
+          for (const std::string& switches : switchSets)
+            add(program, row.file, "comp", nullptr, prelude + engine.prelude() + switches);
         continue;
       }
       for (const GlRaster raster : {GlRaster::Native, GlRaster::Exact}) {
         const std::string named = program + " [" + toString(raster) + "]";
         for (const StageFile& sf : rasterStages(raster))
           add(named, sf.file, sf.stage == GL_VERTEX_SHADER ? "vert" : "geom", nullptr, "");
-        add(named, row.file, "frag", rasterPart(raster), prelude);
+        for (const EngineSwitches& engine : engineSwitchSets(raster))
+          for (const std::string& switches : switchSets)
+            add(named, row.file, "frag", rasterPart(raster), prelude + engine.prelude() + switches);
       }
     }
   }

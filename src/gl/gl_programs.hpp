@@ -8,7 +8,9 @@
 #include <array>
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <string>
+#include <utility>
 
 #include "mfr/core/result.hpp"
 #include "mfr/gl/gl_context.hpp"
@@ -61,6 +63,21 @@ enum class ProgramId : uint8_t {
 };
 inline constexpr size_t kProgramCount = static_cast<size_t>(ProgramId::HashedAlphaResolve) + 1;
 
+/// The engine's compile-time switches (shared_layout.h: MFR_SAMPLES .. MFR_BLEND_MODES): the
+/// view's sampling and which material features its scene has, the same for every program of one
+/// engine. The defaults are shared_layout.h's (one sample, every feature).
+struct EngineSwitches {
+  int samples = 1;
+  bool sampleStorage = false;  // per-sample storage (multisampled)
+  bool vertexColors = true;
+  bool textures = true;
+  bool alphaMask = true;
+  uint32_t blendModes = 15;  // blendBit masks
+
+  /// the #define lines
+  std::string prelude() const;
+};
+
 /// The linked programs of one engine, deleted with it (in the context current then).
 class Programs {
  public:
@@ -69,18 +86,39 @@ class Programs {
   Programs& operator=(const Programs&) = delete;
   ~Programs();
 
-  /// Links every program of the table for `raster`; the k-buffer capture takes `kbufferPrelude`
-  /// (the interlock's lines, or none). The 64-bit atomic programs are linked where the driver
-  /// offers the extensions; one that announces them but does not compile the shaders keeps the
-  /// lock (those two programs are then 0). `rasterUniforms` is called on each raster program.
+  /// Links every program of the table for `raster` and the engine's `switches`; the k-buffer
+  /// capture takes `kbufferPrelude` (the interlock's lines, or none). The 64-bit atomic programs
+  /// are linked where the driver offers the extensions; one that announces them but does not
+  /// compile the shaders keeps the lock (those two programs are then 0). `rasterUniforms` is
+  /// called on each raster program, also on the variants linked later.
   Result<void> link(const GlContext& context, GlRaster raster, const std::string& kbufferPrelude,
+                    const EngineSwitches& switches,
                     const std::function<void(GLuint)>& rasterUniforms);
 
   GLuint operator[](ProgramId id) const { return ids_[static_cast<size_t>(id)]; }
 
+  /// The program `id` compiled with the #define lines `defines` (its own switches, e.g. the
+  /// k-buffer capture's store), linked on first use and kept; empty `defines`: the table's.
+  Result<GLuint> variant(ProgramId id, const std::string& defines);
+
  private:
+  Result<GLuint> linkRow(ProgramId id, const std::string& defines) const;
+
   std::array<GLuint, kProgramCount> ids_;
+  std::map<std::pair<ProgramId, std::string>, GLuint> variants_;
+  GlRaster raster_ = GlRaster::Native;
+  std::string kbufferPrelude_, enginePrelude_;
+  std::function<void(GLuint)> rasterUniforms_;
 };
+
+/// capture_kbuffer.frag's switches: a per-pixel allocation (else a fixed k in one `store`,
+/// kStoreMaxArray or kStoreMaxHeap), occupancy culling, the hybrid tail.
+std::string kbufferSwitches(bool perPixel, uint32_t store, bool occupancy, bool hybrid);
+
+/// resolve.comp's switches: the node layout (kResolveFixedK, kResolveABuffer, kResolvePerPixel),
+/// the hybrid tail, whether every pixel's slots fit the local sort, whether the sorted nodes are
+/// written back.
+std::string resolveSwitches(uint32_t nodes, bool hybrid, bool localSort, bool writeSorted);
 
 /// The k-buffer capture's prelude: with `interlock`, the driver's interlock extension and its
 /// begin / end macros (an error when the driver offers none); empty without.

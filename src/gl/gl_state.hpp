@@ -50,6 +50,7 @@ struct GlEngine::State {
   GLsizei indexCount = 0;
   GLuint fbo = 0;
   Programs programs;
+  BufferPool framePool;  // the last frame's buffers (FrameRun)
   GLuint query = 0;
   // the variable-k allocation the compute shaders computed (countOnDevice, allocateCapped,
   // allocateByImportance), kept for render() and the read-backs of the output

@@ -34,9 +34,11 @@ struct ShaderVariant {
 };
 
 /// Every stage of every program in every variant the engine can link (the k-buffer capture's
-/// spin-lock and each interlock extension, the 64-bit atomic capture), whatever the driver
-/// offers: what `glslangValidator` checks in the tests, so variants llvmpipe cannot run still
-/// compile in CI.
+/// spin-lock and each interlock extension, the 64-bit atomic capture; each program's own switches
+/// in every combination, under the engine switches of one sample with and without the scene's
+/// features and of four samples in both storages), whatever the driver offers: what
+/// `glslangValidator` checks in the tests, so variants llvmpipe cannot run still compile in CI.
+/// A stage whose text repeats (a vertex shader, which takes no switches) is listed once.
 std::vector<ShaderVariant> shaderVariants();
 
 /// Compiles one shader stage (a GLenum) from `source` (complete, with its #version) on the current

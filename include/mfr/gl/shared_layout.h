@@ -144,7 +144,8 @@ MFR_GL_CONST(uint, kMaterialWrapMask, 3u)
 MFR_GL_CONST(uint, kMaterialNearest, 32u)    // flag: TextureFilter::Nearest (else bilinear)
 MFR_GL_CONST(uint, kMaterialBlendShift, 6u)  // mfr::BlendMode in 2 bits (packBlended)
 MFR_GL_CONST(uint, kMaterialBlendMask, 3u)
-MFR_GL_CONST(uint, kBlendPremultiplied, 1u)  // mfr::BlendMode values
+MFR_GL_CONST(uint, kBlendOver, 0u)  // mfr::BlendMode values
+MFR_GL_CONST(uint, kBlendPremultiplied, 1u)
 MFR_GL_CONST(uint, kBlendAdditive, 2u)
 MFR_GL_CONST(uint, kBlendMultiply, 3u)
 MFR_GL_CONST(uint, kNoTexture, 0xffffffffu)
@@ -210,9 +211,47 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //       kBindResolveTails
 // (end of the bindings per shader file)
 
+// resolve.comp's node layouts (its MFR_RESOLVE_NODES switch)
+MFR_GL_CONST(uint, kResolveFixedK, 0u)    // k slots at p * k
+MFR_GL_CONST(uint, kResolveABuffer, 1u)   // n(p) nodes at offsets[p]
+MFR_GL_CONST(uint, kResolvePerPixel, 2u)  // k(p) slots from the allocation's first slot
+
 #ifdef __cplusplus
 }  // namespace mfr::gl
 #else
+// The engine's compile-time switches, the same in every program of one engine (GlEngine::create
+// puts the #defines before this file: gl_programs.hpp's EngineSwitches): the view's sampling and
+// which material features the scene has. Shaders branch on these constants, so the compiler
+// removes the paths a view cannot take; a branch on a uniform would run both sides on a SIMD
+// rasterizer such as llvmpipe (masked) and keep every path's registers on a GPU. The defaults
+// (one sample, every feature) are what a shader lifted without the engine gets.
+#ifndef MFR_SAMPLES
+#define MFR_SAMPLES 1  // samples per pixel (core/samples.hpp)
+#endif
+#ifndef MFR_SAMPLE_STORAGE
+#define MFR_SAMPLE_STORAGE 0  // multisampled: 1 per-sample storage, 0 per-pixel with masks
+#endif
+#ifndef MFR_VERTEX_COLORS
+#define MFR_VERTEX_COLORS 1  // the scene has vertex colours
+#endif
+#ifndef MFR_TEXTURES
+#define MFR_TEXTURES 1  // some material has a base colour texture
+#endif
+#ifndef MFR_ALPHA_MASK
+#define MFR_ALPHA_MASK 1  // some material is alpha-tested (kAlphaMask)
+#endif
+#ifndef MFR_BLEND_MODES
+#define MFR_BLEND_MODES 15u  // bit 1 << mfr::BlendMode for each blend mode of the scene
+#endif
+const int kViewSamples = MFR_SAMPLES;
+const bool kViewSampleStorage = MFR_SAMPLES > 1 && MFR_SAMPLE_STORAGE != 0;
+// per-pixel multisampled storage: the samples of the nodes' coverage masks (1 otherwise)
+const int kViewMaskSamples = kViewSampleStorage ? 1 : kViewSamples;
+const bool kSceneVertexColors = MFR_VERTEX_COLORS != 0;
+const bool kSceneTextures = MFR_TEXTURES != 0;
+const bool kSceneAlphaMask = MFR_ALPHA_MASK != 0;
+const uint kSceneBlendModes = MFR_BLEND_MODES;
+
 // a < b in the node order (unsigned 64-bit (hi, lo))
 bool nodeLess(uvec2 a, uvec2 b) {
   return a.x < b.x || (a.x == b.x && a.y < b.y);
