@@ -100,7 +100,15 @@ void GlEngine::State::drawScene() const {
     glDisable(GL_SAMPLE_SHADING);
   }
   glDisable(GL_DEPTH_TEST);
-  glDisable(GL_CULL_FACE);
+  // every material culls back faces: GL culls them before the fragment shader (the native
+  // raster's GL front face is the scene's back face, raster_native.glsl); otherwise the fragment
+  // shaders discard them per material (surface())
+  if (cullEveryBackFace) {
+    glEnable(GL_CULL_FACE);
+    glCullFace(GL_FRONT);
+  } else {
+    glDisable(GL_CULL_FACE);
+  }
   glDisable(GL_BLEND);
   glDisable(GL_STENCIL_TEST);
   glBindVertexArray(vao);
@@ -440,6 +448,10 @@ Result<GlEngine> GlEngine::create(const GlContext& context, const Scene& scene,
   s->placeCamera(cameraIn, scene);
   s->raster = raster;
   s->vertexColors = !scene.colors.empty();
+  // (the exact raster's geometry shader culls at set-up, as the CPU engine)
+  s->cullEveryBackFace = raster == GlRaster::Native && !scene.materials.empty();
+  for (uint32_t m = 0; m < scene.materials.size(); ++m)
+    s->cullEveryBackFace = s->cullEveryBackFace && scene.cullsBackFaces(m);
   auto kbufferPrelude = kbufferInterlockPrelude(context, interlock);
   if (!kbufferPrelude) return kbufferPrelude.error();
   State& st = *s;

@@ -63,6 +63,7 @@ struct GlEngine::State {
   uint64_t maxBlockBytes = 0;  // GL_MAX_SHADER_STORAGE_BLOCK_SIZE
   GlRaster raster = GlRaster::Native;
   bool vertexColors = false;  // the scene has vertex colours (Scene::colors): attribute 3 streams
+  bool cullEveryBackFace = false;  // native raster, every material culls back faces: GL_CULL_FACE
   std::map<std::string, uint64_t> sceneBytes;
   std::optional<Error> uploadFailure;  // the first scene buffer GL could not allocate
 
