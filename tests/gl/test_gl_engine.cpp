@@ -302,6 +302,33 @@ TEST_P(GlVsCpu, ThreeRunsAreByteIdentical) {
   }
 }
 
+// A frame takes the buffers of the engine's previous frame (BufferPool): whatever another method
+// left in them, the frame is the one a fresh engine renders.
+TEST_P(GlVsCpu, FrameAfterOtherMethodsEqualsAFreshEngines) {
+  MethodDesc method = methodPreset("kplus-array").value();
+  method.k = 4;
+  const GlRenderOutput first = glRender(method);
+  MethodDesc hybrid = methodPreset("kplus-heap+occupancy").value();
+  hybrid.k = 4;
+  hybrid.compositing = Compositing::Hybrid;
+  for (const MethodDesc& other : {hybrid, methodPreset("abuffer").value()}) {
+    glRender(other);
+    const GlRenderOutput again = glRender(method);
+    EXPECT_EQ(first.counts, again.counts) << other.name;
+    EXPECT_EQ(first.nodes, again.nodes) << other.name;
+    ASSERT_EQ(first.image.pixels.size(), again.image.pixels.size());
+    EXPECT_EQ(std::memcmp(first.image.pixels.data(), again.image.pixels.data(),
+                          first.image.pixels.size() * sizeof(glm::vec3)),
+              0)
+        << other.name;
+  }
+  // and the hybrid frame after them equals the CPU engine's
+  const RenderOutput cpu = cpuRender(hybrid);
+  const GlRenderOutput gl = glRender(hybrid);
+  expectSameNodes(cpu, gl);
+  expectSameImage(cpu.image, gl.image);
+}
+
 INSTANTIATE_TEST_SUITE_P(Scenes, GlVsCpu,
                          testing::Values(Case{"procedural:layers", 128, 128},
                                          Case{"procedural:layers", 131, 97},
