@@ -3,7 +3,8 @@
 //   nodes   (kBindNodes, uvec2 = 8 B each)   fixed k: slots [p * k, p * k + k)
 //                                            variable k: [first, first + k(p)) from uAlloc
 //     slot:  x = floatBitsToUint(depth) | y = RGBA8 colour (packFragmentColor)
-//     empty: x = kFarDepthBits (+inf), so a store is always "full" and slot 0 holds its maximum
+//     empty: x = y = kFarDepthBits (x = +inf), so a store is always "full" and slot 0 holds its
+//            maximum
 //     max-array: slot 0 the maximum, the rest unordered; max-heap: a binary max-heap (root slot 0)
 //   uAlloc  (kBindAllocation, rg32ui texel)  variable k only: (first slot, k(p) | kAllocHeapBit)
 //   uLocks  (kBindLocks, r32ui, 4 B)         kLockFree / kLockHeld (unused with MFR_INTERLOCK)
@@ -65,8 +66,7 @@ layout(std430, binding = kBindTails) coherent buffer Tails {
   uint tails[];  // kTailWords per pixel
 };
 layout(std430, binding = kBindCaptureStats) buffer CaptureStats {
-  uint culledOccupancy;
-  uint culledKPlus;
+  uint culled[];  // kCaptureStatSlots x kCaptureStatStride: occupancy, k+ (shared_layout.h)
 };
 
 // The critical section: the store update and the tail, for one pixel's fragments one at a time.
@@ -147,7 +147,7 @@ void main() {
         occupancyBucket(depth, uintBitsToFloat(occupancy[kOccupancyWords * p]),
                         uintBitsToFloat(occupancy[kOccupancyWords * p + 1u]),
                         32u * uOccupancyWords) > t) {
-      atomicAdd(culledOccupancy, 1u);
+      atomicAdd(culled[captureStatSlot(f.px)], 1u);
       if (!kHybrid) drop = true;
       store = false;
     }
@@ -164,7 +164,7 @@ void main() {
     if (!kHybrid) drop = true;
     store = false;
   } else if (store && depthBits > nodes[first].x) {  // k+ test
-    atomicAdd(culledKPlus, 1u);
+    atomicAdd(culled[captureStatSlot(f.px) + 1u], 1u);
     if (!kHybrid) drop = true;
     store = false;
   }

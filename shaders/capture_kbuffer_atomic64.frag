@@ -22,8 +22,7 @@ layout(std430, binding = kBindNodes) coherent buffer Nodes {
   uint64_t nodes[];
 };
 layout(std430, binding = kBindCaptureStats) buffer CaptureStats {
-  uint culledOccupancy;
-  uint culledKPlus;
+  uint culled[];  // kCaptureStatSlots x kCaptureStatStride: occupancy, k+ (shared_layout.h)
 };
 uniform uint uK;
 
@@ -37,7 +36,7 @@ void main() {
   const uint64_t far = packUint2x32(uvec2(0u, kFarDepthBits));
   uint64_t v = packUint2x32(uvec2(shade(f, base), floatBitsToUint(fragmentDepth(f))));
   if (v >= nodes[first + uK - 1u]) {  // k+ test: the last slot only decreases
-    atomicAdd(culledKPlus, 1u);
+    atomicAdd(culled[captureStatSlot(f.px) + 1u], 1u);
     return;
   }
   for (uint i = 0u; i < uK; ++i) {

@@ -116,13 +116,14 @@ float clampUnit(float v) {  // min(max(v, 0), 1) with NaN -> 0
   return c < 1.0 ? c : 1.0;
 }
 
-// encodeSrgb8 by the CPU engine's tables
+// encodeSrgb8 by the CPU engine's tables: its bucket's smallest code, one up where c reaches the
+// next code's lower bound (at most one code boundary lies in a bucket: ColorTables, and the test
+// Color.BucketGuessIsAtMostOneBelowEveryInputOfItsBucket)
 uint encodeSrgb8(float c) {
   precise float scaled = c * 4095.0 + 0.5;
-  int code = int(colorTables[kTableCoarseBase + uint(int(scaled))]);
-  if (c >= uintBitsToFloat(colorTables[kTableBoundBase + uint(code + 1)])) ++code;
-  if (c < uintBitsToFloat(colorTables[kTableBoundBase + uint(code)])) --code;
-  return uint(code);
+  const uint entry = kTableEncodeBase + 2u * uint(int(scaled));
+  const uint code = colorTables[entry];
+  return c >= uintBitsToFloat(colorTables[entry + 1u]) ? code + 1u : code;
 }
 
 // packFragmentColor

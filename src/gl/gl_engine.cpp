@@ -34,7 +34,8 @@ static_assert(blendBit(BlendMode::Over) == 1u << kBlendOver &&
               blendBit(BlendMode::Premultiplied) == 1u << kBlendPremultiplied &&
               blendBit(BlendMode::Additive) == 1u << kBlendAdditive &&
               blendBit(BlendMode::Multiply) == 1u << kBlendMultiply);
-static_assert(kTableWords == kTableBoundBase + 257u && kTableBoundBase == kTableCoarseBase + 4096u);
+static_assert(kTableEncodeBase == kTableLinearBase + 256u &&
+              kTableWords == kTableEncodeBase + 2u * 4096u);
 static_assert(kAllocHistogramBins == kHistogramBins && kAllocSummaryWords == kHistogramBins + 1);
 
 uint64_t GlRenderOutput::totalBufferBytes() const {
@@ -226,8 +227,11 @@ void GlEngine::State::uploadColorTables() {
   const ColorTables& tables = ColorTables::get();
   std::vector<uint32_t> tableWords(kTableWords);
   for (int i = 0; i < 256; ++i) tableWords[kTableLinearBase + i] = bits(tables.srgb8ToLinear[i]);
-  for (int i = 0; i < 4096; ++i) tableWords[kTableCoarseBase + i] = tables.coarseSrgb8[i];
-  for (int i = 0; i < 257; ++i) tableWords[kTableBoundBase + i] = bits(tables.lowerBound[i]);
+  for (int b = 0; b < 4096; ++b) {
+    const uint8_t low = tables.bucketLowSrgb8[b];
+    tableWords[kTableEncodeBase + 2 * b] = low;
+    tableWords[kTableEncodeBase + 2 * b + 1] = bits(tables.lowerBound[low + 1]);
+  }
   colorTables = upload("colour tables", tableWords.size() * 4, tableWords.data());
 }
 

@@ -457,7 +457,8 @@ struct GlEngine::State::FrameRun {
     const uint64_t allocSlots = plan.allocSlots;
     nodeCount = perPixel ? allocSlots : uint64_t{pixels} * k;
     const uint32_t words = static_cast<uint32_t>(method.occupancyWords);
-    const GLuint stats = fb.make("capture counters", 8);
+    constexpr uint32_t kStatWords = kCaptureStatSlots * kCaptureStatStride;
+    const GLuint stats = fb.make("capture counters", kStatWords * 4);
     clearUint(stats, 0);
     if (hybrid) {
       tails = fb.make("tails", uint64_t{pixels} * kTailWords * 4);
@@ -472,9 +473,15 @@ struct GlEngine::State::FrameRun {
         s.program(ProgramId::KBufferAtomic64) != 0 && !perPixel && !hybrid && words == 0;
     out.atomic64 = atomic;
     nodes = fb.make("nodes", nodeCount * kNodeBytes);
-    // the far node; as uint64 words (colour, depth) for the atomic capture
-    const uint32_t far[2] = {atomic ? 0u : kFarDepthBits, atomic ? kFarDepthBits : 0u};
-    glClearNamedBufferData(nodes, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT, far);
+    // the far node: every word kFarDepthBits (a one-word clear, twice as fast as a two-word one
+    // on llvmpipe: 8 against 16 ms for 72 MiB); as uint64 words (colour 0, depth) for the atomic
+    // capture
+    if (atomic) {
+      const uint32_t far[2] = {0u, kFarDepthBits};
+      glClearNamedBufferData(nodes, GL_RG32UI, GL_RG_INTEGER, GL_UNSIGNED_INT, far);
+    } else {
+      clearUint(nodes, kFarDepthBits);
+    }
     // (the lock words stay allocated and charged with the atomics: bytes_used does not depend
     // on the capture's synchronisation)
     const GLuint locks = fb.make("locks", uint64_t{pixels} * 4);
@@ -507,10 +514,13 @@ struct GlEngine::State::FrameRun {
         dispatchGroups((nodeCount + kResolveGroupSize - 1) / kResolveGroupSize);
         glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
       });
-    uint32_t culled[2] = {0, 0};
-    glGetNamedBufferSubData(stats, 0, 8, culled);
-    out.culledOccupancy = culled[0];
-    out.culledKPlus = culled[1];
+    std::vector<uint32_t> culled(kStatWords);
+    glGetNamedBufferSubData(stats, 0, kStatWords * 4, culled.data());
+    out.culledOccupancy = out.culledKPlus = 0;
+    for (uint32_t slot = 0; slot < kStatWords; slot += kCaptureStatStride) {
+      out.culledOccupancy += culled[slot];
+      out.culledKPlus += culled[slot + 1];
+    }
   }
 
   // linked lists: the heads, the pool and its counter [, the tails]; a node per fragment while

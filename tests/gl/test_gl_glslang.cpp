@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
 #include <regex>
 #include <set>
@@ -103,6 +104,8 @@ TEST(GlShaders, EveryVariantValidatesWithGlslang) {
     }
   }
   EXPECT_GT(variants.size(), 300u);  // the switch combinations are there
+  std::cout << "  " << variants.size() << " stages of " << programs.size()
+            << " programs validated\n";
   std::filesystem::remove_all(dir);
   // the variants llvmpipe cannot run are among them
   // (each raster program in both rasters: native and exact)

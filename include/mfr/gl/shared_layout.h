@@ -151,12 +151,13 @@ MFR_GL_CONST(uint, kBlendMultiply, 3u)
 MFR_GL_CONST(uint, kNoTexture, 0xffffffffu)
 MFR_GL_CONST(uint, kAlphaOpaque, 0u)  // mfr::AlphaMode values
 MFR_GL_CONST(uint, kAlphaMask, 1u)
-// colour tables (std430 uint words): 256 floats (bits) of srgb8ToLinear, 4096 coarse codes,
-// 257 floats (bits) of lowerBound
+// colour tables (std430 uint words): 256 floats (bits) of srgb8ToLinear, then per encode bucket
+// b = int(c * 4095 + 0.5) two words: the code of the bucket's smallest input
+// (ColorTables::bucketLowSrgb8) and the float bits of the next code's lower bound (lowerBound), so
+// the encode is one lookup and one upward correction
 MFR_GL_CONST(uint, kTableLinearBase, 0u)
-MFR_GL_CONST(uint, kTableCoarseBase, 256u)
-MFR_GL_CONST(uint, kTableBoundBase, 4352u)
-MFR_GL_CONST(uint, kTableWords, 4609u)
+MFR_GL_CONST(uint, kTableEncodeBase, 256u)
+MFR_GL_CONST(uint, kTableWords, 8448u)
 
 // Bindings per shader file: the kBind* points each file declares (SSBO unless marked; image:
 // an imageBuffer unit, texture: a texture unit). A raster program also has its raster part's
@@ -211,6 +212,14 @@ MFR_GL_CONST(uint, kTableWords, 4609u)
 //       kBindResolveTails
 // (end of the bindings per shader file)
 
+// the k-buffer capture's culled counters (kBindCaptureStats): kCaptureStatSlots slots of
+// kCaptureStatStride words (a 64-byte cache line each), word 0 the occupancy test's, word 1 the
+// k+ test's; a fragment adds to its 64x64 tile's slot, so rasterizer threads working on
+// different tiles seldom contend for one line (on llvmpipe a single counter cost 15 ms of a
+// 300 ms capture); the host sums the slots
+MFR_GL_CONST(uint, kCaptureStatSlots, 16u)
+MFR_GL_CONST(uint, kCaptureStatStride, 16u)
+
 // resolve.comp's node layouts (its MFR_RESOLVE_NODES switch)
 MFR_GL_CONST(uint, kResolveFixedK, 0u)    // k slots at p * k
 MFR_GL_CONST(uint, kResolveABuffer, 1u)   // n(p) nodes at offsets[p]
@@ -251,6 +260,12 @@ const bool kSceneVertexColors = MFR_VERTEX_COLORS != 0;
 const bool kSceneTextures = MFR_TEXTURES != 0;
 const bool kSceneAlphaMask = MFR_ALPHA_MASK != 0;
 const uint kSceneBlendModes = MFR_BLEND_MODES;
+
+// the first word of the k-buffer capture's culled counters for a fragment at storage pixel px
+// (kCaptureStatSlots)
+uint captureStatSlot(ivec2 px) {
+  return (((uint(px.y) >> 6) * 5u + (uint(px.x) >> 6)) % kCaptureStatSlots) * kCaptureStatStride;
+}
 
 // a < b in the node order (unsigned 64-bit (hi, lo))
 bool nodeLess(uvec2 a, uvec2 b) {
