@@ -482,12 +482,20 @@ class GlRenderEngine final : public Engine {
   }
 
   Result<std::vector<uint32_t>> countFragments(const PreparedView& view) override {
-    // multisampled: the per-sample A-buffer's nodes, summed per pixel (as the CPU engine counts)
-    RenderOptions options;
-    options.sampleStorage = SampleStorage::Sample;
-    auto out = render(view, methodPreset("abuffer").value(), options);
-    if (!out) return out.error();
-    return std::move(out->depthComplexity);
+    // the count pass alone (no A-buffer, which need not fit a storage block); multisampled, per
+    // sample, summed per pixel (the per-sample A-buffer's nodes, as the CPU engine counts)
+    const auto* gv = dynamic_cast<const GlView*>(&view);
+    if (!gv) return makeError("--engine gl: the view was prepared by another engine");
+    context_.makeCurrent();
+    auto engine = gv->engine(SampleStorage::Sample);
+    if (!engine) return engine.error();
+    auto counted = (*engine)->count();
+    if (!counted) return counted.error();
+    const size_t per = static_cast<size_t>((*engine)->sampling().storagePerPixel());
+    if (per == 1) return counted;
+    std::vector<uint32_t> n(counted->size() / per, 0);
+    for (size_t i = 0; i < counted->size(); ++i) n[i / per] += (*counted)[i];
+    return n;
   }
 
   Result<std::vector<float>> nearestCosine(const PreparedView& view) override {

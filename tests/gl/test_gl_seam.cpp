@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -462,6 +463,33 @@ TEST(GlSeamErrors, MethodsNotInTheGlEngineAndBudgetsAreOneLine) {
   EXPECT_EQ(gl->nearestCosine(**prepared).value(), cpu.nearestCosine(**cpuView).value());
   EXPECT_FALSE(cpu.render(**prepared, methodPreset("abuffer").value(), {}).ok())
       << "a GL view given to the CPU engine";
+}
+
+// n(p) from the count pass alone, also where the view's A-buffer exceeds a storage block (mfr info
+// --engine gl at its default 1024x1024 on procedural:layers); multisampled, per sample summed per
+// pixel, as the CPU engine counts.
+TEST(GlSeam, CountFragmentsNeedsNoABuffer) {
+  MFR_GL_ENGINE_OR_SKIP(gl, "auto", "native");  // (multisampling is the native raster's)
+  const Scene scene = loadScene("procedural:layers?k=16&r=16&pd=1").value();
+  CpuEngine cpu(EngineOptions{2, 16});
+  for (const int samples : {1, 4}) {
+    SCOPED_TRACE(samples);
+    View view{&scene, *scene.defaultCamera, samples == 1 ? 320 : 96, samples == 1 ? 320 : 80};
+    view.samples = samples;
+    auto glView = gl->prepare(view);
+    auto cpuView = cpu.prepare(view);
+    ASSERT_TRUE(glView.ok()) << glView.error().message;
+    ASSERT_TRUE(cpuView.ok()) << cpuView.error().message;
+    auto g = gl->countFragments(**glView);
+    auto r = cpu.countFragments(**cpuView);
+    ASSERT_TRUE(g.ok()) << g.error().message;
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(*g, *r);
+    if (samples == 1) {  // 256 layers on 102,400 pixels: 210 MB of A-buffer nodes
+      EXPECT_FALSE(gl->render(**glView, methodPreset("abuffer").value(), {}).ok());
+      EXPECT_EQ(std::accumulate(g->begin(), g->end(), uint64_t{0}), uint64_t{256} * 320 * 320);
+    }
+  }
 }
 
 // `mfr compare --engine gl`: ground truth and every run from the GL engine, results.json says so;
