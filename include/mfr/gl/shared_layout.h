@@ -21,7 +21,7 @@ MFR_GL_CONST(uint, kNodeHiIndex, 0u)            // uvec2 component holding the d
 MFR_GL_CONST(uint, kFarDepthBits, 0x7f800000u)  // +inf: the empty node (mfr::kFarNode)
 MFR_GL_CONST(uint, kLockFree, 0u)               // per-pixel spin-lock values
 MFR_GL_CONST(uint, kLockHeld, 1u)
-MFR_GL_CONST(uint, kStoreMaxArray, 0u)  // k-buffer stores (uStore)
+MFR_GL_CONST(uint, kStoreMaxArray, 0u)  // k-buffer stores (MFR_STORE, alloc_pack's uStore)
 MFR_GL_CONST(uint, kStoreMaxHeap, 1u)
 // occupancy per pixel: zn bits, zf bits, j_k (the k-th occupied bucket)
 MFR_GL_CONST(uint, kOccupancyWords, 3u)
