@@ -6,7 +6,12 @@ layout(std430, binding = kBindAccum) coherent buffer Accum {
   float accum[];  // kAoitNodeWords N + kAoitColorWords per pixel
 };
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
-uniform uint uNodeCount;  // N: 4, 8 or 16
+// Compile-time switches (gl_programs.cpp's aoitSwitches):
+//   MFR_AOIT_NODES  N: 4, 8 or 16 nodes
+#ifndef MFR_AOIT_NODES
+#define MFR_AOIT_NODES 4
+#endif
+const uint kNodeCount = MFR_AOIT_NODES;
 
 void main() {
   FragmentData f;
@@ -20,8 +25,8 @@ void main() {
   // AoitPixel::addColor: an additive node adds its emission times vis(z); the word 0 adds nothing
   const float a = (rgba >> 24) == kAdditiveNode ? 1.0 : alpha;
   if (a <= 0.0 || rgba == 0u) return;
-  const uint i = (kAoitNodeWords * uNodeCount + kAoitColorWords) * uint(f.pixel);
-  const int n = int(uNodeCount);
+  const uint i = (kAoitNodeWords * kNodeCount + kAoitColorWords) * uint(f.pixel);
+  const int n = int(kNodeCount);
   float d[kAoitMaxNodes + 1];
   float tr[kAoitMaxNodes + 1];
   for (int j = 0; j <= kAoitMaxNodes; ++j) {  // the nodes are final (pass 1)
@@ -31,7 +36,7 @@ void main() {
   const float vis = aoitVisibility(n, d, tr, depth);
   const vec3 c = vec3(srgb8ToLinear(rgba & 0xffu), srgb8ToLinear((rgba >> 8) & 0xffu),
                       srgb8ToLinear((rgba >> 16) & 0xffu));
-  const uint o = i + kAoitNodeWords * uNodeCount;  // the colour sum after the nodes
+  const uint o = i + kAoitNodeWords * kNodeCount;  // the colour sum after the nodes
   bool done = false;
   while (!done) {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {

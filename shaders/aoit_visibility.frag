@@ -1,6 +1,6 @@
 // Per-pixel memory (pixel p; bindings in shared_layout.h), both AOIT passes:
 //
-//   accum  (kBindAccum, W = kAoitNodeWords N + kAoitColorWords floats: N = uNodeCount = 4, 8, 16)
+//   accum  (kBindAccum, W = kAoitNodeWords N + kAoitColorWords floats: N = kNodeCount = 4, 8, 16)
 //     [Wp + 2i] depth of node i   [Wp + 2i + 1] its transmittance (i = 0..N-1, this pass;
 //     unused nodes: kAoitEmptyDepth and the total transmittance)   [Wp + 2N..2N+2] sum vis a c
 //   uLocks (kBindLocks, r32ui, 4 B)   the per-pixel spin-lock around the update
@@ -15,7 +15,12 @@
 layout(std430, binding = kBindAccum) coherent buffer Accum {
   float accum[];  // kAoitNodeWords N + kAoitColorWords per pixel
 };
-uniform uint uNodeCount;  // N: 4, 8 or 16
+// Compile-time switches (gl_programs.cpp's aoitSwitches):
+//   MFR_AOIT_NODES  N: 4, 8 or 16 nodes
+#ifndef MFR_AOIT_NODES
+#define MFR_AOIT_NODES 4
+#endif
+const uint kNodeCount = MFR_AOIT_NODES;
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
 
 void main() {
@@ -28,8 +33,8 @@ void main() {
   precise float alpha = float(rgba >> 24) * uInv255;
   if (alpha <= 0.0) return;
   precise float t = 1.0 - alpha;
-  const uint i = (kAoitNodeWords * uNodeCount + kAoitColorWords) * uint(f.pixel);
-  const int n = int(uNodeCount);
+  const uint i = (kAoitNodeWords * kNodeCount + kAoitColorWords) * uint(f.pixel);
+  const int n = int(kNodeCount);
   bool done = false;
   while (!done) {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {

@@ -29,7 +29,12 @@ layout(std430, binding = kBindTails) coherent buffer Tails {
 };
 
 uniform uint uPoolSize;
-uniform uint uHybrid;  // 1: the fragments the pool turns away go to the pixel's tail
+// Compile-time switches (gl_programs.cpp's listSwitches):
+//   MFR_HYBRID  1: the fragments the pool turns away go to the pixel's tail
+#ifndef MFR_HYBRID
+#define MFR_HYBRID 0
+#endif
+const uint kHybrid = MFR_HYBRID;
 
 // tails[i] += v as a float, lock-free
 void addToTail(uint i, float v) {
@@ -56,7 +61,7 @@ void main() {
     pool[kListNodeWords * node] = depthBits;
     pool[kListNodeWords * node + 1u] = rgba;
     pool[kListNodeWords * node + 2u] = next;
-  } else if (uHybrid != 0u) {  // mfr::HybridTail::add's terms (method_math.h's hybridTailAdd)
+  } else if (kHybrid != 0u) {  // mfr::HybridTail::add's terms (method_math.h's hybridTailAdd)
     const uint t = kTailWords * f.pixel;
     // hybridTailAddNode: an additive node (alpha byte 0) adds its emission and no alpha
     // (hybridTailAddCovered: weighted by the share of the pixel's samples the fragment covers)

@@ -1,10 +1,10 @@
 // Per-pixel memory (pixel p; bindings in shared_layout.h), both MBOIT passes:
 //
-//   accum  (kBindAccum, W = kMboitWordsBase + M words: M = uMomentWords)
+//   accum  (kBindAccum, W = kMboitWordsBase + M words: M = kMomentWords)
 //     [Wp + 0] b0 (float)   [Wp + 1..M] the moments (this pass)   [Wp + M+1..M+3] sum T a c
 //     [Wp + M+4] sum T a
-//     The moments: N = uMomentCount floats (4, 6 or 8: power moments b1..bN, or with
-//     uTrigonometric N / 2 complex moments as real and imaginary parts), M = N; with uQuantized
+//     The moments: N = kMomentCount floats (4, 6 or 8: power moments b1..bN, or with
+//     kTrigonometric N / 2 complex moments as real and imaginary parts), M = N; with kQuantized
 //     N 16-bit unorm codes of method_math.h's storage basis, two per word (low half first),
 //     M = N / 2.
 //   uLocks (kBindLocks, r32ui, 4 B)   the per-pixel spin-lock around the update
@@ -23,10 +23,23 @@
 layout(std430, binding = kBindAccum) coherent buffer Accum {
   uint accum[];  // kMboitWordsBase + M per pixel
 };
-uniform uint uMomentCount;    // N: 4, 6 or 8
-uniform uint uMomentWords;    // M: N, or N / 2 with uQuantized
-uniform uint uTrigonometric;  // 1: N / 2 trigonometric moments
-uniform uint uQuantized;      // 1: 16-bit storage
+// Compile-time switches (gl_programs.cpp's mboitSwitches):
+//   MFR_MOMENTS  N: 4, 6 or 8
+//   MFR_TRIGONOMETRIC  1: N / 2 trigonometric moments
+//   MFR_QUANTIZED  1: 16-bit storage, two codes per word
+#ifndef MFR_MOMENTS
+#define MFR_MOMENTS 4
+#endif
+#ifndef MFR_TRIGONOMETRIC
+#define MFR_TRIGONOMETRIC 0
+#endif
+#ifndef MFR_QUANTIZED
+#define MFR_QUANTIZED 0
+#endif
+const uint kMomentCount = MFR_MOMENTS;
+const uint kTrigonometric = MFR_TRIGONOMETRIC;
+const uint kQuantized = MFR_QUANTIZED;
+const uint kMomentWords = kQuantized != 0u ? kMomentCount / 2u : kMomentCount;  // M
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
 
 void main() {
@@ -40,24 +53,24 @@ void main() {
   if (alpha <= 0.0) return;
   const float A = mboitAbsorbance(alpha);
   const float z = mboitWarpDepth(depth);
-  const uint i = (kMboitWordsBase + uMomentWords) * uint(f.pixel);
-  const int count = int(uMomentCount);
-  const bool trig = uTrigonometric != 0u;
+  const uint i = (kMboitWordsBase + kMomentWords) * uint(f.pixel);
+  const int count = int(kMomentCount);
+  const bool trig = kTrigonometric != 0u;
   bool done = false;
   while (!done) {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
       float s0 = uintBitsToFloat(accum[i]);
       float m[kMboitMaxMoments];
-      if (uQuantized != 0u) {
+      if (kQuantized != 0u) {
         for (uint j = 0u; j < uint(kMboitMaxMoments); ++j) {
-          const uint word = j < uMomentCount ? accum[i + 1u + j / 2u] : 0u;
+          const uint word = j < kMomentCount ? accum[i + 1u + j / 2u] : 0u;
           const uint code = (j % 2u == 0u) ? (word & 0xffffu) : (word >> 16);
           m[j] = float(code) / kUnorm16Max;  // with b0 = 0 the old values weigh nothing
         }
         mboitAddQuantizedMoments(count, trig, s0, m, A, z);
-        for (uint w = 0u; w < uMomentWords; ++w)
+        for (uint w = 0u; w < kMomentWords; ++w)
           accum[i + 1u + w] = unorm16Code(m[2u * w]) | (unorm16Code(m[2u * w + 1u]) << 16);
-      } else if (uMomentCount == 4u && !trig) {
+      } else if (kMomentCount == 4u && !trig) {
         float s1 = uintBitsToFloat(accum[i + 1u]), s2 = uintBitsToFloat(accum[i + 2u]),
               s3 = uintBitsToFloat(accum[i + 3u]), s4 = uintBitsToFloat(accum[i + 4u]);
         mboitAddMoments(s0, s1, s2, s3, s4, A, z);
@@ -67,12 +80,12 @@ void main() {
         accum[i + 4u] = floatBitsToUint(s4);
       } else {
         for (uint j = 0u; j < uint(kMboitMaxMoments); ++j)
-          m[j] = j < uMomentCount ? uintBitsToFloat(accum[i + 1u + j]) : 0.0;
+          m[j] = j < kMomentCount ? uintBitsToFloat(accum[i + 1u + j]) : 0.0;
         if (trig)
           mboitAddTrigMoments(count / 2, s0, m, A, z);
         else
           mboitAddPowerMoments(count, s0, m, A, z);
-        for (uint j = 0u; j < uMomentCount; ++j) accum[i + 1u + j] = floatBitsToUint(m[j]);
+        for (uint j = 0u; j < kMomentCount; ++j) accum[i + 1u + j] = floatBitsToUint(m[j]);
       }
       accum[i] = floatBitsToUint(s0);
       memoryBarrierBuffer();

@@ -17,7 +17,7 @@
 // the smallest key (depth bits, colour word) >= bound and how many fragments have it (dual: also
 // the largest key < hi and its count), under the pixel's lock; the key order is total, so the
 // result does not depend on the arrival order. peel_step.comp blends the layer and advances the
-// bounds between passes. The tail pass (uTail) adds the fragments still in range to the tail.
+// bounds between passes. The tail pass (kTail) adds the fragments still in range to the tail.
 layout(std430, binding = kBindAccum) coherent buffer PeelState {
   uint state[];
 };
@@ -29,8 +29,17 @@ layout(std430, binding = kBindTails) coherent buffer Tails {
   uint tails[];  // kTailWords per pixel
 };
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
-uniform uint uDual;  // 1: dual depth peeling
-uniform uint uTail;  // 1: the tail pass (hybrid): the fragments in range into the tail
+// Compile-time switches (gl_programs.cpp's peelSwitches):
+//   MFR_DUAL  1: dual depth peeling
+//   MFR_TAIL  1: the tail pass (hybrid): the fragments in range into the tail
+#ifndef MFR_DUAL
+#define MFR_DUAL 0
+#endif
+#ifndef MFR_TAIL
+#define MFR_TAIL 0
+#endif
+const uint kDual = MFR_DUAL;
+const uint kTail = MFR_TAIL;
 
 uvec2 keyAt(uint i) {
   return uvec2(state[i], state[i + 1u]);
@@ -46,13 +55,13 @@ bool keyEqual(uvec2 a, uvec2 b) {
 // whether `key` is still to peel (peel: >= bound; dual: >= lo and < hi)
 bool remains(uint w, uvec2 key) {
   if (nodeLess(key, keyAt(w))) return false;
-  return uDual == 0u || nodeLess(key, keyAt(w + 2u));
+  return kDual == 0u || nodeLess(key, keyAt(w + 2u));
 }
 
 // the pass's update of pixel p's candidates (mfr::PeelPixel::add, mfr::DualPeelPixel::add)
 void peelAdd(uint w, uvec2 key) {
-  const uint nearW = uDual != 0u ? w + 4u : w + 2u;
-  const uint nearM = uDual != 0u ? w + 8u : w + 4u;
+  const uint nearW = kDual != 0u ? w + 4u : w + 2u;
+  const uint nearM = kDual != 0u ? w + 8u : w + 4u;
   const uvec2 nearest = keyAt(nearW);
   const bool none = nearest.x == 0xffffffffu && nearest.y == 0xffffffffu;
   if (nodeLess(key, nearest)) {
@@ -61,7 +70,7 @@ void peelAdd(uint w, uvec2 key) {
   } else if (keyEqual(key, nearest)) {
     state[nearM] = state[nearM] + 1u;
   }
-  if (uDual != 0u) {
+  if (kDual != 0u) {
     const uvec2 farthest = keyAt(w + 6u);
     if (none || nodeLess(farthest, key)) {
       setKey(w + 6u, key);
@@ -96,16 +105,16 @@ void main() {
   countInCapture(f);
   const uint depthBits = floatBitsToUint(fragmentDepth(f));
   const uint p = uint(f.pixel);
-  const uint w = (uDual != 0u ? kDualPeelWords : kPeelWords) * p;
+  const uint w = (kDual != 0u ? kDualPeelWords : kPeelWords) * p;
   // (the bounds change only between passes): a depth outside them needs no shading
-  if (depthBits < state[w] || (uDual != 0u && depthBits > state[w + 2u])) return;
+  if (depthBits < state[w] || (kDual != 0u && depthBits > state[w + 2u])) return;
   const uvec2 key = uvec2(depthBits, shade(f, base));
   if (!remains(w, key)) return;
-  if (uTail == 0u) atomicAdd(inRange, 1u);
+  if (kTail == 0u) atomicAdd(inRange, 1u);
   bool done = false;
   while (!done) {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
-      if (uTail != 0u)
+      if (kTail != 0u)
         tailAdd(p, key.y);
       else
         peelAdd(w, key);

@@ -13,8 +13,17 @@ layout(std430, binding = kBindImage) writeonly buffer Image {
   float image[];  // linear RGB, 3 floats per pixel
 };
 uniform uint uPixels;
-uniform uint uDual;
-uniform uint uHybrid;  // 1: the pixel's tail lies behind the front layers
+// Compile-time switches (gl_programs.cpp's peelSwitches):
+//   MFR_DUAL  1: dual depth peeling
+//   MFR_HYBRID  1: the pixel's tail lies behind the front layers
+#ifndef MFR_DUAL
+#define MFR_DUAL 0
+#endif
+#ifndef MFR_HYBRID
+#define MFR_HYBRID 0
+#endif
+const uint kDual = MFR_DUAL;
+const uint kHybrid = MFR_HYBRID;
 uniform vec3 uBackground;
 
 vec3 colorAt(uint i) {
@@ -23,7 +32,7 @@ vec3 colorAt(uint i) {
 }
 
 vec3 tailBehind(uint p, vec3 behind) {
-  if (uHybrid == 0u) return behind;
+  if (kHybrid == 0u) return behind;
   const uint t = kTailWords * p;
   return hybridBehind(vec3(uintBitsToFloat(tails[t]), uintBitsToFloat(tails[t + 1u]),
                            uintBitsToFloat(tails[t + 2u])),
@@ -35,7 +44,7 @@ void main() {
   const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
   if (p >= uPixels) return;
   vec3 result;
-  if (uDual == 0u) {
+  if (kDual == 0u) {
     const uint w = kPeelWords * p;
     result = overBackground(colorAt(w + 5u), uintBitsToFloat(state[w + 8u]),
                             tailBehind(p, uBackground));

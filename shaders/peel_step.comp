@@ -20,7 +20,12 @@ layout(std430, binding = kBindColorTables) readonly buffer ColorTables {
   uint colorTables[];
 };
 uniform uint uPixels;
-uniform uint uDual;
+// Compile-time switches (gl_programs.cpp's peelSwitches):
+//   MFR_DUAL  1: dual depth peeling
+#ifndef MFR_DUAL
+#define MFR_DUAL 0
+#endif
+const uint kDual = MFR_DUAL;
 uniform float uInv255;
 
 float srgb8ToLinear(uint code) {
@@ -57,7 +62,7 @@ void main() {
   const uint p = group * kResolveGroupSize + gl_LocalInvocationID.x;
   if (p >= uPixels) return;
   uint took = 0u;
-  if (uDual == 0u) {
+  if (kDual == 0u) {
     const uint w = kPeelWords * p;
     const uvec2 c = uvec2(state[w + 2u], state[w + 3u]);
     if (c.x == 0xffffffffu && c.y == 0xffffffffu) return;

@@ -34,7 +34,12 @@ layout(std430, binding = kBindResolveTails) readonly buffer Tails {
   uint tails[];  // kTailWords per pixel
 };
 
-uniform uint uHybrid;
+// Compile-time switches (gl_programs.cpp's listSwitches):
+//   MFR_HYBRID  1: mfr::compositeHybrid with the pixel's tail
+#ifndef MFR_HYBRID
+#define MFR_HYBRID 0
+#endif
+const uint kHybrid = MFR_HYBRID;
 uniform uint uPixels;
 uniform vec3 uBackground;
 uniform float uInv255;
@@ -83,7 +88,7 @@ void main() {
   }
   lengths[p] = n;
   vec3 behind = uBackground;
-  if (uHybrid != 0u) {
+  if (kHybrid != 0u) {
     const uint t = kTailWords * p;
     const vec3 sum = vec3(uintBitsToFloat(tails[t]), uintBitsToFloat(tails[t + 1u]),
                           uintBitsToFloat(tails[t + 2u]));

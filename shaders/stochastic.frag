@@ -10,8 +10,8 @@
 // Bytes per pixel: 52 + 4 (lock); no nodes.
 //
 // Stochastic transparency (Enderton, Sintorn, Shirley, Luebke, I3D 2010) with S = 8 samples, and
-// Laine and Karras' stratified alpha (EGSR 2011) with uStratified (mfr::StochasticPasses): three
-// geometry passes of this shader, uPass
+// Laine and Karras' stratified alpha (EGSR 2011) with kStratified (mfr::StochasticPasses): three
+// geometry passes of this shader, kPass
 //   0 total alpha       T *= 1 - a, under the lock
 //   1 stochastic depth  the fragment covers the samples of its mask (method_math.h's
 //                       stochasticMask of stochasticKey(pixel, depth bits, colour word)); each
@@ -25,23 +25,32 @@ layout(std430, binding = kBindAccum) coherent buffer Accum {
   uint accum[];  // kStochasticWords per pixel
 };
 layout(binding = kBindLocks, r32ui) uniform coherent uimageBuffer uLocks;
-uniform uint uPass;        // 0 total alpha, 1 stochastic depth, 2 capture
-uniform uint uStratified;  // 1: stochastic-strat
+// Compile-time switches (gl_programs.cpp's stochasticSwitches):
+//   MFR_PASS  0 total alpha, 1 stochastic depth, 2 capture
+//   MFR_STRATIFIED  1: stochastic-strat
+#ifndef MFR_PASS
+#define MFR_PASS 0
+#endif
+#ifndef MFR_STRATIFIED
+#define MFR_STRATIFIED 0
+#endif
+const uint kPass = MFR_PASS;
+const uint kStratified = MFR_STRATIFIED;
 
 void main() {
   FragmentData f;
   if (!rasterFragment(f)) discard;
   vec4 base;
   if (!surface(f, false, base)) discard;
-  if (uPass == 2u) countInCapture(f);
+  if (kPass == 2u) countInCapture(f);
   const float depth = fragmentDepth(f);
   const uint rgba = shade(f, base);
   const uint alpha8 = rgba >> 24;
   const uint i = kStochasticWords * uint(f.pixel);
-  if (uPass == 1u) {
+  if (kPass == 1u) {
     if (alpha8 == 0u) return;
     const uint mask =
-        stochasticMask(kStochasticSamples, uStratified != 0u,
+        stochasticMask(kStochasticSamples, kStratified != 0u,
                        stochasticKey(uint(f.pixel), floatBitsToUint(depth), rgba), alpha8);
     for (int j = 0; j < kStochasticSamples; ++j)
       if (((mask >> uint(j)) & 1u) != 0u) atomicMin(accum[i + uint(j)], floatBitsToUint(depth));
@@ -50,7 +59,7 @@ void main() {
   precise float a = float(alpha8) * uInv255;  // unpackFragmentColor's alpha
   float w = 0.0;
   vec3 c = vec3(0.0);
-  if (uPass == 2u) {
+  if (kPass == 2u) {
     if (a <= 0.0) return;
     int seen = 0;
     for (int j = 0; j < kStochasticSamples; ++j)
@@ -64,7 +73,7 @@ void main() {
   bool done = false;
   while (!done) {
     if (imageAtomicExchange(uLocks, f.pixel, kLockHeld) == kLockFree) {
-      if (uPass == 0u) {
+      if (kPass == 0u) {
         precise float trans = uintBitsToFloat(accum[t]) * (1.0 - a);
         accum[t] = floatBitsToUint(trans);
       } else {

@@ -250,13 +250,11 @@ struct GlEngine::State::FrameRun {
     const GLuint locks = makeAccumulators(pixel);
     const bool stratified = plan.method.compositing == Compositing::StochasticStrat8;
     const auto draw = [&](GLuint passIndex) {
-      const GLuint p = s.program(ProgramId::Stochastic);
+      const GLuint p = variant(ProgramId::Stochastic, stochasticSwitches(passIndex, stratified));
       // every pass binds the counts image, though only the capture (uPass 2) counts: bound for
       // pass 2 alone, its imageAtomicAdd never reached the buffer on llvmpipe (Mesa 22.3.6; the
       // unit's binding and the uniforms queried right, n(p) read back 0, the sums intact)
       useCapture(p);
-      glProgramUniform1ui(p, loc(p, "uPass"), passIndex);
-      glProgramUniform1ui(p, loc(p, "uStratified"), stratified ? 1u : 0u);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       fb.bindImage(locks, kBindLocks);
       s.drawScene();
@@ -324,22 +322,19 @@ struct GlEngine::State::FrameRun {
         pixel[kAoitNodeWords * j + 1] = std::bit_cast<uint32_t>(1.0f);
       }
     const GLuint locks = makeAccumulators(pixel);
-    auto accumulate = [&](GLuint program, bool capture) {
+    // the programs' switches: the AOIT nodes, or the MBOIT moments
+    const Compositing c = plan.method.compositing;
+    const std::string switches = isWboit ? std::string()
+                                 : isAoit
+                                     ? aoitSwitches(aoitNodes)
+                                     : mboitSwitches(static_cast<uint32_t>(mboitMomentCount(c)),
+                                                     mboitTrigonometric(c), mboitQuantized(c));
+    auto accumulate = [&](ProgramId id, bool capture) {
+      const GLuint program = variant(id, switches);
       if (capture) {
         useCapture(program);
       } else {
         glUseProgram(program);
-      }
-      if (isAoit) {
-        glProgramUniform1ui(program, loc(program, "uNodeCount"), aoitNodes);
-      } else if (!isWboit) {
-        glProgramUniform1ui(program, loc(program, "uMomentCount"),
-                            static_cast<GLuint>(mboitMomentCount(plan.method.compositing)));
-        glProgramUniform1ui(program, loc(program, "uTrigonometric"),
-                            mboitTrigonometric(plan.method.compositing) ? 1u : 0u);
-        glProgramUniform1ui(program, loc(program, "uQuantized"),
-                            mboitQuantized(plan.method.compositing) ? 1u : 0u);
-        glProgramUniform1ui(program, loc(program, "uMomentWords"), mboitMomentWords(plan.method));
       }
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       fb.bindImage(locks, kBindLocks);
@@ -347,13 +342,13 @@ struct GlEngine::State::FrameRun {
       glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
     };
     if (isAoit)
-      pass("visibility", [&] { accumulate(s.program(ProgramId::AoitVisibility), false); });
+      pass("visibility", [&] { accumulate(ProgramId::AoitVisibility, false); });
     else if (!isWboit)
-      pass("moments", [&] { accumulate(s.program(ProgramId::MboitMoments), false); });
+      pass("moments", [&] { accumulate(ProgramId::MboitMoments, false); });
     pass("capture", [&] {
-      accumulate(isWboit  ? s.program(ProgramId::Wboit)
-                 : isAoit ? s.program(ProgramId::AoitColor)
-                          : s.program(ProgramId::MboitColor),
+      accumulate(isWboit  ? ProgramId::Wboit
+                 : isAoit ? ProgramId::AoitColor
+                          : ProgramId::MboitColor,
                  true);
     });
   }
@@ -538,10 +533,9 @@ struct GlEngine::State::FrameRun {
       clearUint(tails, 0);
     }
     pass("capture", [&] {
-      const GLuint p = s.program(ProgramId::ListCapture);
+      const GLuint p = variant(ProgramId::ListCapture, listSwitches(plan.hybrid));
       useCapture(p);
       glProgramUniform1ui(p, loc(p, "uPoolSize"), static_cast<GLuint>(nodeCount));
-      glProgramUniform1ui(p, loc(p, "uHybrid"), plan.hybrid ? 1u : 0u);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindListHeads, heads);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindNodes, nodes);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindFill, counter);
@@ -558,9 +552,8 @@ struct GlEngine::State::FrameRun {
     image = fb.make("image", uint64_t{pixels} * 12);
     offsets = fb.make("lengths", uint64_t{pixels} * 4);
     pass("resolve", [&] {
-      const GLuint p = s.program(ProgramId::ListResolve);
+      const GLuint p = variant(ProgramId::ListResolve, listSwitches(plan.hybrid));
       useResolve(p);
-      glProgramUniform1ui(p, loc(p, "uHybrid"), plan.hybrid ? 1u : 0u);
       glProgramUniform1f(p, loc(p, "uInv255"), 1.0f / 255.0f);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindListHeads, heads);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindListLengths, offsets);
@@ -623,14 +616,11 @@ struct GlEngine::State::FrameRun {
       tails = fb.make("tails", uint64_t{pixels} * kTailWords * 4);
       clearUint(tails, 0);
     }
-    const GLuint draw = s.program(ProgramId::Peel), step = s.program(ProgramId::PeelStep);
-    glProgramUniform1ui(draw, loc(draw, "uDual"), dual ? 1u : 0u);
-    glProgramUniform1ui(step, loc(step, "uDual"), dual ? 1u : 0u);
+    const GLuint step = variant(ProgramId::PeelStep, peelStepSwitches(dual));
     glProgramUniform1ui(step, loc(step, "uPixels"), pixels);
     glProgramUniform1f(step, loc(step, "uInv255"), 1.0f / 255.0f);
     const auto geometry = [&](bool tail) {
-      useCapture(draw);
-      glProgramUniform1ui(draw, loc(draw, "uTail"), tail ? 1u : 0u);
+      useCapture(variant(ProgramId::Peel, peelSwitches(dual, tail)));
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindCaptureStats, stats);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindTails, tails ? tails : stats);
@@ -667,11 +657,10 @@ struct GlEngine::State::FrameRun {
   void resolvePeel() {
     image = fb.make("image", uint64_t{plan.pixels} * 12);
     pass("resolve", [&] {
-      const GLuint p = s.program(ProgramId::PeelResolve);
+      const GLuint p = variant(
+          ProgramId::PeelResolve,
+          peelResolveSwitches(plan.method.compositing == Compositing::DualPeel, plan.hybrid));
       useResolve(p);
-      glProgramUniform1ui(p, loc(p, "uDual"),
-                          plan.method.compositing == Compositing::DualPeel ? 1u : 0u);
-      glProgramUniform1ui(p, loc(p, "uHybrid"), plan.hybrid ? 1u : 0u);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindResolveTails, tails ? tails : accum);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
@@ -697,13 +686,14 @@ struct GlEngine::State::FrameRun {
   void resolveAccumulators(ProgramId program) {
     image = fb.make("image", uint64_t{plan.pixels} * 12);
     pass("resolve", [&] {
-      const GLuint p = s.program(program);
+      const GLuint p =
+          program == ProgramId::AoitResolve
+              ? variant(program,
+                        aoitSwitches(static_cast<uint32_t>(aoitNodeCount(plan.method.compositing))))
+              : s.program(program);
       useResolve(p);
       if (program == ProgramId::MboitResolve)
         glProgramUniform1ui(p, loc(p, "uMomentWords"), mboitMomentWords(plan.method));
-      if (program == ProgramId::AoitResolve)
-        glProgramUniform1ui(p, loc(p, "uNodeCount"),
-                            static_cast<GLuint>(aoitNodeCount(plan.method.compositing)));
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindAccum, accum);
       glBindBufferBase(GL_SHADER_STORAGE_BUFFER, kBindImage, image);
       if (program == ProgramId::HashedAlphaResolve)

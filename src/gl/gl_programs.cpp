@@ -240,6 +240,36 @@ std::string resolveSwitches(uint32_t nodes, bool hybrid, bool localSort, bool wr
          defineLine("MFR_WRITE_SORTED", writeSorted ? 1 : 0);
 }
 
+std::string mboitSwitches(uint32_t moments, bool trigonometric, bool quantized) {
+  return defineLine("MFR_MOMENTS", moments) +
+         defineLine("MFR_TRIGONOMETRIC", trigonometric ? 1 : 0) +
+         defineLine("MFR_QUANTIZED", quantized ? 1 : 0);
+}
+
+std::string aoitSwitches(uint32_t nodes) {
+  return defineLine("MFR_AOIT_NODES", nodes);
+}
+
+std::string stochasticSwitches(uint32_t pass, bool stratified) {
+  return defineLine("MFR_PASS", pass) + defineLine("MFR_STRATIFIED", stratified ? 1 : 0);
+}
+
+std::string peelSwitches(bool dual, bool tail) {
+  return defineLine("MFR_DUAL", dual ? 1 : 0) + defineLine("MFR_TAIL", tail ? 1 : 0);
+}
+
+std::string peelStepSwitches(bool dual) {
+  return defineLine("MFR_DUAL", dual ? 1 : 0);
+}
+
+std::string peelResolveSwitches(bool dual, bool hybrid) {
+  return defineLine("MFR_DUAL", dual ? 1 : 0) + defineLine("MFR_HYBRID", hybrid ? 1 : 0);
+}
+
+std::string listSwitches(bool hybrid) {
+  return defineLine("MFR_HYBRID", hybrid ? 1 : 0);
+}
+
 Programs::~Programs() {
   for (GLuint p : ids_)
     if (p) glDeleteProgram(p);
@@ -387,6 +417,38 @@ std::vector<std::string> programSwitchSets(ProgramId id) {
           for (const bool local : {false, true})
             for (const bool write : {false, true})
               sets.push_back(resolveSwitches(nodes, hybrid, local, write));
+      break;
+    case ProgramId::MboitMoments:
+    case ProgramId::MboitColor:
+      for (const uint32_t moments : {4u, 6u, 8u})
+        for (const bool trigonometric : {false, true})
+          for (const bool quantized : {false, true})
+            sets.push_back(mboitSwitches(moments, trigonometric, quantized));
+      break;
+    case ProgramId::AoitVisibility:
+    case ProgramId::AoitColor:
+    case ProgramId::AoitResolve:
+      for (const uint32_t nodes : {4u, 8u, 16u}) sets.push_back(aoitSwitches(nodes));
+      break;
+    case ProgramId::Stochastic:
+      for (const uint32_t pass : {0u, 1u, 2u})
+        for (const bool stratified : {false, true})
+          sets.push_back(stochasticSwitches(pass, stratified));
+      break;
+    case ProgramId::Peel:
+      for (const bool dual : {false, true})
+        for (const bool tail : {false, true}) sets.push_back(peelSwitches(dual, tail));
+      break;
+    case ProgramId::PeelStep:
+      for (const bool dual : {false, true}) sets.push_back(peelStepSwitches(dual));
+      break;
+    case ProgramId::PeelResolve:
+      for (const bool dual : {false, true})
+        for (const bool hybrid : {false, true}) sets.push_back(peelResolveSwitches(dual, hybrid));
+      break;
+    case ProgramId::ListCapture:
+    case ProgramId::ListResolve:
+      for (const bool hybrid : {false, true}) sets.push_back(listSwitches(hybrid));
       break;
     default:
       sets.push_back("");

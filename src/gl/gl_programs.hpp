@@ -115,6 +115,25 @@ class Programs {
 /// kStoreMaxArray or kStoreMaxHeap), occupancy culling, the hybrid tail.
 std::string kbufferSwitches(bool perPixel, uint32_t store, bool occupancy, bool hybrid);
 
+/// mboit_moments.frag's and mboit_color.frag's switches: the moment count N (4, 6 or 8),
+/// trigonometric moments, 16-bit storage.
+std::string mboitSwitches(uint32_t moments, bool trigonometric, bool quantized);
+
+/// The AOIT programs' switch: the node count (4, 8 or 16).
+std::string aoitSwitches(uint32_t nodes);
+
+/// stochastic.frag's switches: the pass (0 total alpha, 1 stochastic depth, 2 capture), the
+/// stratified masks.
+std::string stochasticSwitches(uint32_t pass, bool stratified);
+
+/// Depth peeling's switches: dual peeling, and peel.frag's tail pass / peel_resolve.comp's tail.
+std::string peelSwitches(bool dual, bool tail);
+std::string peelStepSwitches(bool dual);
+std::string peelResolveSwitches(bool dual, bool hybrid);
+
+/// The linked lists' switch (capture_list.frag, resolve_list.comp): the hybrid tail.
+std::string listSwitches(bool hybrid);
+
 /// resolve.comp's switches: the node layout (kResolveFixedK, kResolveABuffer, kResolvePerPixel),
 /// the hybrid tail, whether every pixel's slots fit the local sort, whether the sorted nodes are
 /// written back.
