@@ -99,7 +99,7 @@ Result<unsigned> createCheckedBuffer(const std::string& name, uint64_t bytes, co
   // (the data's own bytes: a buffer rounded up to 16 B reads no further than they go)
   glNamedBufferData(b, static_cast<GLsizeiptr>(size), size == bytes ? data : nullptr,
                     staticDraw ? GL_STATIC_DRAW : GL_DYNAMIC_COPY);
-  GLenum e = glGetError();
+  const GLenum e = glGetError();
   if (e == GL_NO_ERROR && data && size != bytes && bytes > 0)
     glNamedBufferSubData(b, 0, static_cast<GLsizeiptr>(bytes), data);
   if (e == GL_NO_ERROR && b != 0) return b;

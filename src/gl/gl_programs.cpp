@@ -398,8 +398,8 @@ std::vector<EngineSwitches> engineSwitchSets(GlRaster raster) {
   return sets;
 }
 
-// Each program's own switch sets (its Programs::variant defines), every combination: the
-// k-buffer capture's and the resolve's; one empty set for the others.
+// Each program's own switch sets (its Programs::variant defines, built by the *Switches
+// functions above), every combination; one empty set for a program without switches.
 std::vector<std::string> programSwitchSets(ProgramId id) {
   std::vector<std::string> sets;
   switch (id) {

@@ -470,9 +470,9 @@ class GlRenderEngine final : public Engine {
 
   Result<RenderOutput> render(const PreparedView& view, const MethodDesc& method,
                               const RenderOptions& options) override {
-    const auto* gv = dynamic_cast<const GlView*>(&view);
-    if (!gv) return makeError("--engine gl: the view was prepared by another engine");
-    context_.makeCurrent();  // (another GL engine on this thread may have made its own current)
+    auto glv = glView(view);
+    if (!glv) return glv.error();
+    const GlView* gv = *glv;
     auto plan = planPasses(method, options);
     if (!plan) return plan.error();
     MFR_TRY(checkBlendSupport(method, gv->view().scene->blendModes()));
@@ -484,28 +484,34 @@ class GlRenderEngine final : public Engine {
   Result<std::vector<uint32_t>> countFragments(const PreparedView& view) override {
     // the count pass alone (no A-buffer, which need not fit a storage block); multisampled, per
     // sample, summed per pixel (the per-sample A-buffer's nodes, as the CPU engine counts)
-    const auto* gv = dynamic_cast<const GlView*>(&view);
-    if (!gv) return makeError("--engine gl: the view was prepared by another engine");
-    context_.makeCurrent();
-    auto engine = gv->engine(SampleStorage::Sample);
+    auto gv = glView(view);
+    if (!gv) return gv.error();
+    auto engine = (*gv)->engine(SampleStorage::Sample);
     if (!engine) return engine.error();
     auto counted = (*engine)->count();
     if (!counted) return counted.error();
-    const size_t per = static_cast<size_t>((*engine)->sampling().storagePerPixel());
-    if (per == 1) return counted;
-    std::vector<uint32_t> n(counted->size() / per, 0);
-    for (size_t i = 0; i < counted->size(); ++i) n[i / per] += (*counted)[i];
-    return n;
+    RenderOutput out;
+    out.depthComplexity = std::move(counted.value());
+    toImagePixels(out, (*engine)->sampling().storagePerPixel());
+    return std::move(out.depthComplexity);
   }
 
   Result<std::vector<float>> nearestCosine(const PreparedView& view) override {
-    const auto* gv = dynamic_cast<const GlView*>(&view);
-    if (!gv) return makeError("--engine gl: the view was prepared by another engine");
-    context_.makeCurrent();
-    return gv->engine().nearestCosine();
+    auto gv = glView(view);
+    if (!gv) return gv.error();
+    return (*gv)->engine().nearestCosine();
   }
 
  private:
+  // a view this engine prepared, its context made current (another GL engine on this thread may
+  // have made its own current)
+  Result<const GlView*> glView(const PreparedView& view) const {
+    const auto* gv = dynamic_cast<const GlView*>(&view);
+    if (!gv) return makeError("--engine gl: the view was prepared by another engine");
+    context_.makeCurrent();
+    return gv;
+  }
+
   GlContext context_;
   bool interlock_ = false;
   GlRaster raster_ = GlRaster::Native;
