@@ -36,8 +36,7 @@ if(MFR_BUILD_TESTS)
   target_compile_options(mfr_gl_tests PRIVATE ${MFR_WARNINGS})
   target_include_directories(mfr_gl_tests PRIVATE src)  # gl/shader_sources.hpp
   target_link_libraries(mfr_gl_tests PRIVATE mfr_gl GTest::gtest GTest::gtest_main)
-  target_compile_definitions(mfr_gl_tests PRIVATE MFR_CLI_PATH="$<TARGET_FILE:mfr_cli>"
-    MFR_SCENES_DIR="${MFR_SCENES_DIR}")
+  mfr_test_paths(mfr_gl_tests)
   add_dependencies(mfr_gl_tests mfr_cli)
   # discovery at test time: a machine without a GL 4.5 context skips (or, with CI=true, fails) the
   # tests instead of failing the build

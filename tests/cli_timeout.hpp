@@ -13,6 +13,7 @@
 #include <string>
 
 #include "cli_runner.hpp"
+#include "test_paths.hpp"
 
 namespace mfr::test {
 

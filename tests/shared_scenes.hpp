@@ -9,6 +9,7 @@
 #include <string>
 
 #include <gtest/gtest.h>
+#include "test_paths.hpp"
 
 namespace mfr::test {
 

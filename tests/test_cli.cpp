@@ -13,6 +13,7 @@
 
 #include "cli_runner.hpp"
 #include "mfr/method/method.hpp"
+#include "test_paths.hpp"
 
 namespace {
 
@@ -228,7 +229,7 @@ TEST(Cli, FileSizeLimitIsAWriteErrorNotASignal) {
   fs::create_directories(dir);
   const fs::path image = dir / "out.png", stats = dir / "stats.json";
   // 10 blocks of 512 bytes: a 512x512 noisy render's PNG is far larger
-  const std::string limited = "sh -c 'ulimit -f 10; exec " MFR_CLI_PATH;
+  const std::string limited = "sh -c 'ulimit -f 10; exec " + MFR_CLI_PATH;
   const CliRun r =
       mfr::test::runShell(limited + " render procedural:hairball --width 512 --height 512 -q -o " +
                               image.string() + "'",
@@ -242,7 +243,7 @@ TEST(Cli, FileSizeLimitIsAWriteErrorNotASignal) {
 
   // stdout past the limit (--json into a file) is an error too, not a silently cut output
   const CliRun json = mfr::test::runShell(
-      "sh -c 'ulimit -f 1; exec " MFR_CLI_PATH " presets --format json'", tempDir());
+      "sh -c 'ulimit -f 1; exec " + MFR_CLI_PATH + " presets --format json'", tempDir());
   EXPECT_FALSE(json.signaled) << json.err;
   EXPECT_EQ(json.exitCode, 1) << json.err;
   EXPECT_EQ(json.err, "mfr: error: stdout: write error (File too large)\n");

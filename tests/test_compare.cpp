@@ -25,6 +25,7 @@
 #include "mfr/scene/camera.hpp"
 #include "mfr/scene/load.hpp"
 #include "mfr/scene/scene.hpp"
+#include "test_paths.hpp"
 
 namespace mfr {
 namespace {
@@ -635,7 +636,7 @@ TEST(CompareOutputFolder, AFailedCompareLeavesTheOldFolderWholeAndANewOneReplace
   // a 64x64 compare whose larger files hit the file-size limit (the small ones fit): before, the
   // small new files landed beside the old 16x16 results.json
   const CompareCliRun cut = mfr::test::runShell(
-      "sh -c 'ulimit -f 4; exec " MFR_CLI_PATH " " + compareArgs(64, "fkb", dir) + "'", root);
+      "sh -c 'ulimit -f 4; exec " + MFR_CLI_PATH + " " + compareArgs(64, "fkb", dir) + "'", root);
   EXPECT_EQ(cut.exitCode, 1) << cut.err;
   EXPECT_NE(cut.err.find("write error (File too large)"), std::string::npos) << cut.err;
   EXPECT_TRUE(contentsOf(dir) == first) << "the old folder was changed";
@@ -670,8 +671,8 @@ TEST(CompareOutputFolder, ConcurrentComparesIntoOneFolderLeaveOneWholeComparison
   fs::create_directories(root);
   // a staging folder of a process that is gone (killed mid-compare) is cleaned up
   fs::create_directories(root / ".out.compare-tmp.999999999.0");
-  const std::string a = MFR_CLI_PATH " " + compareArgs(16, "fkb", dir);
-  const std::string b = MFR_CLI_PATH " " + compareArgs(24, "fkb,vkb", dir);
+  const std::string a = MFR_CLI_PATH + " " + compareArgs(16, "fkb", dir);
+  const std::string b = MFR_CLI_PATH + " " + compareArgs(24, "fkb,vkb", dir);
   const CompareCliRun r = mfr::test::runShell(
       "sh -c '" + a + " & a=$!; " + b + " & b=$!; wait $a && wait $b && echo both'", root);
   ASSERT_EQ(r.exitCode, 0) << r.err;

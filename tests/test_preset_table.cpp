@@ -9,6 +9,7 @@
 
 #include "cli_runner.hpp"
 #include "mfr/method/method.hpp"
+#include "test_paths.hpp"
 
 namespace mfr {
 namespace {

@@ -32,6 +32,7 @@
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
 #include "mfr/scene/load.hpp"
+#include "test_paths.hpp"
 
 namespace mfr::gl {
 namespace {

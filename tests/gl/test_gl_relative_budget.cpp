@@ -17,6 +17,7 @@
 #include "mfr/gl/gl_render_engine.hpp"
 #include "mfr/method/budget_spec.hpp"
 #include "mfr/scene/load.hpp"
+#include "test_paths.hpp"
 
 namespace mfr::gl {
 namespace {

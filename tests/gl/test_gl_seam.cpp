@@ -25,6 +25,7 @@
 #include "mfr/gl/gl_technique.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/scene/load.hpp"
+#include "test_paths.hpp"
 
 namespace mfr::gl {
 namespace {
