@@ -25,8 +25,8 @@ dataset are read-only.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
-import functools
 import json
 import os
 import re
@@ -46,13 +46,6 @@ from ._mfr import (  # noqa: F401  (re-exported)
     RenderResult,
     Scene,
     __version__,
-    builtin_model,
-    decode_srgb,
-    encode_srgb,
-    engine_names,
-    preset_names,
-    read_png,
-    write_png,
 )
 
 __all__ = [
@@ -64,48 +57,147 @@ __all__ = [
     "save_dataset", "save_model", "write_png",
 ]
 
-# --- argument types: a TypeError naming the parameter ------------------------------------------
+# --- arguments ---------------------------------------------------------------------------------
+#
+# Every public function is a Python function with its real signature (inspect.signature works; a
+# missing or unknown argument is Python's own TypeError naming the function), and passes its
+# arguments on unconverted: the extension converts each one and names the function and the
+# parameter when it cannot ("render(): width: expected an integer, got str", "render(): seed:
+# expected an integer in [0, 18446744073709551615], got -1"), never pybind11's "incompatible
+# function arguments" signature dump or "Unable to cast Python instance". Paths are str, bytes or
+# os.PathLike, passed to the file system as os.fsencode gives them.
 
-# what pybind11 converts to each C++ type of a signature, and how to say it
-_ACCEPTS = {
-    "int": ("an integer", lambda v: hasattr(type(v), "__index__")),
-    "float": ("a number", lambda v: hasattr(type(v), "__float__") or hasattr(type(v), "__index__")),
-    "str": ("a str", lambda v: isinstance(v, (str, bytes))),
-    "bool": ("True or False", lambda v: isinstance(v, (bool, np.bool_))),
-    "List[str]": ("a list of str", lambda v: isinstance(v, (list, tuple)) and
-                  all(isinstance(x, str) for x in v)),
-}
+_PREFIX = re.compile(r"^[\w.]+\(\): ")
 
 
-def _named_type_errors(function):
-    """`function` (of _mfr) whose pybind11 "incompatible function arguments" TypeError (the whole
-    signature, naming no parameter) becomes "width: expected an integer, got str"."""
-    signature = (function.__doc__ or "\n").splitlines()[0]
-    parameters = re.findall(r"(?:\(|, )(\w+): ([\w.\[\]]+)", signature)
-
-    @functools.wraps(function)
-    def call(*args, **kwargs):
-        try:
-            return function(*args, **kwargs)
-        except TypeError as e:
-            if "incompatible function arguments" not in str(e):
-                raise
-            given = dict(zip((name for name, _ in parameters), args))
-            given.update(kwargs)
-            for name, kind in parameters:
-                if name in given and kind in _ACCEPTS and not _ACCEPTS[kind][1](given[name]):
-                    raise TypeError(f"{name}: expected {_ACCEPTS[kind][0]}, got "
-                                    f"{type(given[name]).__name__}") from None
+@contextlib.contextmanager
+def _as_function(name):
+    """Argument errors of the functions called inside ("Model(): weights: ...") named after the
+    public function `name` that was called ("make_model(): weights: ...")."""
+    try:
+        yield
+    except (TypeError, ValueError, OverflowError) as e:
+        text = str(e)
+        if not _PREFIX.match(text):
             raise
+        raise type(e)(_PREFIX.sub(name + "(): ", text, count=1)) from None
 
-    return call
+
+def _argument_error(function, kind, parameter, message):
+    return kind(f"{function}(): {parameter}: {message}")
 
 
-load_scene = _named_type_errors(_mfr.load_scene)
-metrics = _named_type_errors(_mfr.metrics)
-parse_bytes = _named_type_errors(_mfr.parse_bytes)
-_render = _named_type_errors(_mfr.render)
-_compare = _named_type_errors(_mfr._compare)
+def _as_list(value, single):
+    """A list argument: one `single` value as [value], an iterable (a generator, an array) as a
+    list; anything else as it is, for the extension to refuse naming the parameter."""
+    if isinstance(value, single):
+        return [value]
+    if isinstance(value, (str, bytes, dict)) or not isinstance(value, Iterable):
+        return value
+    return list(value)
+
+
+def _path_text(value):
+    """A path for a report's text: os.fspath of a path, anything else as it is."""
+    return os.fspath(value) if isinstance(value, (str, bytes, os.PathLike)) else value
+
+
+def _differs(value, default):
+    try:
+        return bool(value != default)
+    except (TypeError, ValueError):  # e.g. a numpy array: no single truth value
+        return True
+
+
+def load_scene(source, *, seed=1, transmission_floor=0.1, alpha=None, background=None,
+               memory_limit=None, allow_outside_references=False, gltf_scene=None) -> Scene:
+    """Loads a scene: a .gltf/.glb, .obj, .ply or JSON scene file (a str, bytes or os.PathLike
+    path), or "procedural:NAME[?k=v&...]". seed: procedural scenes' seed; transmission_floor:
+    glass alpha floor; alpha: override every material's alpha (0..1); background: linear RGB;
+    memory_limit: refuse scenes needing more (bytes or "8GB"; default 75% of the physical
+    memory); allow_outside_references: let a scene file name files outside its folder (`mfr
+    --allow-outside-references`); gltf_scene: which of a glTF file's scenes (`mfr --scene N`;
+    default the file's own). Raises mfr.Error naming the input. Points and lines are not
+    rendered: Scene.primitives_skipped counts them."""
+    return _mfr.load_scene(source, seed=seed, transmission_floor=transmission_floor, alpha=alpha,
+                           background=background, memory_limit=memory_limit,
+                           allow_outside_references=allow_outside_references,
+                           gltf_scene=gltf_scene)
+
+
+def metrics(reference, test, ppd=FLIP_DEFAULT_PPD) -> dict:
+    """Error of `test` against `reference`, as `mfr metrics --json` computes it: each a PNG path
+    or an array (uint8 (h, w, 3|4) sRGB, or float (h, w, 3) linear, sRGB-encoded first). Returns
+    a dict: width, height, mse_linear, mse_srgb, psnr_linear, psnr_srgb (inf when identical), mse
+    and psnr (the linear ones), flip_mean, flip_median, flip_p95, flip_p99, flip_max,
+    pixels_per_degree, and flip_map (LDR-FLIP per pixel, float32 (h, w) in [0, 1])."""
+    return _mfr.metrics(reference, test, ppd)
+
+
+def parse_bytes(text) -> int:
+    """A size in bytes: "20MB" -> 20971520 (binary units, as the command line's --budget)."""
+    return _mfr.parse_bytes(text)
+
+
+def read_png(path) -> np.ndarray:
+    """Reads a PNG as uint8 (height, width, 4) RGBA (sRGB colour)."""
+    return _mfr.read_png(path)
+
+
+def write_png(path, image) -> None:
+    """Writes uint8 (h, w, 3|4) sRGB, or float (h, w, 3) linear RGB (sRGB-encoded as mfr render
+    does), as a PNG."""
+    _mfr.write_png(path, image)
+
+
+def encode_srgb(image) -> np.ndarray:
+    """Linear float (h, w, 3) -> sRGB uint8 (h, w, 4), exactly as images are written."""
+    return _mfr.encode_srgb(image)
+
+
+def decode_srgb(image) -> np.ndarray:
+    """sRGB uint8 (h, w, 3|4) -> linear float32 (h, w, 3)."""
+    return _mfr.decode_srgb(image)
+
+
+def engine_names() -> list:
+    """The engines render and compare accept ("cpu", "gl")."""
+    return _mfr.engine_names()
+
+
+def preset_names() -> list:
+    """The method presets (each bounded one also as NAME+occupancy)."""
+    return _mfr.preset_names()
+
+
+def builtin_model() -> Model:
+    """The model dkb uses without model= (models/dkb-default.mfrnn, compiled into the
+    library)."""
+    return _mfr.builtin_model()
+
+
+def _method(function, name, doc):
+    function.__name__ = name
+    function.__qualname__ = "Model." + name
+    function.__doc__ = (doc or "").split("\n\n", 1)[-1]  # less pybind11's signature line
+    return function
+
+
+# Model's methods with their real signatures too (the extension's own raise the same named errors)
+_model_predict, _model_save = Model.predict, Model.save
+_model_to_bytes, _model_check_dkb, _model_load = Model.to_bytes, Model.check_dkb, Model.load
+Model.predict = _method(lambda self, features: _model_predict(self, features), "predict",
+                        _model_predict.__doc__)
+Model.save = _method(lambda self, path: _model_save(self, path), "save", _model_save.__doc__)
+Model.to_bytes = _method(lambda self: _model_to_bytes(self), "to_bytes", _model_to_bytes.__doc__)
+Model.check_dkb = _method(lambda self: _model_check_dkb(self), "check_dkb",
+                          _model_check_dkb.__doc__)
+Model.load = staticmethod(_method(lambda path: _model_load(path), "load", _model_load.__doc__))
+_model_init = Model.__init__
+Model.__init__ = _method(lambda self, weights, biases, metadata:
+                         _model_init(self, weights, biases, metadata), "__init__",
+                         _model_init.__doc__)
+
 
 #: The methods `mfr compare` runs when --methods is not given.
 DEFAULT_COMPARE_METHODS = ("fkb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "dkb-fill", "optimal",
@@ -173,16 +265,17 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
     importance (float32 (h, w) for vkb*/dkb*, else None) and stats (dict, the keys of
     --stats-json but 'image'). Raises mfr.Error with the library's message for bad input.
     """
-    return _render(scene, method=method, budget=budget, k=k, width=width, height=height,
-                   camera=camera, view=view, orbit=orbit, orbit_view=orbit_view, zoom=zoom,
-                   composite=composite, capture=capture, threads=threads, seed=seed, model=model,
-                   occupancy_d=occupancy_d, importance=importance, alpha=alpha,
-                   background=background, transmission_floor=transmission_floor,
-                   shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
-                   blend=blend, engine=engine, gl_sync=gl_sync, gl_raster=gl_raster,
-                   memory_limit=memory_limit, allow_outside_references=allow_outside_references,
-                   depth_complexity=depth_complexity, max_peels=max_peels,
-                   samples=str(samples), sample_storage=sample_storage)
+    return _mfr.render(scene, method=method, budget=budget, k=k, width=width, height=height,
+                       camera=camera, view=view, orbit=orbit, orbit_view=orbit_view, zoom=zoom,
+                       composite=composite, capture=capture, threads=threads, seed=seed,
+                       model=model, occupancy_d=occupancy_d, importance=importance, alpha=alpha,
+                       background=background, transmission_floor=transmission_floor,
+                       shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
+                       blend=blend, engine=engine, gl_sync=gl_sync, gl_raster=gl_raster,
+                       memory_limit=memory_limit,
+                       allow_outside_references=allow_outside_references,
+                       depth_complexity=depth_complexity, max_peels=max_peels, samples=samples,
+                       sample_storage=sample_storage)
 
 
 def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_METHODS, width=1024,
@@ -214,13 +307,12 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
     report's error-vs-bytes-per-pixel figure per count). A method that fails at a budget is
     recorded with its error; bad input raises mfr.Error.
     """
-    if isinstance(budgets, (str, int)):
-        budgets = [budgets]
+    budgets = _as_list(budgets, (str, int))
     if isinstance(methods, str):
         methods = [m.strip() for m in methods.split(",")]
-    out = os.fspath(out)
-    call = [repr(scene.name if isinstance(scene, Scene) else scene), repr(out),
-            f"budgets={list(budgets)!r}", f"methods={list(methods)!r}",
+    methods = _as_list(methods, ())
+    call = [repr(scene.name if isinstance(scene, Scene) else _path_text(scene)),
+            repr(_path_text(out)), f"budgets={budgets!r}", f"methods={methods!r}",
             f"width={width!r}", f"height={height!r}"]
     for name, value, default in (("camera", camera, None), ("view", view, None),
                                  ("orbit", orbit, 0), ("orbit_view", orbit_view, None),
@@ -240,23 +332,23 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                                  ("samples", samples, 1), ("sample_storage", sample_storage,
                                                            "pixel"),
                                  ("sample_counts", sample_counts, None)):
-        if value != default:
+        if _differs(value, default):
             call.append(f"{name}={value!r}")
     if model is not None:
-        call.append(f"model={os.fspath(model)!r}" if not isinstance(model, Model) else
-                    "model=<mfr.Model>")
-    return _compare(scene, out, budgets=list(budgets), methods=list(methods), width=width,
-                    height=height, camera=camera, view=view, orbit=orbit, orbit_view=orbit_view,
-                    orbit_step=orbit_step, zoom=zoom, composite=composite, capture=capture,
-                    threads=threads, seed=seed, model=model, ppd=ppd, alpha=alpha,
-                    background=background, transmission_floor=transmission_floor,
-                    shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
-                    blend=blend, engine=engine, gl_sync=gl_sync, gl_raster=gl_raster,
-                    memory_limit=memory_limit, allow_outside_references=allow_outside_references,
-                    samples=str(samples), sample_storage=sample_storage,
-                    sample_counts="" if sample_counts is None else
-                    ",".join(str(c) for c in sample_counts),
-                    command_line="mfr.compare(" + ", ".join(call) + ")")
+        call.append("model=<mfr.Model>" if isinstance(model, Model) else
+                    f"model={_path_text(model)!r}")
+    return _mfr._compare(scene, out, budgets=budgets, methods=methods, width=width,
+                         height=height, camera=camera, view=view, orbit=orbit,
+                         orbit_view=orbit_view, orbit_step=orbit_step, zoom=zoom,
+                         composite=composite, capture=capture, threads=threads, seed=seed,
+                         model=model, ppd=ppd, alpha=alpha, background=background,
+                         transmission_floor=transmission_floor,
+                         shuffle_draw_order=shuffle_draw_order, gltf_scene=gltf_scene, cull=cull,
+                         blend=blend, engine=engine, gl_sync=gl_sync, gl_raster=gl_raster,
+                         memory_limit=memory_limit,
+                         allow_outside_references=allow_outside_references, samples=samples,
+                         sample_storage=sample_storage, sample_counts=sample_counts,
+                         command_line="mfr.compare(" + ", ".join(call) + ")")
 
 
 # --- the deep k-buffer's models ----------------------------------------------------------------
@@ -281,16 +373,33 @@ def make_model(weights: Sequence[Any], biases: Sequence[Any], metadata=None) -> 
     dict (FEATURE_SET and TARGET_SCALING are added as "features" and "target" when missing, so
     dkb accepts the model) or a str written verbatim (JSON text).
     """
-    weights = [np.asarray(w) for w in weights]
-    biases = [np.asarray(b) for b in biases]
+    with _as_function("make_model"):
+        return _make_model("make_model", weights, biases, metadata)
+
+
+def _sizes(weights) -> list:
+    """The layer sizes the weight arrays declare, for the default metadata ([] when they do not
+    have the shapes of a network: Model() then says what is wrong, naming the argument)."""
+    try:
+        shapes = [np.shape(w) for w in weights]
+        return [int(shapes[0][-1])] + [int(shape[0]) for shape in shapes]
+    except (TypeError, ValueError, IndexError):
+        return []
+
+
+def _make_model(function, weights, biases, metadata) -> Model:
+    weights, biases = _as_list(weights, ()), _as_list(biases, ())
     if metadata is None or isinstance(metadata, dict):
-        sizes = [int(weights[0].shape[-1])] + [int(w.shape[0]) for w in weights] if weights else []
-        meta = _default_metadata(sizes) if metadata is None else dict(metadata)
+        meta = _default_metadata(_sizes(weights)) if metadata is None else dict(metadata)
         meta.setdefault("features", FEATURE_SET)
         meta.setdefault("target", TARGET_SCALING)
-        metadata = json.dumps(meta, indent=2)
+        try:
+            metadata = json.dumps(meta, indent=2, allow_nan=False)
+        except (TypeError, ValueError) as e:
+            raise _argument_error(function, type(e), "metadata", f"not JSON: {e}") from None
     elif not isinstance(metadata, str):
-        raise TypeError("metadata: expected None, a dict or a JSON str")
+        raise _argument_error(function, TypeError, "metadata",
+                              f"expected None, a dict or a JSON str, got {type(metadata).__name__}")
     return Model(weights, biases, metadata)
 
 
@@ -298,8 +407,10 @@ def save_model(path, weights, biases=None, metadata=None) -> Model:
     """Writes a .mfrnn model (include/mfr/learn/model_file.hpp) that `mfr render -m dkb --model`
     and mfr.render(method="dkb", model=...) use unchanged. `weights` is a list of weight arrays
     (see make_model) with `biases`, or an mfr.Model. Returns the mfr.Model written."""
-    model = weights if isinstance(weights, Model) else make_model(weights, biases, metadata)
-    model.save(os.fspath(path))
+    with _as_function("save_model"):
+        model = (weights if isinstance(weights, Model) else
+                 _make_model("save_model", weights, biases, metadata))
+        model.save(path)
     return model
 
 
@@ -307,7 +418,8 @@ def load_model(path) -> Model:
     """Reads a .mfrnn model; model.weights / model.biases are read-only float32 arrays
     (np.array(w) copies them for training), model.metadata the JSON text. Raises mfr.Error
     naming the file for a missing, truncated or malformed file."""
-    return Model.load(os.fspath(path))
+    with _as_function("load_model"):
+        return Model.load(path)
 
 
 # --- datasets ----------------------------------------------------------------------------------
@@ -340,7 +452,7 @@ def load_dataset(path, *, check: bool = True) -> Dataset:
     """Reads a .mfrds dataset written by `mfr dataset` (or save_dataset). check: refuse, as
     `mfr train` does, a dataset whose metadata declares another feature set or target than this
     build's (mfr.Error). Raises mfr.Error naming the file for a missing or malformed file."""
-    d = _mfr._load_dataset(os.fspath(path), check)
+    d = _mfr._load_dataset(path, check)
     try:
         metadata = json.loads(d["metadata"]) if d["metadata"] else None
     except ValueError:
@@ -364,11 +476,15 @@ def save_dataset(path, features, targets=None, scenes: Iterable[str] = ("python"
         if metadata is None:  # as read: the same bytes are written back
             metadata = data.metadata_text if data.metadata_text else data.metadata
     elif targets is None:
-        raise TypeError("save_dataset: targets are required with a features array")
+        raise _argument_error("save_dataset", TypeError, "targets",
+                              "required with a features array")
     if metadata is None:
         metadata = {"features": FEATURE_SET, "target": TARGET_SCALING,
                     "written_by": f"mfr {__version__} (Python)"}
     if isinstance(metadata, dict):
-        metadata = json.dumps(metadata)
-    _mfr._save_dataset(os.fspath(path), np.asarray(features), np.asarray(targets), list(scenes),
-                       scene, view, budget_step, pixel, metadata)
+        try:
+            metadata = json.dumps(metadata, allow_nan=False)
+        except (TypeError, ValueError) as e:
+            raise _argument_error("save_dataset", type(e), "metadata", f"not JSON: {e}") from None
+    _mfr._save_dataset(path, features, targets, _as_list(scenes, ()), scene, view, budget_step,
+                       pixel, metadata)

@@ -28,9 +28,12 @@ std::string shapeText(const py::array& a) {
 
 /// Model from weights[l] (out x in) and biases[l] (out), checked so that an mfr.Model is always a
 /// valid network (the library would abort on mismatched shapes).
-std::shared_ptr<Model> makeModel(const std::vector<py::array>& weights,
-                                 const std::vector<py::array>& biases,
-                                 const std::string& metadata) {
+std::shared_ptr<Model> makeModel(const py::object& weightsArg, const py::object& biasesArg,
+                                 const py::object& metadataArg) {
+  const std::vector<py::object> weights =
+      listArgument(weightsArg, "weights", "a list of weight arrays");
+  const std::vector<py::object> biases = listArgument(biasesArg, "biases", "a list of bias arrays");
+  const std::string metadata = castArgument<std::string>(metadataArg, "metadata");
   if (weights.empty() || weights.size() > kMaxLayers)
     throw py::value_error("weights: expected 1 to 16 layers, got " +
                           std::to_string(weights.size()));
@@ -40,7 +43,9 @@ std::shared_ptr<Model> makeModel(const std::vector<py::array>& weights,
   auto model = std::make_shared<Model>();
   learn::Mlp& net = model->net;
   for (size_t l = 0; l < weights.size(); ++l) {
-    const FloatArray w(weights[l]), b(biases[l]);
+    const FloatArray w =
+        numberArrayArgument<float>(weights[l], "weights[" + std::to_string(l) + "]");
+    const FloatArray b = numberArrayArgument<float>(biases[l], "biases[" + std::to_string(l) + "]");
     const std::string layer = "layer " + std::to_string(l);
     if (w.ndim() != 2)
       throw py::value_error("weights[" + std::to_string(l) +
@@ -83,8 +88,8 @@ py::array vectorView(const Eigen::VectorXf& v, py::handle owner) {
   return a;
 }
 
-py::array predict(const Model& model, const py::array& featuresArg) {
-  const FloatArray features(featuresArg);
+py::array predict(const Model& model, const py::object& featuresArg) {
+  const FloatArray features = numberArrayArgument<float>(featuresArg, "features");
   const learn::Mlp& net = model.net;
   if (features.ndim() != 2 || features.shape(1) != net.inputs())
     throw py::value_error("features: expected shape (N, " + std::to_string(net.inputs()) +
@@ -157,6 +162,21 @@ py::dict loadDataset(const py::object& pathArg, bool check) {
 
 using UintArray = py::array_t<uint32_t, py::array::c_style | py::array::forcecast>;
 
+/// None, or a column of per-sample indices: integers in [0, 2^32 - 1] (numpy would wrap -1 to
+/// 4294967295 silently).
+py::object indexColumnArgument(const py::object& column, const char* name) {
+  if (column.is_none()) return column;
+  const py::array array = arrayArgument(column, name, "an array of integers");
+  const char kind = array.dtype().kind();
+  if (kind != 'i' && kind != 'u')
+    throw py::type_error(std::string(name) + ": expected an array of integers, got " +
+                         arrayContents(column, array));
+  if (array.size() > 0 &&
+      (array.attr("min")() < py::int_(0) || array.attr("max")() > py::int_(UINT32_MAX)))
+    throw overflow_error(std::string(name) + ": values must be in [0, 4294967295]");
+  return array;
+}
+
 void saveDataset(const py::object& pathArg, const py::array& featuresArg,
                  const py::array& targetsArg, const std::vector<std::string>& scenes,
                  const py::object& sceneArg, const py::object& viewArg,
@@ -223,18 +243,21 @@ void addLearn(py::module_& m) {
       m, "Model",
       "A multilayer perceptron as a .mfrnn file holds it: ReLU hidden layers, sigmoid output. "
       "weights[l] has shape (outputs, inputs) and biases[l] (outputs,): y = W x + b.")
-      .def(py::init(&makeModel), py::arg("weights"), py::arg("biases"), py::arg("metadata"),
+      .def(py::init(namedArguments("Model(): ", &makeModel)), py::arg("weights"), py::arg("biases"),
+           py::arg("metadata"),
            "From numpy arrays (any real dtype, stored as float32) and a JSON metadata text. "
            "Raises ValueError for inconsistent shapes or non-finite values.")
-      .def_static("load", &loadModel, py::arg("path"), "Reads a .mfrnn file (mfr.Error if bad).")
-      .def(
-          "save",
-          [](const Model& model, const py::object& pathArg) {
-            const std::string path = pathText(pathArg);
-            py::gil_scoped_release release;
-            unwrap(learn::writeModel(path, model));
-          },
-          py::arg("path"), "Writes the .mfrnn file (include/mfr/learn/model_file.hpp).")
+      .def_static("load", namedArguments("Model.load(): ", &loadModel), py::arg("path"),
+                  "Reads a .mfrnn file (mfr.Error if bad).")
+      .def("save",
+           namedArguments(
+               "Model.save(): ",
+               +[](const Model& model, const py::object& pathArg) {
+                 const std::string path = pathText(pathArg);
+                 py::gil_scoped_release release;
+                 unwrap(learn::writeModel(path, model));
+               }),
+           py::arg("path"), "Writes the .mfrnn file (include/mfr/learn/model_file.hpp).")
       .def(
           "to_bytes",
           [](const Model& model) {
@@ -242,7 +265,7 @@ void addLearn(py::module_& m) {
             return py::bytes(reinterpret_cast<const char*>(bytes.data()), bytes.size());
           },
           "The .mfrnn file's bytes.")
-      .def("predict", &predict, py::arg("features"),
+      .def("predict", namedArguments("Model.predict(): ", &predict), py::arg("features"),
            "The network's output for float (N, inputs) features: float32 (N, outputs), computed "
            "by the library (as dkb does).")
       .def(
@@ -290,10 +313,34 @@ void addLearn(py::module_& m) {
         return std::make_shared<Model>(*model);
       },
       "The model dkb uses without model= (models/dkb-default.mfrnn, compiled into the library).");
-  m.def("_load_dataset", &loadDataset, py::arg("path"), py::arg("check"));
-  m.def("_save_dataset", &saveDataset, py::arg("path"), py::arg("features"), py::arg("targets"),
-        py::arg("scenes"), py::arg("scene"), py::arg("view"), py::arg("budget_step"),
-        py::arg("pixel"), py::arg("metadata"));
+  // the arguments converted here, named, before the work
+  m.def("_load_dataset",
+        namedArguments(
+            "load_dataset(): ",
+            +[](const py::object& path, const py::object& check) {
+              return loadDataset(path, castArgument<bool>(check, "check"));
+            }),
+        py::arg("path"), py::arg("check"));
+  m.def("_save_dataset",
+        namedArguments(
+            "save_dataset(): ",
+            +[](const py::object& path, const py::object& features, const py::object& targets,
+                const py::object& scenes, const py::object& scene, const py::object& view,
+                const py::object& budgetStep, const py::object& pixel, const py::object& metadata) {
+              std::vector<std::string> names;
+              for (const py::object& name : listArgument(scenes, "scenes", "a list of str"))
+                names.push_back(castArgument<std::string>(
+                    name, "scenes[" + std::to_string(names.size()) + "]"));
+              saveDataset(path, numberArrayArgument<float>(features, "features"),
+                          numberArrayArgument<float>(targets, "targets"), names,
+                          indexColumnArgument(scene, "scene"), indexColumnArgument(view, "view"),
+                          indexColumnArgument(budgetStep, "budget_step"),
+                          indexColumnArgument(pixel, "pixel"),
+                          castArgument<std::string>(metadata, "metadata"));
+            }),
+        py::arg("path"), py::arg("features"), py::arg("targets"), py::arg("scenes"),
+        py::arg("scene"), py::arg("view"), py::arg("budget_step"), py::arg("pixel"),
+        py::arg("metadata"));
 }
 
 }  // namespace mfr::python

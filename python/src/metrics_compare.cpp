@@ -20,12 +20,15 @@ namespace {
 
 /// A path (str or os.PathLike) read as PNG, or an image array (image8Argument).
 Image8 imageOrPath(const py::object& image, const char* what) {
-  if (py::isinstance<py::str>(image) || py::hasattr(image, "__fspath__")) {
+  if (isPath(image)) {
     const std::string path = pathText(image, what);
     py::gil_scoped_release release;
     return unwrap(readPng(path));
   }
-  return image8Argument(py::array::ensure(image), what);
+  if (!py::isinstance<py::array>(image) && !py::isinstance<py::sequence>(image))
+    throw py::type_error(std::string(what) + ": expected a PNG path or an image array, got " +
+                         typeName(image));
+  return image8Argument(image, what);
 }
 
 double pixelsPerDegree(double ppd) {
@@ -33,10 +36,11 @@ double pixelsPerDegree(double ppd) {
   return ppd;
 }
 
-py::dict metrics(const py::object& referenceArg, const py::object& testArg, double ppd) {
+py::dict metrics(const py::object& referenceArg, const py::object& testArg,
+                 const py::object& ppdArg) {
+  const double ppd = pixelsPerDegree(castArgument<double>(ppdArg, "ppd"));
   const Image8 reference = imageOrPath(referenceArg, "reference");
   const Image8 test = imageOrPath(testArg, "test");
-  pixelsPerDegree(ppd);
   if (reference.width != test.width || reference.height != test.height)
     throw LibraryError("reference is " + std::to_string(reference.width) + "x" +
                        std::to_string(reference.height) + " but test is " +
@@ -74,24 +78,62 @@ py::dict metrics(const py::object& referenceArg, const py::object& testArg, doub
   return d;
 }
 
-py::object compare(const py::object& sceneArg, const std::string& out,
-                   const std::vector<py::object>& budgets, const std::vector<std::string>& methods,
-                   int width, int height, const py::object& camera, const py::object& view,
-                   int orbit, const py::object& orbitView, double orbitStep, double zoom,
-                   const py::object& composite, const std::string& capture, int threads,
-                   uint64_t seed, const py::object& model, double ppd, const py::object& alpha,
-                   const py::object& background, double transmissionFloor,
-                   const py::object& shuffleDrawOrder, const py::object& gltfScene,
-                   const py::object& cull, const py::object& blend, const std::string& engineName,
-                   const std::string& glSync, const std::string& glRaster,
-                   const py::object& memoryLimitArg, bool allowOutsideReferences,
-                   const std::string& samplesArg, const std::string& sampleStorage,
-                   const std::string& sampleCountsArg, const std::string& commandLine) {
+py::object compare(const py::object& sceneArg, const py::object& outArg, const py::object& budgets,
+                   const py::object& methods, const py::object& widthArg,
+                   const py::object& heightArg, const py::object& camera, const py::object& view,
+                   const py::object& orbitArg, const py::object& orbitView,
+                   const py::object& orbitStepArg, const py::object& zoomArg,
+                   const py::object& composite, const py::object& captureArg,
+                   const py::object& threadsArg, const py::object& seedArg, const py::object& model,
+                   const py::object& ppdArg, const py::object& alpha, const py::object& background,
+                   const py::object& transmissionFloorArg, const py::object& shuffleDrawOrder,
+                   const py::object& gltfScene, const py::object& cull, const py::object& blend,
+                   const py::object& engineArg, const py::object& glSyncArg,
+                   const py::object& glRasterArg, const py::object& memoryLimitArg,
+                   const py::object& allowOutsideReferencesArg, const py::object& samplesArg,
+                   const py::object& sampleStorageArg, const py::object& sampleCountsArg,
+                   const py::object& commandLineArg) {
+  // every argument converted (and its type checked) before any work
+  const std::string out = pathText(outArg, "out");
+  const int width = castArgument<int>(widthArg, "width");
+  const int height = castArgument<int>(heightArg, "height");
+  const int orbit = castArgument<int>(orbitArg, "orbit");
+  const double orbitStep = castArgument<double>(orbitStepArg, "orbit_step");
+  const double zoom = castArgument<double>(zoomArg, "zoom");
+  const auto capture = castArgument<std::string>(captureArg, "capture");
+  const int threads = castArgument<int>(threadsArg, "threads");
+  const auto seed = castArgument<uint64_t>(seedArg, "seed");
+  const double ppd = castArgument<double>(ppdArg, "ppd");
+  const double transmissionFloor = castArgument<double>(transmissionFloorArg, "transmission_floor");
+  const auto engineName = castArgument<std::string>(engineArg, "engine");
+  const auto glSync = castArgument<std::string>(glSyncArg, "gl_sync");
+  const auto glRaster = castArgument<std::string>(glRasterArg, "gl_raster");
+  const bool allowOutsideReferences =
+      castArgument<bool>(allowOutsideReferencesArg, "allow_outside_references");
+  const auto sampleStorage = castArgument<std::string>(sampleStorageArg, "sample_storage");
+  const auto commandLine = castArgument<std::string>(commandLineArg, "command_line");
+  if (!py::isinstance<Scene>(sceneArg) && !isPath(sceneArg))
+    throw py::type_error(
+        "scene: expected an mfr.Scene or a source (str, bytes or os.PathLike), "
+        "got " +
+        typeName(sceneArg));
+  if (!model.is_none() && !py::isinstance<learn::Model>(model) && !isPath(model))
+    throw py::type_error(
+        "model: expected an mfr.Model or a .mfrnn path (str, bytes or "
+        "os.PathLike), got " +
+        typeName(model));
+  std::vector<py::object> budgetList;
+  if (PyUnicode_Check(budgets.ptr()) || PyIndex_Check(budgets.ptr()))
+    budgetList.push_back(budgets);  // one budget
+  else
+    budgetList = listArgument(budgets, "budgets", "a budget or a list of budgets");
+  std::vector<std::string> methodNames;
+  for (const py::object& item : listArgument(methods, "methods", "a list of str"))
+    methodNames.push_back(
+        castArgument<std::string>(item, "methods[" + std::to_string(methodNames.size()) + "]"));
   if (out.empty()) throw LibraryError("out: an output folder is required");
-  const int samples = unwrap(parseSamples(samplesArg, "samples"));
-  std::vector<int> sampleCounts;
-  if (!sampleCountsArg.empty())
-    sampleCounts = unwrap(parseSampleCounts(sampleCountsArg, "sample_counts"));
+  const int samples = samplesArgument(samplesArg);
+  const std::vector<int> sampleCounts = sampleCountsArgument(sampleCountsArg);
   const bool temporal = orbit != 0 && orbitView.is_none();  // every view of the orbit
   if (temporal && orbit < 2)
     throw LibraryError("orbit " + std::to_string(orbit) +
@@ -105,7 +147,7 @@ py::object compare(const py::object& sceneArg, const std::string& out,
   CompareOptions options;
   options.seed = seed;
   options.flipPixelsPerDegree = pixelsPerDegree(ppd);
-  for (const std::string& name : methods) {
+  for (const std::string& name : methodNames) {
     if (name.empty()) throw LibraryError("methods: empty method name in the list");
     unwrap(methodPreset(name));
     for (const std::string& seen : options.methods)
@@ -124,11 +166,12 @@ py::object compare(const py::object& sceneArg, const std::string& out,
       options.model = unwrap(loadMethodModel(modelName));
     }
   }
-  for (const py::object& budget : budgets) {
+  for (const py::object& budget : budgetList) {
     // a size ("20MB", bytes) or a share of the A-buffer's node bytes ("25%")
-    const BudgetSpec spec = py::isinstance<py::str>(budget)
-                                ? unwrap(parseBudgetSpec(budget.cast<std::string>()))
-                                : BudgetSpec(budgetArgument(budget));
+    const std::string name = "budgets[" + std::to_string(options.budgets.size()) + "]";
+    const BudgetSpec spec = PyUnicode_Check(budget.ptr())
+                                ? unwrap(parseBudgetSpec(castArgument<std::string>(budget, name)))
+                                : BudgetSpec(budgetArgument(budget, name));
     for (const BudgetSpec& seen : options.budgets)
       if (seen == spec) throw LibraryError("budgets: " + spec.label + " listed twice");
     options.budgets.push_back(spec);
@@ -213,23 +256,24 @@ py::object compare(const py::object& sceneArg, const std::string& out,
 
 void addMetricsAndCompare(py::module_& m) {
   m.attr("FLIP_DEFAULT_PPD") = kFlipDefaultPixelsPerDegree;
-  m.def("metrics", &metrics, py::arg("reference"), py::arg("test"),
+  m.def("metrics", namedArguments("metrics(): ", &metrics), py::arg("reference"), py::arg("test"),
         py::arg("ppd") = kFlipDefaultPixelsPerDegree,
         R"(Error of `test` against `reference`, as `mfr metrics --json` computes it: each a PNG path
 or an array (uint8 (h, w, 3|4) sRGB, or float (h, w, 3) linear, sRGB-encoded first). Returns a
 dict: width, height, mse_linear, mse_srgb, psnr_linear, psnr_srgb (inf when identical), mse and psnr
 (the linear ones), flip_mean, flip_median, flip_p95, flip_p99, flip_max, pixels_per_degree, and
 flip_map (LDR-FLIP per pixel, float32 (h, w) in [0, 1]).)");
-  m.def("_compare", &compare, py::arg("scene"), py::arg("out"), py::kw_only(), py::arg("budgets"),
-        py::arg("methods"), py::arg("width"), py::arg("height"), py::arg("camera"), py::arg("view"),
-        py::arg("orbit"), py::arg("orbit_view"), py::arg("orbit_step"), py::arg("zoom"),
-        py::arg("composite"), py::arg("capture"), py::arg("threads"), py::arg("seed"),
-        py::arg("model"), py::arg("ppd"), py::arg("alpha"), py::arg("background"),
-        py::arg("transmission_floor"), py::arg("shuffle_draw_order"), py::arg("gltf_scene"),
-        py::arg("cull"), py::arg("blend"), py::arg("engine"), py::arg("gl_sync"),
-        py::arg("gl_raster"), py::arg("memory_limit"), py::arg("allow_outside_references"),
-        py::arg("samples"), py::arg("sample_storage"), py::arg("sample_counts"),
-        py::arg("command_line"), "mfr.compare's work (see python/mfr/__init__.py).");
+  m.def("_compare", namedArguments("compare(): ", &compare), py::arg("scene"), py::arg("out"),
+        py::kw_only(), py::arg("budgets"), py::arg("methods"), py::arg("width"), py::arg("height"),
+        py::arg("camera"), py::arg("view"), py::arg("orbit"), py::arg("orbit_view"),
+        py::arg("orbit_step"), py::arg("zoom"), py::arg("composite"), py::arg("capture"),
+        py::arg("threads"), py::arg("seed"), py::arg("model"), py::arg("ppd"), py::arg("alpha"),
+        py::arg("background"), py::arg("transmission_floor"), py::arg("shuffle_draw_order"),
+        py::arg("gltf_scene"), py::arg("cull"), py::arg("blend"), py::arg("engine"),
+        py::arg("gl_sync"), py::arg("gl_raster"), py::arg("memory_limit"),
+        py::arg("allow_outside_references"), py::arg("samples"), py::arg("sample_storage"),
+        py::arg("sample_counts"), py::arg("command_line"),
+        "mfr.compare's work (see python/mfr/__init__.py).");
 }
 
 }  // namespace mfr::python

@@ -31,7 +31,10 @@
 namespace mfr::python {
 
 py::object toPython(const nlohmann::json& value) {
-  return py::module_::import("json").attr("loads")(value.dump());
+  // a scene or model path need not be UTF-8: such bytes become U+FFFD here (the "scene" of the
+  // statistics is set from the path's bytes again, as os.fsdecode gives it)
+  return py::module_::import("json").attr("loads")(
+      value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
 }
 
 namespace {
@@ -76,6 +79,11 @@ MethodDesc buildMethod(const std::string& name, const py::object& k, const py::o
   if (!model.is_none()) {
     if (py::isinstance<learn::Model>(model))
       o.model = model.cast<std::shared_ptr<learn::Model>>();
+    else if (!isPath(model))
+      throw py::type_error(
+          "model: expected an mfr.Model or a .mfrnn path (str, bytes or "
+          "os.PathLike), got " +
+          typeName(model));
     else if ((o.modelPath = pathText(model, "model")).empty())
       throw LibraryError("model: empty path");
   }
@@ -113,17 +121,41 @@ PyRenderResult renderResult(RenderOutput&& out, nlohmann::json stats, int width,
 }
 
 py::object renderScene(
-    const py::object& sceneArg, const std::string& method, const py::object& budget,
-    const py::object& k, int width, int height, const py::object& camera, const py::object& view,
-    int orbit, const py::object& orbitView, double zoom, const py::object& composite,
-    const std::string& capture, int threads, uint64_t seed, const py::object& model,
-    const py::object& occupancyD, const py::object& importance, const py::object& alpha,
-    const py::object& background, double transmissionFloor, const py::object& shuffleDrawOrder,
-    const py::object& gltfScene, const py::object& cull, const py::object& blend,
-    const std::string& engineName, const std::string& glSync, const std::string& glRaster,
-    const py::object& memoryLimitArg, bool allowOutsideReferences, bool wantDepthComplexity,
-    const py::object& maxPeels, const std::string& samplesArg, const std::string& sampleStorage) {
-  const int samples = unwrap(parseSamples(samplesArg, "samples"));
+    const py::object& sceneArg, const py::object& methodArg, const py::object& budget,
+    const py::object& k, const py::object& widthArg, const py::object& heightArg,
+    const py::object& camera, const py::object& view, const py::object& orbitArg,
+    const py::object& orbitView, const py::object& zoomArg, const py::object& composite,
+    const py::object& captureArg, const py::object& threadsArg, const py::object& seedArg,
+    const py::object& model, const py::object& occupancyD, const py::object& importance,
+    const py::object& alpha, const py::object& background, const py::object& transmissionFloorArg,
+    const py::object& shuffleDrawOrder, const py::object& gltfScene, const py::object& cull,
+    const py::object& blend, const py::object& engineArg, const py::object& glSyncArg,
+    const py::object& glRasterArg, const py::object& memoryLimitArg,
+    const py::object& allowOutsideReferencesArg, const py::object& wantDepthComplexityArg,
+    const py::object& maxPeels, const py::object& samplesArg, const py::object& sampleStorageArg) {
+  // every argument converted (and its type checked) before any work
+  const auto method = castArgument<std::string>(methodArg, "method");
+  const int width = castArgument<int>(widthArg, "width");
+  const int height = castArgument<int>(heightArg, "height");
+  const int orbit = castArgument<int>(orbitArg, "orbit");
+  const double zoom = castArgument<double>(zoomArg, "zoom");
+  const auto capture = castArgument<std::string>(captureArg, "capture");
+  const int threads = castArgument<int>(threadsArg, "threads");
+  const auto seed = castArgument<uint64_t>(seedArg, "seed");
+  const double transmissionFloor = castArgument<double>(transmissionFloorArg, "transmission_floor");
+  const auto engineName = castArgument<std::string>(engineArg, "engine");
+  const auto glSync = castArgument<std::string>(glSyncArg, "gl_sync");
+  const auto glRaster = castArgument<std::string>(glRasterArg, "gl_raster");
+  const bool allowOutsideReferences =
+      castArgument<bool>(allowOutsideReferencesArg, "allow_outside_references");
+  const bool wantDepthComplexity = castArgument<bool>(wantDepthComplexityArg, "depth_complexity");
+  const auto sampleStorage = castArgument<std::string>(sampleStorageArg, "sample_storage");
+  if (!py::isinstance<Scene>(sceneArg) && !isPath(sceneArg))
+    throw py::type_error(
+        "scene: expected an mfr.Scene or a source (str, bytes or os.PathLike), "
+        "got " +
+        typeName(sceneArg));
+  const int samples = samplesArgument(samplesArg);
   const std::optional<uint64_t> memoryLimit = memoryLimitArgument(memoryLimitArg);
   const SceneRequest request =
       sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
@@ -188,12 +220,14 @@ py::object renderScene(
                        }));
   }
   // one view: its result; an orbit of N views: a list of N results
-  if (rendered.size() == 1 && (orbit == 0 || !orbitView.is_none()))
-    return py::cast(
-        renderResult(std::move(rendered[0].output), std::move(rendered[0].stats), width, height));
+  const auto result = [&](Rendered& r) {
+    PyRenderResult out = renderResult(std::move(r.output), std::move(r.stats), width, height);
+    out.stats["scene"] = pathString(scene.source);
+    return py::cast(std::move(out));
+  };
+  if (rendered.size() == 1 && (orbit == 0 || !orbitView.is_none())) return result(rendered[0]);
   py::list results;
-  for (Rendered& r : rendered)
-    results.append(py::cast(renderResult(std::move(r.output), std::move(r.stats), width, height)));
+  for (Rendered& r : rendered) results.append(result(r));
   return results;
 }
 
@@ -210,20 +244,20 @@ py::array readPngArray(const py::object& pathArg) {
   return ownedArray<uint8_t>(std::move(image.rgba), {h, w, 4});
 }
 
-void writePngArray(const py::object& pathArg, const py::array& image) {
+void writePngArray(const py::object& pathArg, const py::object& image) {
   const std::string path = pathText(pathArg);
   const Image8 encoded = image8Argument(image, "image");
   py::gil_scoped_release release;
   unwrap(writePng(path, encoded));
 }
 
-py::array encodeSrgbArray(const py::array& linear) {
+py::array encodeSrgbArray(const py::object& linear) {
   Image8 encoded = image8Argument(linear, "image");
   const py::ssize_t h = encoded.height, w = encoded.width;
   return ownedArray<uint8_t>(std::move(encoded.rgba), {h, w, 4});
 }
 
-py::array decodeSrgbArray(const py::array& srgb) {
+py::array decodeSrgbArray(const py::object& srgb) {
   ImageRGB linear = decodeSrgb(image8Argument(srgb, "image"));
   const py::ssize_t h = linear.height, w = linear.width;
   return ownedArray<float>(std::move(linear.pixels), {h, w, 3});
@@ -235,7 +269,9 @@ void addSceneAndRender(py::module_& m) {
   py::class_<Scene, std::shared_ptr<Scene>>(m, "Scene",
                                             "A loaded scene (mfr.load_scene): one flat triangle "
                                             "soup in world space with materials and cameras.")
-      .def_readonly("name", &Scene::name, "The file path or procedural spec it was loaded from.")
+      .def_property_readonly(
+          "name", [](const Scene& s) { return pathString(s.name); },
+          "The file path or procedural spec it was loaded from (os.fsdecode of its bytes).")
       .def_readonly("primitives_skipped", &Scene::primitivesSkipped,
                     "The file's primitives that are not surfaces (glTF points, lines): not "
                     "rendered.")
@@ -265,15 +301,25 @@ void addSceneAndRender(py::module_& m) {
                              })
       .def_property(
           "background", [](const Scene& s) { return vec3Tuple(s.background); },
-          [](Scene& s, const py::object& v) { s.background = backgroundArgument(v); },
+          namedArguments(
+              "Scene.",
+              +[](Scene& s, const py::object& v) { s.background = backgroundArgument(v); }),
           "Linear RGB behind everything, components in [0, 1].")
       .def_property(
           "alpha_override", [](const Scene& s) { return s.alphaOverride; },
-          [](Scene& s, const py::object& v) { s.alphaOverride = alphaArgument(v); },
+          namedArguments(
+              "Scene.",
+              +[](Scene& s, const py::object& v) {
+                s.alphaOverride = alphaArgument(v, "alpha_override");
+              }),
           "When set (0..1), every material is blended with this alpha; None: the file's.")
       .def_property(
           "cull", [](const Scene& s) { return std::string(toString(s.cull)); },
-          [](Scene& s, const std::string& v) { s.cull = unwrap(parseCullMode(v, "cull")); },
+          namedArguments(
+              "Scene.",
+              +[](Scene& s, const py::object& v) {
+                s.cull = unwrap(parseCullMode(castArgument<std::string>(v, "cull"), "cull"));
+              }),
           "Back faces culled: 'auto' (as the file says: glTF materials with doubleSided false), "
           "'none' or 'back' (every back face), as `mfr --cull`.")
       .def_property_readonly(
@@ -293,20 +339,24 @@ void addSceneAndRender(py::module_& m) {
           },
           "Vertex indices of the triangles, uint32 (T, 3), read-only view.")
       .def("__repr__", [](const Scene& s) {
-        return "<mfr.Scene '" + s.name + "': " + std::to_string(s.triangleCount()) +
-               " triangles, " + std::to_string(s.materials.size()) + " materials, " +
-               std::to_string(s.cameras.size()) + " cameras>";
+        return py::str("<mfr.Scene {!r}: {} triangles, {} materials, {} cameras>")
+            .format(pathString(s.name), s.triangleCount(), s.materials.size(), s.cameras.size());
       });
 
   m.def(
       "load_scene",
-      [](const py::object& source, uint64_t seed, double transmissionFloor, const py::object& alpha,
-         const py::object& background, const py::object& memoryLimit, bool allowOutsideReferences,
-         const py::object& gltfScene) {
-        return loadSceneArgument(pathText(source, "source"), seed, transmissionFloor, alpha,
-                                 background, memoryLimitArgument(memoryLimit),
-                                 allowOutsideReferences, gltfScene);
-      },
+      namedArguments(
+          "load_scene(): ",
+          +[](const py::object& source, const py::object& seed, const py::object& transmissionFloor,
+              const py::object& alpha, const py::object& background, const py::object& memoryLimit,
+              const py::object& allowOutsideReferences, const py::object& gltfScene) {
+            const std::string path = pathText(source, "source");
+            return loadSceneArgument(
+                path, castArgument<uint64_t>(seed, "seed"),
+                castArgument<double>(transmissionFloor, "transmission_floor"), alpha, background,
+                memoryLimitArgument(memoryLimit),
+                castArgument<bool>(allowOutsideReferences, "allow_outside_references"), gltfScene);
+          }),
       py::arg("source"), py::kw_only(), py::arg("seed") = 1, py::arg("transmission_floor") = 0.1,
       py::arg("alpha") = py::none(), py::arg("background") = py::none(),
       py::arg("memory_limit") = py::none(), py::arg("allow_outside_references") = false,
@@ -342,20 +392,21 @@ lines are not rendered: Scene.primitives_skipped counts them.)");
                py::str(r.image.attr("shape")).cast<std::string>() + ">";
       });
 
-  m.def("render", &renderScene, py::arg("scene"), py::kw_only(), py::arg("method") = "abuffer",
-        py::arg("budget") = py::none(), py::arg("k") = py::none(), py::arg("width") = 1024,
-        py::arg("height") = 1024, py::arg("camera") = py::none(), py::arg("view") = py::none(),
-        py::arg("orbit") = 0, py::arg("orbit_view") = py::none(), py::arg("zoom") = 1.0,
-        py::arg("composite") = py::none(), py::arg("capture") = "tile", py::arg("threads") = 0,
-        py::arg("seed") = 1, py::arg("model") = py::none(), py::arg("occupancy_d") = py::none(),
-        py::arg("importance") = py::none(), py::arg("alpha") = py::none(),
-        py::arg("background") = py::none(), py::arg("transmission_floor") = 0.1,
-        py::arg("shuffle_draw_order") = py::none(), py::arg("gltf_scene") = py::none(),
-        py::arg("cull") = py::none(), py::arg("blend") = py::none(), py::arg("engine") = "cpu",
-        py::arg("gl_sync") = "auto", py::arg("gl_raster") = "native",
-        py::arg("memory_limit") = py::none(), py::arg("allow_outside_references") = false,
-        py::arg("depth_complexity") = true, py::arg("max_peels") = py::none(),
-        py::arg("samples") = "1", py::arg("sample_storage") = "pixel",
+  m.def("render", namedArguments("render(): ", &renderScene), py::arg("scene"), py::kw_only(),
+        py::arg("method") = "abuffer", py::arg("budget") = py::none(), py::arg("k") = py::none(),
+        py::arg("width") = 1024, py::arg("height") = 1024, py::arg("camera") = py::none(),
+        py::arg("view") = py::none(), py::arg("orbit") = 0, py::arg("orbit_view") = py::none(),
+        py::arg("zoom") = 1.0, py::arg("composite") = py::none(), py::arg("capture") = "tile",
+        py::arg("threads") = 0, py::arg("seed") = 1, py::arg("model") = py::none(),
+        py::arg("occupancy_d") = py::none(), py::arg("importance") = py::none(),
+        py::arg("alpha") = py::none(), py::arg("background") = py::none(),
+        py::arg("transmission_floor") = 0.1, py::arg("shuffle_draw_order") = py::none(),
+        py::arg("gltf_scene") = py::none(), py::arg("cull") = py::none(),
+        py::arg("blend") = py::none(), py::arg("engine") = "cpu", py::arg("gl_sync") = "auto",
+        py::arg("gl_raster") = "native", py::arg("memory_limit") = py::none(),
+        py::arg("allow_outside_references") = false, py::arg("depth_complexity") = true,
+        py::arg("max_peels") = py::none(), py::arg("samples") = 1,
+        py::arg("sample_storage") = "pixel",
         R"(Renders a scene (an mfr.Scene, or a source string loaded with `seed`) with one method, as
 `mfr render` does with the same options, and returns an mfr.RenderResult (a list of them for an
 orbit of several views). See mfr.render's Python documentation (python/mfr/__init__.py) for the
@@ -364,18 +415,23 @@ arguments.)");
   m.def("engine_names", &engineNames, "The engines render and compare accept (\"cpu\", \"gl\").");
   m.def("preset_names", &presetNames,
         "The method presets (each bounded one also as NAME+occupancy).");
-  m.def(
-      "parse_bytes", [](const std::string& text) { return unwrap(parseByteSize(text)); },
-      py::arg("text"), "\"20MB\" -> 20971520 (binary units, as the command line's --budget).");
+  m.def("parse_bytes",
+        namedArguments(
+            "parse_bytes(): ",
+            +[](const py::object& text) {
+              return unwrap(parseByteSize(castArgument<std::string>(text, "text")));
+            }),
+        py::arg("text"), "\"20MB\" -> 20971520 (binary units, as the command line's --budget).");
 
-  m.def("read_png", &readPngArray, py::arg("path"),
+  m.def("read_png", namedArguments("read_png(): ", &readPngArray), py::arg("path"),
         "Reads a PNG as uint8 (height, width, 4) RGBA (sRGB colour).");
-  m.def("write_png", &writePngArray, py::arg("path"), py::arg("image"),
+  m.def("write_png", namedArguments("write_png(): ", &writePngArray), py::arg("path"),
+        py::arg("image"),
         "Writes uint8 (h, w, 3|4) sRGB, or float (h, w, 3) linear RGB (sRGB-encoded as mfr "
         "render does), as a PNG.");
-  m.def("encode_srgb", &encodeSrgbArray, py::arg("image"),
+  m.def("encode_srgb", namedArguments("encode_srgb(): ", &encodeSrgbArray), py::arg("image"),
         "Linear float (h, w, 3) -> sRGB uint8 (h, w, 4), exactly as images are written.");
-  m.def("decode_srgb", &decodeSrgbArray, py::arg("image"),
+  m.def("decode_srgb", namedArguments("decode_srgb(): ", &decodeSrgbArray), py::arg("image"),
         "sRGB uint8 (h, w, 3|4) -> linear float32 (h, w, 3).");
 }
 
@@ -386,7 +442,19 @@ PYBIND11_MODULE(_mfr, m) {
   using namespace mfr::python;
   m.doc() = "mfr: bounded-memory multi-fragment rendering (the C++ library's Python binding)";
   m.attr("__version__") = MFR_VERSION;
-  py::register_exception<LibraryError>(m, "Error", PyExc_RuntimeError);
+  // mfr.Error: the library's message, which may echo a path's bytes that are not UTF-8 (shown as
+  // \xNN escapes rather than failing to make the message)
+  static py::exception<LibraryError> error(m, "Error", PyExc_RuntimeError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const LibraryError& e) {
+      const std::string_view text = e.what();
+      const auto message = py::reinterpret_steal<py::object>(PyUnicode_DecodeUTF8(
+          text.data(), static_cast<Py_ssize_t>(text.size()), "backslashreplace"));
+      PyErr_SetObject(error.ptr(), message.ptr());
+    }
+  });
 #ifdef MFR_HAS_GL
   mfr::gl::registerGlEngine();  // engine="gl"
 #endif

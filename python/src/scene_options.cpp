@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "mfr/core/quote.hpp"
+#include "mfr/core/samples.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/method/budget_spec.hpp"
@@ -14,27 +15,21 @@
 namespace mfr::python {
 namespace {
 
+/// A sequence of finite numbers (castArgument<double> names the item: "background[1]").
 std::vector<double> numbers(const py::object& value, const char* what) {
-  if (py::isinstance<py::str>(value)) throw LibraryError(std::string(what) + ": expected numbers");
-  if (!py::isinstance<py::iterable>(value))
-    throw py::type_error(std::string(what) + ": expected a sequence of numbers, got " +
-                         std::string(py::str(value.get_type().attr("__name__"))));
   std::vector<double> v;
-  for (const py::handle item : value)
+  for (const py::object& item : listArgument(value, what, "a sequence of numbers"))
     v.push_back(
         castArgument<double>(item, std::string(what) + "[" + std::to_string(v.size()) + "]"));
-  for (double x : v)
-    if (!std::isfinite(x))
-      throw LibraryError(std::string(what) + ": values must be finite numbers");
   return v;
 }
 
 }  // namespace
 
-std::optional<float> alphaArgument(const py::object& alpha) {
+std::optional<float> alphaArgument(const py::object& alpha, const char* name) {
   if (alpha.is_none()) return std::nullopt;
-  const double a = castArgument<double>(alpha, "alpha");
-  if (!(a >= 0.0 && a <= 1.0)) throw LibraryError("alpha: must be in [0, 1]");
+  const double a = castArgument<double>(alpha, name);
+  if (!(a >= 0.0 && a <= 1.0)) throw LibraryError(std::string(name) + ": must be in [0, 1]");
   return static_cast<float>(a);
 }
 
@@ -79,8 +74,11 @@ std::shared_ptr<Scene> loadSceneArgument(const std::string& source, uint64_t see
 SceneArgument sceneArgument(const py::object& scene, uint64_t seed, const SceneRequest& request,
                             std::optional<uint64_t> memoryLimit, bool allowOutsideReferences) {
   if (!py::isinstance<Scene>(scene)) {
-    if (!py::isinstance<py::str>(scene) && !py::hasattr(scene, "__fspath__"))
-      throw py::type_error("scene: expected an mfr.Scene or a source (str or os.PathLike)");
+    if (!isPath(scene))
+      throw py::type_error(
+          "scene: expected an mfr.Scene or a source (str, bytes or "
+          "os.PathLike), got " +
+          typeName(scene));
     const std::string source = pathText(scene, "scene");
     LoadOptions load;
     load.seed = seed;
@@ -122,13 +120,10 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
   r.height = height;
   if (!camera.is_none()) {
     if (py::isinstance<py::str>(camera)) {  // the command line's text, "EX,EY,EZ,TX,TY,TZ,..."
-      r.camera = camera.cast<std::string>();
+      r.camera = castArgument<std::string>(camera, "camera");
       if (r.camera.empty()) throw LibraryError("camera: empty");
     } else {
-      if (!py::isinstance<py::iterable>(camera))
-        throw py::type_error("camera: expected 6, 9 or 10 numbers or a str, got " +
-                             std::string(py::str(camera.get_type().attr("__name__"))));
-      for (const py::handle item : camera)
+      for (const py::object& item : listArgument(camera, "camera", "6, 9 or 10 numbers or a str"))
         r.cameraNumbers.push_back(
             castArgument<double>(item, "camera[" + std::to_string(r.cameraNumbers.size()) + "]"));
       if (r.cameraNumbers.empty()) throw LibraryError("camera: expected 6, 9 or 10 numbers");
@@ -155,12 +150,9 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
     r.shuffleDrawOrder = castArgument<uint64_t>(shuffleDrawOrder, "shuffle_draw_order");
   if (!cull.is_none()) r.cull = castArgument<std::string>(cull, "cull");
   if (py::isinstance<py::str>(blend)) {  // "MODE" or "MATERIAL=MODE", or a list of them
-    r.blend.push_back(blend.cast<std::string>());
+    r.blend.push_back(castArgument<std::string>(blend, "blend"));
   } else if (!blend.is_none()) {
-    if (!py::isinstance<py::iterable>(blend))
-      throw py::type_error("blend: expected a str or a list of str, got " +
-                           std::string(py::str(blend.get_type().attr("__name__"))));
-    for (const py::handle item : blend)
+    for (const py::object& item : listArgument(blend, "blend", "a str or a list of str"))
       r.blend.push_back(
           castArgument<std::string>(item, "blend[" + std::to_string(r.blend.size()) + "]"));
   }
@@ -168,33 +160,63 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
   return r;
 }
 
-BudgetSpec budgetSpecArgument(const py::object& budget) {
-  if (py::isinstance<py::str>(budget)) {
-    auto spec = parseBudgetSpec(budget.cast<std::string>());
-    if (!spec) throw LibraryError("budget: " + spec.error().message);
+BudgetSpec budgetSpecArgument(const py::object& budget, const std::string& name) {
+  if (PyUnicode_Check(budget.ptr())) {
+    auto spec = parseBudgetSpec(castArgument<std::string>(budget, name));
+    if (!spec) throw LibraryError(name + ": " + spec.error().message);
     return spec.value();
   }
-  return BudgetSpec(budgetArgument(budget));
+  return BudgetSpec(budgetArgument(budget, name));
 }
 
-uint64_t budgetArgument(const py::object& budget) {
-  if (py::isinstance<py::str>(budget)) return unwrap(parseByteSize(budget.cast<std::string>()));
-  if (py::isinstance<py::bool_>(budget) || !py::isinstance<py::int_>(budget))
-    throw LibraryError("budget: expected bytes (an int) or a size such as \"20MB\"");
-  const long long bytes = budget.cast<long long>();
-  if (bytes <= 0) throw LibraryError("budget: must be a positive number of bytes");
-  return static_cast<uint64_t>(bytes);
+namespace {
+
+/// A positive number of bytes as an int: TypeError for another type (`expected` says what the
+/// parameter takes), mfr.Error for 0 or less (as the command line), OverflowError past 2^64 - 1.
+uint64_t positiveBytes(const py::object& value, const std::string& name, const char* expected) {
+  if (isBool(value) || !PyIndex_Check(value.ptr()))
+    throw py::type_error(name + ": expected " + expected + ", got " + typeName(value));
+  if (value <= py::int_(0)) throw LibraryError(name + ": must be a positive number of bytes");
+  return castArgument<uint64_t>(value, name);
+}
+
+}  // namespace
+
+uint64_t budgetArgument(const py::object& budget, const std::string& name) {
+  if (PyUnicode_Check(budget.ptr()))
+    return unwrap(parseByteSize(castArgument<std::string>(budget, name)));
+  return positiveBytes(budget, name, "bytes (an int) or a size such as \"20MB\"");
 }
 
 std::optional<uint64_t> memoryLimitArgument(const py::object& limit) {
   if (limit.is_none()) return std::nullopt;
-  if (py::isinstance<py::str>(limit))
-    return unwrap(parseMemoryLimitOption(limit.cast<std::string>(), Spelling::Python));
-  if (py::isinstance<py::bool_>(limit) || !py::isinstance<py::int_>(limit))
-    throw LibraryError("memory_limit: expected bytes (an int) or a size such as \"8GB\"");
-  const long long bytes = limit.cast<long long>();
-  if (bytes <= 0) throw LibraryError("memory_limit: must be a positive number of bytes");
-  return static_cast<uint64_t>(bytes);
+  if (PyUnicode_Check(limit.ptr()))
+    return unwrap(
+        parseMemoryLimitOption(castArgument<std::string>(limit, "memory_limit"), Spelling::Python));
+  return positiveBytes(limit, "memory_limit", "bytes (an int) or a size such as \"8GB\"");
+}
+
+int samplesArgument(const py::object& samples) {
+  const std::string text = PyUnicode_Check(samples.ptr())
+                               ? castArgument<std::string>(samples, "samples")
+                               : std::to_string(castArgument<long long>(samples, "samples"));
+  return unwrap(parseSamples(text, "samples"));
+}
+
+std::vector<int> sampleCountsArgument(const py::object& counts) {
+  if (counts.is_none()) return {};
+  std::string text;
+  if (PyUnicode_Check(counts.ptr())) {
+    text = castArgument<std::string>(counts, "sample_counts");
+  } else {
+    const std::vector<py::object> items =
+        listArgument(counts, "sample_counts", "a list of integers or a str");
+    for (size_t i = 0; i < items.size(); ++i)
+      text += (i ? "," : "") + std::to_string(castArgument<long long>(
+                                   items[i], "sample_counts[" + std::to_string(i) + "]"));
+  }
+  if (text.empty()) return {};
+  return unwrap(parseSampleCounts(text, "sample_counts"));
 }
 
 CaptureMode captureArgument(const std::string& capture) {
@@ -234,8 +256,10 @@ ImportanceOverrides importanceArgument(const py::dict& params) {
   return o;
 }
 
-Image8 image8Argument(const py::array& image, const char* what) {
+Image8 image8Argument(const py::object& imageArg, const char* what) {
   const std::string name = what;
+  // an array, or a nested list of numbers (converted as numpy.asarray does)
+  const py::array image = arrayArgument(imageArg, name, "an image array (height, width, channels)");
   if (image.ndim() != 3 || image.shape(0) < 1 || image.shape(1) < 1)
     throw py::value_error(name + ": expected an array (height, width, channels), got " +
                           std::to_string(image.ndim()) + " dimensions");

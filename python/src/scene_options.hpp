@@ -49,16 +49,20 @@ SceneRequest sceneRequestArgument(int width, int height, const py::object& camer
                                   const py::object& cull, const py::object& blend);
 
 /// A budget: bytes as an int, a size ("20MB") or a share of the A-buffer ("25%").
-BudgetSpec budgetSpecArgument(const py::object& budget);
+BudgetSpec budgetSpecArgument(const py::object& budget, const std::string& name = "budget");
 
 /// None, or alpha in [0, 1].
-std::optional<float> alphaArgument(const py::object& alpha);
+std::optional<float> alphaArgument(const py::object& alpha, const char* name = "alpha");
 /// Three finite numbers in [0, 1].
 glm::vec3 backgroundArgument(const py::object& background);
 /// Bytes as an int, or a size string ("20MB", parseByteSize).
-uint64_t budgetArgument(const py::object& budget);
+uint64_t budgetArgument(const py::object& budget, const std::string& name = "budget");
 /// None (the library's default, defaultMemoryLimit()), bytes as an int, or a size string.
 std::optional<uint64_t> memoryLimitArgument(const py::object& limit);
+/// `samples`: 1, 2, 4 or 8 as an int or the command line's text.
+int samplesArgument(const py::object& samples);
+/// `sample_counts`: None (none), a list of ints or the command line's text ("1,4,8").
+std::vector<int> sampleCountsArgument(const py::object& counts);
 /// "tile" or "parallel".
 CaptureMode captureArgument(const std::string& capture);
 /// vkb's importance parameters from a dict (alpha, n_limit, periphery_d, fovea, noise,
@@ -67,6 +71,6 @@ CaptureMode captureArgument(const std::string& capture);
 ImportanceOverrides importanceArgument(const py::dict& params);
 /// An image array: uint8 (h, w, 3|4) sRGB (alpha set to 255 for 3 channels), or floating-point
 /// (h, w, 3) linear RGB, sRGB-encoded with encodeSrgb. `what` names it in errors.
-Image8 image8Argument(const py::array& image, const char* what);
+Image8 image8Argument(const py::object& image, const char* what);
 
 }  // namespace mfr::python

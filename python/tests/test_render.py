@@ -411,7 +411,6 @@ def test_errors_carry_the_librarys_messages(tmp_path, cli_error):
     (dict(threads=-1), r"^threads -1: must be in \[0, 1024\], 0 = all cores$"),
     (dict(threads=1025), r"^threads 1025: must be in \[0, 1024\], 0 = all cores$"),
     (dict(camera=(1, 2, 3)), r"^camera: expected 6, 9 or 10 numbers"),
-    (dict(camera=(0, 0, 1, 0, 0, float("nan"))), r"^camera: values must be finite"),
     (dict(camera=(1, 1, 1, 1, 1, 1)), r"^camera: eye and target must differ"),
     (dict(camera="0,0,3,0,0,zero"), r"^camera: .*zero.* is not a number"),
     (dict(view=0), r"view 0 but the scene has 0 camera\(s\)"),
@@ -501,18 +500,18 @@ def test_type_errors_name_the_parameter_and_the_type(kwargs, message):
     args.update(kwargs)
     with pytest.raises(TypeError) as e:
         mfr.render("procedural:bottles", **args)
-    assert str(e.value) == message
+    assert str(e.value) == "render(): " + message
 
 
 def test_type_errors_of_other_functions_name_the_parameter(tmp_path):
-    with pytest.raises(TypeError, match=r"^seed: expected an integer, got str$"):
+    with pytest.raises(TypeError, match=r"^load_scene\(\): seed: expected an integer, got str$"):
         mfr.load_scene("procedural:bottles", seed="one")
-    with pytest.raises(TypeError, match=r"^ppd: expected a number, got str$"):
+    with pytest.raises(TypeError, match=r"^metrics\(\): ppd: expected a number, got str$"):
         mfr.metrics(np.zeros((2, 2, 3), np.uint8), np.zeros((2, 2, 3), np.uint8), ppd="x")
-    with pytest.raises(TypeError, match=r"^methods: expected a list of str, got list$"):
+    with pytest.raises(TypeError, match=r"^compare\(\): methods\[1\]: expected a str, got int$"):
         mfr.compare("procedural:bottles", tmp_path / "c", "40KB", methods=["fkb", 3], width=W,
                     height=H)
-    with pytest.raises(TypeError, match=r"^height: expected an integer, got str$"):
+    with pytest.raises(TypeError, match=r"^compare\(\): height: expected an integer, got str$"):
         mfr.compare("procedural:bottles", tmp_path / "c", "40KB", methods=["fkb"], width=W,
                     height="tall")
 

@@ -221,7 +221,11 @@ Result<std::string> writeComparison(const CompareResult& r, const std::string& o
       written.push_back(png(run.kMapFile, run.kMap));
       written.push_back(png(run.importanceFile, run.importanceMap));
     }
-  const std::string jsonText = compareToJson(r, mfrVersion).dump(2) + "\n";
+  // a scene or model path need not be UTF-8 (a file name is bytes); JSON text must be: such
+  // bytes are written as U+FFFD rather than failing the whole comparison
+  const std::string jsonText =
+      compareToJson(r, mfrVersion).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) +
+      "\n";
   written.push_back(writeText(dir / "results.json", jsonText));
   written.push_back(writeText(dir / "results.csv", compareToCsv(r)));
   written.push_back(writeText(dir / "report.html", compareReportHtml(r, info)));

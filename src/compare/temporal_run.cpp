@@ -85,7 +85,8 @@ Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest&
   j["frames"] = folders;
   j["plots"] = plots.value();
   j["temporal"] = temporalToJson(run.result);
-  run.jsonText = j.dump(2) + "\n";
+  // a path that is not UTF-8: U+FFFD in the JSON, as compare_output.cpp
+  run.jsonText = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
   MFR_TRY(writeFileAtomically((dir / "results.json").string(), run.jsonText));
   MFR_TRY(writeFileAtomically((dir / "report.html").string(),
                               temporalReportHtml(run.result, r.source, r.width, r.height,
