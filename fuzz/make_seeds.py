@@ -366,6 +366,58 @@ def issue29_seeds():
     write("json_scene", "issue29_long_mesh_name.json", json.dumps({"mesh": "m" * 100000 + ".obj"}))
 
 
+def issue49_seeds():
+    """The hostile inputs of issue 49 (tests/test_reliability_json.cpp), small versions: JSON
+    nested past the 64 levels every reader allows (include/mfr/core/json_limits.hpp), dataset text
+    that is not UTF-8, a target outside [0, 1]."""
+    def deep(n):
+        return "[" * n + "0" + "]" * n
+
+    def with_hole(doc, raw):
+        return json.dumps(doc).replace('"@HOLE@"', raw, 1)
+    extras = triangle_gltf("buffer.bin", {"uri": "texture.png"},
+                           extra=lambda d: d["nodes"][0].update({"extras": "@HOLE@"}))
+    write("gltf", "issue49_deep_extras.gltf", with_hole(extras, deep(100)))
+    write("gltf", "issue49_extras_at_limit.gltf", with_hole(extras, deep(61)))
+    stride = triangle_gltf("buffer.bin", {"uri": "texture.png"},
+                           extra=lambda d: d["bufferViews"][1].update({"byteStride": "@HOLE@"}))
+    write("gltf", "issue49_deep_stride.gltf", with_hole(stride, deep(100)))
+    write("gltf", "issue49_array_stride.gltf", with_hole(stride, deep(3)))
+    text = with_hole(triangle_gltf(None, {"bufferView": 0, "mimeType": "image/png"},
+                                   extra=lambda d: d["nodes"][0].update({"extras": "@HOLE@"})),
+                     deep(100))
+    good = glb(triangle_gltf(None, {"bufferView": 0, "mimeType": "image/png"}), BUFFER)
+    js_len = struct.unpack_from("<I", good, 12)[0]
+    js = text.encode() + b" " * (-len(text) % 4)
+    write("glb", "issue49_deep_extras.glb", good[:8] + struct.pack("<I", len(good) - js_len + len(js)) +
+          struct.pack("<I", len(js)) + good[16:20] + js + good[20 + js_len:])
+    write("json_scene", "issue49_deep_cameras.json",
+          '{"mesh": "mesh.obj", "cameras": %s}' % deep(100))
+    sizes = [12, 4, 1]
+    weights = [0.1] * (12 * 4 + 4 + 4 + 1)
+    write("mfrnn", "issue49_deep_metadata.mfrnn",
+          model_bytes(sizes, weights, '{"features": %s}' % deep(100)))
+    write("mfrnn", "issue49_array_composite.mfrnn",
+          model_bytes(sizes, weights, '{"features": "%s", "composite": %s}' % (FEATURE_SET, deep(3))))
+
+    def dataset(scenes, meta, targets):
+        out = b"MFRDS\0\0\0" + struct.pack("<IIII", 2, 12, 1, len(scenes))
+        out += b"".join(struct.pack("<I", len(s)) + s for s in scenes)
+        out += struct.pack("<I", len(meta)) + meta + struct.pack("<Q", len(targets))
+        for i, t in enumerate(targets):
+            out += struct.pack("<4I", 0, i, 0, i) + struct.pack("<12f", *[j / 12.0 for j in range(12)])
+            out += struct.pack("<f", t)
+        return out
+    meta = json.dumps({"features": FEATURE_SET, "target": TARGET_SCALING}).encode()
+    write("mfrds", "issue49_deep_metadata.mfrds",
+          dataset([b"procedural:layers"], ('{"features": %s}' % deep(100)).encode(), [0.5]))
+    write("mfrds", "issue49_name_not_utf8.mfrds", dataset([b"procedural:\xfflayers"], meta, [0.5]))
+    write("mfrds", "issue49_metadata_not_utf8.mfrds",
+          dataset([b"procedural:layers"], b'{"note": "\xc3("}', [0.5]))
+    write("mfrds", "issue49_target_2.mfrds", dataset([b"procedural:layers"], meta, [0.5, 2.0]))
+    write("mfrds", "issue49_valid_v2.mfrds", dataset([b"procedural:layers"], meta, [0.0, 0.5, 1.0]))
+
+
 if __name__ == "__main__":
     gltf_seeds()
     obj_seeds()
@@ -378,4 +430,5 @@ if __name__ == "__main__":
     mfrds_seeds()
     png_seeds()
     issue29_seeds()
+    issue49_seeds()
     print("seeds written to", SEEDS)

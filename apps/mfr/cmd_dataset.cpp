@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/cpu/raster_frame.hpp"
 #include "mfr/learn/dataset.hpp"
@@ -65,6 +66,11 @@ int runDataset(DatasetArgs& a) {
     return fail("--composite " + quoteInput(a.composite) + ": expected kbuffer or hybrid");
   sampling.compositing = rule.value();
   sampling.curveTargets = !a.curveOut.empty();
+  // the file stores scene names as UTF-8 (learn::writeDataset refuses others): before any work
+  for (const std::string& source : a.scenes)
+    if (const size_t bad = invalidUtf8At(source); bad != std::string::npos)
+      return fail(echoPath(source) + ": the scene name is not valid UTF-8 (at byte " +
+                  std::to_string(bad) + "), which a dataset's scene names must be");
   Progress progress(!a.scene.quiet);
   nlohmann::json perScene = nlohmann::json::array();
   for (const std::string& source : a.scenes) {

@@ -67,6 +67,9 @@ std::shared_ptr<Model> makeModel(const py::object& weightsArg, const py::object&
     if (!net.weights.back().allFinite() || !net.biases.back().allFinite())
       throw py::value_error(layer + ": weights and biases must be finite");
   }
+  // what save() and load() refuse (checkDkbModel, too): too long, not UTF-8, nested too deeply
+  if (const std::string problem = learn::metadataProblem(metadata); !problem.empty())
+    throw py::value_error(problem);
   model->metadata = metadata;
   return model;
 }
@@ -195,7 +198,8 @@ void saveDataset(const py::object& pathArg, const py::array& featuresArg,
   for (const std::string& name : scenes)
     if (name.empty() || name.size() > 4096)
       throw py::value_error("scenes: names must be 1 to 4096 bytes long");
-  if (metadata.size() > (1u << 20)) throw py::value_error("metadata: longer than 1 MiB");
+  if (const std::string problem = learn::metadataProblem(metadata); !problem.empty())
+    throw py::value_error(problem);  // as readDataset and writeDataset refuse it
   const auto column = [&](const py::object& arg, const char* name) {
     if (arg.is_none()) return UintArray(std::vector<py::ssize_t>{n});  // zeros below
     UintArray a(arg);
@@ -223,9 +227,10 @@ void saveDataset(const py::object& pathArg, const py::array& featuresArg,
                             ": there are " + std::to_string(scenes.size()) + " scenes");
     for (int c = 0; c < kDkbFeatureCount; ++c) s.features[c] = f(i, c);
     s.target = t(i);
-    bool finite = std::isfinite(s.target);
-    for (float f : s.features) finite = finite && std::isfinite(f);
-    if (!finite) throw py::value_error("sample " + std::to_string(i) + ": values must be finite");
+    // the check load_dataset and mfr train apply (readDataset): e.g. a target outside [0, 1]
+    if (const auto problem = learn::datasetSampleProblem(s, 1, scenes.size()))
+      throw py::value_error(std::string(problem->field) + "[" + std::to_string(i) +
+                            "]: " + problem->text);
   }
   py::gil_scoped_release release;
   unwrap(learn::writeDataset(path, data));

@@ -5,18 +5,21 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <iterator>
+#include <string_view>
 
 #include <tbb/task_arena.h>
 #include <nlohmann/json.hpp>
 
 #include "mfr/core/atomic_file.hpp"
+#include "mfr/core/file_access.hpp"
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/cpu/deep_importance.hpp"
 #include "mfr/cpu/optimal_oracle.hpp"
+#include "mfr/learn/model_file.hpp"
 #include "mfr/method/budget_spec.hpp"
 #include "mfr/method/dfaoit.hpp"
 #include "mfr/method/optimal_allocation.hpp"
@@ -80,7 +83,53 @@ class Reader {
   size_t pos_ = 0;
 };
 
+/// The problem with scene name `index`, or "": 1..kMaxName bytes of UTF-8 (the format's rule).
+std::string sceneNameProblem(const std::string& name, size_t index) {
+  const std::string which = "scene " + std::to_string(index) + "'s name";
+  if (name.empty() || name.size() > kMaxName)
+    return which + " is " + std::to_string(name.size()) + " bytes long (1 to " +
+           std::to_string(kMaxName) + " allowed)";
+  if (const size_t bad = invalidUtf8At(name); bad != std::string_view::npos)
+    return which + " is not valid UTF-8 (at byte " + std::to_string(bad) + " of " +
+           std::to_string(name.size()) + ")";
+  return "";
+}
+
+/// A float for a message.
+std::string number(float v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", static_cast<double>(v));
+  return text;
+}
+
 }  // namespace
+
+std::optional<SampleProblem> datasetSampleProblem(const DatasetSample& s, uint32_t targetCount,
+                                                  size_t sceneCount) {
+  if (s.scene >= sceneCount)
+    return SampleProblem{"scene", "scene index " + std::to_string(s.scene) +
+                                      " is not below the scene count " +
+                                      std::to_string(sceneCount)};
+  for (size_t i = 0; i < s.features.size(); ++i)
+    if (!std::isfinite(s.features[i]))
+      return SampleProblem{"features", "feature " + std::to_string(i) + " is " +
+                                           number(s.features[i]) + ", not a finite number"};
+  const auto outside = [](std::string what, float t) -> std::optional<SampleProblem> {
+    if (std::isfinite(t) && t >= 0.0f && t <= 1.0f) return std::nullopt;
+    return SampleProblem{"targets", what + " is " + number(t) + ", outside [0, 1]"};
+  };
+  // the targets the file holds (Dataset::targetCount)
+  if (targetCount == kDfaoitTargetCount) {
+    for (size_t i = 0; i < s.colour.size(); ++i)
+      if (auto p = outside("colour target " + std::to_string(i), s.colour[i])) return p;
+  } else if (targetCount == 1) {
+    return outside("target", s.target);
+  } else {
+    for (size_t i = 0; i < s.curve.size() && i < targetCount; ++i)
+      if (auto p = outside("curve target " + std::to_string(i), s.curve[i])) return p;
+  }
+  return std::nullopt;
+}
 
 uint64_t fnv1a64(std::string_view bytes) {
   uint64_t h = 0xcbf29ce484222325ull;
@@ -214,6 +263,25 @@ std::vector<DatasetSample> sampleDfaoitView(const RasterFrame& frame, uint32_t s
 }
 
 Result<void> writeDataset(const std::string& path, const Dataset& data) {
+  // what readDataset refuses is never written
+  const auto refuse = [&](const std::string& problem) {
+    return makeError("dataset " + path + ": cannot write it: " + problem);
+  };
+  if (data.targetCount != 1 && data.targetCount != kCurveOutputs &&
+      data.targetCount != kDfaoitTargetCount)
+    return refuse(std::to_string(data.targetCount) + " targets per sample, not 1, " +
+                  std::to_string(kDfaoitTargetCount) + " or " + std::to_string(kCurveOutputs));
+  if (data.scenes.empty() || data.scenes.size() > kMaxScenes)
+    return refuse(std::to_string(data.scenes.size()) + " scenes (1 to " +
+                  std::to_string(kMaxScenes) + " allowed)");
+  for (size_t i = 0; i < data.scenes.size(); ++i)
+    if (std::string problem = sceneNameProblem(data.scenes[i], i); !problem.empty())
+      return refuse(problem);
+  if (std::string problem = metadataProblem(data.metadata); !problem.empty())
+    return refuse(problem);
+  for (size_t i = 0; i < data.samples.size(); ++i)
+    if (auto problem = datasetSampleProblem(data.samples[i], data.targetCount, data.scenes.size()))
+      return refuse("sample " + std::to_string(i) + ": " + problem->text);
   std::string out;
   out.reserve(64 + data.samples.size() * sampleBytes(data.targetCount));
   out.append(kMagic, sizeof kMagic);
@@ -248,12 +316,12 @@ Result<void> writeDataset(const std::string& path, const Dataset& data) {
 }
 
 Result<Dataset> readDataset(const std::string& path) {
-  std::error_code ec;  // a FIFO or device would block or never end: regular files only
-  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-    return makeError("dataset " + path + ": not a regular file");
-  std::ifstream file(path, std::ios::binary);
-  if (!file) return makeError("dataset " + path + ": cannot open (missing or unreadable)");
-  const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
+  // opened once, every check on the descriptor (a FIFO or device would block or never end)
+  auto file = openRegularFile(path, "dataset " + path);
+  if (!file) return file.error();
+  auto read = file->readText();
+  if (!read) return read.error();
+  const std::string& bytes = *read;
   Reader in(bytes, path);
   std::string magic;
   if (!in.getString(magic, sizeof kMagic) || std::memcmp(magic.data(), kMagic, sizeof kMagic) != 0)
@@ -280,12 +348,16 @@ Result<Dataset> readDataset(const std::string& path) {
     std::string name;
     if (!in.get(length) || length == 0 || length > kMaxName || !in.getString(name, length))
       return in.error("truncated or bad scene name");
+    if (std::string problem = sceneNameProblem(name, i); !problem.empty())
+      return makeError("dataset " + path + ": " + problem);
     data.scenes.push_back(std::move(name));
   }
   uint32_t metadataLength = 0;
   if (!in.get(metadataLength) || metadataLength > kMaxMetadata ||
       !in.getString(data.metadata, metadataLength))
     return in.error("truncated or bad metadata");
+  if (std::string problem = metadataProblem(data.metadata); !problem.empty())
+    return makeError("dataset " + path + ": " + problem);
   uint64_t count = 0;
   if (!in.get(count)) return in.error("truncated sample count");
   if (count > in.remaining() / perSample)
@@ -303,18 +375,15 @@ Result<Dataset> readDataset(const std::string& path) {
       for (float& t : s.colour) (void)in.get(t);
     else
       for (uint32_t t = 0; t < targets; ++t) (void)in.get(s.curve[t]);
-    if (s.scene >= sceneCount) return in.error("sample " + std::to_string(i) + ": bad scene");
-    bool finite = std::isfinite(s.target) && s.target >= 0.0f && s.target <= 1.0f;
-    for (float t : s.curve) finite = finite && std::isfinite(t) && t >= 0.0f && t <= 1.0f;
-    for (float t : s.colour) finite = finite && std::isfinite(t) && t >= 0.0f && t <= 1.0f;
-    for (float f : s.features) finite = finite && std::isfinite(f);
-    if (!finite)
-      return in.error("sample " + std::to_string(i) + ": non-finite or out-of-range value");
+    if (auto problem = datasetSampleProblem(s, targets, sceneCount))
+      return in.error("sample " + std::to_string(i) + ": " + problem->text);
   }
   return data;
 }
 
 Result<Compositing> datasetRule(const Dataset& data, const std::string& path) {
+  if (std::string problem = metadataProblem(data.metadata); !problem.empty())
+    return makeError("dataset " + path + ": " + problem);
   const auto meta = nlohmann::json::parse(data.metadata, nullptr, false);
   if (!meta.is_object() || !meta.contains("composite")) return Compositing::Hybrid;
   const auto& declared = meta["composite"];
@@ -323,10 +392,12 @@ Result<Compositing> datasetRule(const Dataset& data, const std::string& path) {
     if (rule && kBufferFamilyRule(rule.value())) return rule.value();
   }
   return makeError("dataset " + path + ": its metadata declares the compositing rule " +
-                   oneLine(declared.dump(), 60) + ", expected \"hybrid\" or \"kbuffer\"");
+                   jsonExcerpt(declared, 60) + ", expected \"hybrid\" or \"kbuffer\"");
 }
 
 Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& path) {
+  if (std::string problem = metadataProblem(data.metadata); !problem.empty())
+    return makeError("dataset " + path + ": " + problem);
   const auto meta = nlohmann::json::parse(data.metadata, nullptr, false);
   if (!meta.is_object()) return {};
   const bool dfaoit = data.targetCount == kDfaoitTargetCount;
@@ -344,7 +415,7 @@ Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& pat
     if (it == meta.end()) continue;
     if (!it->is_string() || it->get<std::string>() != value)
       return makeError("dataset " + path + ": its metadata declares " + key + " " +
-                       oneLine(it->dump(), 120) + ", this build computes \"" + value +
+                       jsonExcerpt(*it, 120) + ", this build computes \"" + value +
                        "\" (regenerate it with mfr dataset)");
   }
   return {};

@@ -7,16 +7,14 @@
 
 #include <algorithm>
 #include <bit>
-#include <cerrno>
 #include <cmath>
 #include <concepts>
-#include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <string_view>
-#include <system_error>
 
 #include "mfr/core/atomic_file.hpp"
+#include "mfr/core/file_access.hpp"
+#include "mfr/core/json_limits.hpp"
 
 namespace mfr::learn {
 namespace {
@@ -63,10 +61,6 @@ std::string truncated(size_t expected, size_t actual, bool atLeast) {
   return cat("truncated: expected ", atLeast ? "at least " : "", expected, " bytes, got ", actual);
 }
 
-std::string errnoText(int err) {
-  return std::generic_category().message(err);
-}
-
 // --- bytes ------------------------------------------------------------------------------------
 
 /// Writes into a buffer sized beforehand (GCC 12 gives a false -Wstringop-overflow on
@@ -98,49 +92,6 @@ size_t layerBytes(const std::vector<int>& sizes, size_t l) {
 }
 
 // --- validation shared by reading and writing ---------------------------------------------------
-
-/// Offset of the first byte that is not well-formed UTF-8 (RFC 3629: no overlong forms, no
-/// surrogates, nothing above U+10FFFF), or npos.
-size_t invalidUtf8At(std::string_view s) {
-  size_t i = 0;
-  while (i < s.size()) {
-    const uint8_t lead = static_cast<uint8_t>(s[i]);
-    size_t length = 1;
-    uint32_t cp = lead, minimum = 0;
-    if (lead >= 0x80) {
-      if ((lead & 0xE0) == 0xC0) {
-        length = 2, cp = lead & 0x1F, minimum = 0x80;
-      } else if ((lead & 0xF0) == 0xE0) {
-        length = 3, cp = lead & 0x0F, minimum = 0x800;
-      } else if ((lead & 0xF8) == 0xF0) {
-        length = 4, cp = lead & 0x07, minimum = 0x10000;
-      } else {
-        return i;
-      }
-    }
-    if (s.size() - i < length) return i;
-    for (size_t k = 1; k < length; ++k) {
-      const uint8_t next = static_cast<uint8_t>(s[i + k]);
-      if ((next & 0xC0) != 0x80) return i;
-      cp = cp << 6 | (next & 0x3F);
-    }
-    if (cp < minimum || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return i;
-    i += length;
-  }
-  return std::string_view::npos;
-}
-
-/// Problem with the metadata, or "".
-std::string metadataProblem(const std::string& metadata) {
-  if (metadata.size() > kMaxMetadata) {
-    return cat("metadata too long: ", metadata.size(), " bytes (at most ", kMaxMetadata, ")");
-  }
-  const size_t bad = invalidUtf8At(metadata);
-  if (bad != std::string_view::npos) {
-    return cat("metadata is not valid UTF-8 (at byte ", bad, " of ", metadata.size(), ")");
-  }
-  return "";
-}
 
 /// The first non-finite parameter, as a problem, or "". Layers are numbered from 0.
 std::string parameterProblem(const Mlp& net) {
@@ -225,6 +176,18 @@ Result<std::vector<int>> decodeHeader(const uint8_t* bytes, size_t size, const s
 
 }  // namespace
 
+std::string metadataProblem(std::string_view metadata) {
+  if (metadata.size() > kMaxMetadata) {
+    return cat("metadata too long: ", metadata.size(), " bytes (at most ", kMaxMetadata, ")");
+  }
+  const size_t bad = invalidUtf8At(metadata);
+  if (bad != std::string_view::npos) {
+    return cat("metadata is not valid UTF-8 (at byte ", bad, " of ", metadata.size(), ")");
+  }
+  if (std::string deep = jsonDepthProblem(metadata); !deep.empty()) return "metadata: " + deep;
+  return "";
+}
+
 std::vector<uint8_t> encodeModel(const Model& model) {
   const Mlp& net = model.net;
   checkShapes(net);
@@ -297,28 +260,15 @@ Result<void> writeModel(const std::string& path, const Model& model) {
 }
 
 Result<Model> readModel(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    return fail(path, "cannot read a model file: is a directory");
-  }
-  if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec)) {
-    return fail(path, "cannot read a model file: not a regular file");  // a FIFO would block
-  }
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) return fail(path, "cannot open model file (", errnoText(errno), ")");
-  std::vector<uint8_t> bytes;
-  uint8_t buffer[1 << 16];
-  size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof buffer, file)) > 0 && bytes.size() <= kMaxFileBytes) {
-    bytes.insert(bytes.end(), buffer, buffer + got);
-  }
-  const int err = std::ferror(file) ? (errno ? errno : EIO) : 0;
-  std::fclose(file);
-  if (err != 0) return fail(path, "read error (", errnoText(err), ")");
-  if (bytes.size() > kMaxFileBytes) {
+  // opened once, every check on the descriptor (a FIFO, device or directory is refused there)
+  auto file = openRegularFile(path, path);
+  if (!file) return file.error();
+  if (file->size() > kMaxFileBytes) {
     return fail(path, "larger than any valid model file (at most ", kMaxFileBytes, " bytes)");
   }
-  return decodeModel(bytes.data(), bytes.size(), path);
+  auto bytes = file->read(kMaxFileBytes);
+  if (!bytes) return bytes.error();
+  return decodeModel(bytes->data(), bytes->size(), path);
 }
 
 }  // namespace mfr::learn

@@ -6,6 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/learn/model_file.hpp"
 
@@ -83,10 +84,12 @@ Result<void> checkDfaoitModel(const learn::Model& model, const std::string& name
                      std::to_string(model.net.inputs()) + " inputs and " +
                      std::to_string(model.net.outputs()) + " outputs in " +
                      std::to_string(model.net.sizes.size() - 1) + " layers");
+  if (std::string problem = learn::metadataProblem(model.metadata); !problem.empty())
+    return makeError("model " + name + ": " + problem);
   const auto meta = nlohmann::json::parse(model.metadata, nullptr, false);
   const auto declared = [&](const char* key) -> std::string {
     if (!meta.is_object() || !meta.contains(key)) return "";
-    return meta[key].is_string() ? meta[key].get<std::string>() : meta[key].dump();
+    return meta[key].is_string() ? meta[key].get<std::string>() : jsonExcerpt(meta[key], 120);
   };
   if (declared("features") != kDfaoitFeatureSet)
     return makeError("model " + name + ": trained on the feature set \"" +

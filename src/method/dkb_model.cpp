@@ -3,6 +3,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/learn/dataset.hpp"
 #include "mfr/learn/model_file.hpp"
@@ -48,10 +49,12 @@ Result<void> checkModelFits(const learn::Model& model, const std::string& name,
                      std::to_string(kind.outputs) + (kind.outputs == 1 ? " output" : " outputs") +
                      ", not " + std::to_string(model.net.inputs()) + " and " +
                      std::to_string(model.net.outputs()));
+  if (std::string problem = learn::metadataProblem(model.metadata); !problem.empty())
+    return makeError("model " + name + ": " + problem);
   const auto meta = nlohmann::json::parse(model.metadata, nullptr, false);
   const auto declared = [&](const char* key) -> std::string {
     if (!meta.is_object() || !meta.contains(key)) return "";
-    return meta[key].is_string() ? meta[key].get<std::string>() : meta[key].dump();
+    return meta[key].is_string() ? meta[key].get<std::string>() : jsonExcerpt(meta[key], 120);
   };
   const std::string features = declared("features"), target = declared("target");
   if (features.empty())
@@ -110,6 +113,8 @@ Result<void> checkDkbCurveModel(const learn::Model& model, const std::string& na
 }
 
 Result<Compositing> dkbModelRule(const learn::Model& model, const std::string& name) {
+  if (std::string problem = learn::metadataProblem(model.metadata); !problem.empty())
+    return makeError("model " + name + ": " + problem);
   const auto meta = nlohmann::json::parse(model.metadata, nullptr, false);
   if (!meta.is_object() || !meta.contains("composite")) return Compositing::Hybrid;
   const auto& declared = meta["composite"];
@@ -118,7 +123,7 @@ Result<Compositing> dkbModelRule(const learn::Model& model, const std::string& n
     if (rule && kBufferFamilyRule(rule.value())) return rule.value();
   }
   return makeError("model " + name + ": its metadata declares the compositing rule " +
-                   oneLine(declared.dump(), 60) + ", expected \"hybrid\" or \"kbuffer\"");
+                   jsonExcerpt(declared, 60) + ", expected \"hybrid\" or \"kbuffer\"");
 }
 
 Result<void> checkDkbModelRule(const learn::Model& model, const std::string& name,

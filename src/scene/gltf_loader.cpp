@@ -28,6 +28,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -41,6 +42,7 @@
 #include "file_loaders.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
@@ -190,6 +192,10 @@ Result<nlohmann::json> gltfJson(const std::vector<unsigned char>& bytes) {
     begin += 20;
     size = chunkLength;
   }
+  // before anything recursive reads it (tinygltf converts extras and extensions recursively)
+  const std::string deep =
+      jsonDepthProblem(std::string_view(reinterpret_cast<const char*>(begin), size));
+  if (!deep.empty()) return makeError(deep);
   try {
     return nlohmann::json::parse(begin, begin + size);
   } catch (const nlohmann::json::exception& e) {
@@ -283,7 +289,7 @@ Result<void> checkReferences(const nlohmann::json& doc, GltfFiles& files) {
                          stride.get<int64_t>() <= 252 && stride.get<int64_t>() % 4 == 0;
       if (!valid)
         return makeError("bufferViews[" + std::to_string(i) + "].byteStride " +
-                         oneLine(stride.dump(), 40) + ": must be a multiple of 4 in [4, 252]");
+                         jsonExcerpt(stride, 40) + ": must be a multiple of 4 in [4, 252]");
     }
   // an item's uri, when it has one
   const auto uriOf = [](const nlohmann::json& item) -> const std::string* {

@@ -18,6 +18,7 @@
 
 #include "file_loaders.hpp"
 #include "mfr/core/file_access.hpp"
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
 
@@ -105,6 +106,9 @@ Result<Scene> loadJsonScene(const std::string& path, const OpenFile& file,
                             const LoadOptions& options) {
   auto text = file.readText();
   if (!text) return text.error();
+  // before anything recursive reads it (copies, comparisons and dumps recurse per level)
+  if (const std::string deep = jsonDepthProblem(*text); !deep.empty())
+    return makeError(path + ": " + deep);
   json root;
   try {
     root = json::parse(*text);

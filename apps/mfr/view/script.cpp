@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/method.hpp"
@@ -172,7 +173,11 @@ Result<std::vector<nlohmann::json>> loadScript(const std::string& path) {
   if (!in) return makeError("--script " + echoPath(path) + ": cannot read the file");
   std::stringstream buffer;
   buffer << in.rdbuf();
-  nlohmann::json doc = nlohmann::json::parse(buffer.str(), nullptr, false);
+  const std::string text = buffer.str();
+  // before the steps are copied (a copy recurses once per level of nesting)
+  if (const std::string deep = jsonDepthProblem(text); !deep.empty())
+    return makeError("--script " + echoPath(path) + ": " + deep);
+  nlohmann::json doc = nlohmann::json::parse(text, nullptr, false);
   if (doc.is_discarded() || !doc.is_array())
     return makeError("--script " + echoPath(path) + ": expected a JSON array of action objects");
   std::vector<nlohmann::json> steps(doc.begin(), doc.end());

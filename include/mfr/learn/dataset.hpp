@@ -79,12 +79,26 @@ uint64_t fnv1a64(std::string_view bytes);
 /// fnv1a64 as 16 lower-case hex digits.
 std::string hashHex(uint64_t hash);
 
-/// Writes the .mfrds file. Not validated here: the caller keeps scene indices below
-/// scenes.size(), 1..65536 scenes with names of 1..4096 bytes, metadata up to 1 MiB and finite
-/// values, or readDataset will refuse the file. Errors: the file cannot be written.
+/// What readDataset and writeDataset refuse in one sample (and Python's save_dataset before it
+/// builds one): `field` the column it is in ("scene", "features" or "targets"), `text` what is
+/// wrong, e.g. "target is 2, outside [0, 1]".
+struct SampleProblem {
+  const char* field;
+  std::string text;
+};
+/// The first problem of sample `s` in a dataset of `targetCount` targets per sample
+/// (Dataset::targetCount) and `sceneCount` scenes: a scene index not below it, a feature that is
+/// not finite, a target the file holds (t(p), the curve's or the colour's) outside [0, 1].
+std::optional<SampleProblem> datasetSampleProblem(const DatasetSample& s, uint32_t targetCount,
+                                                  size_t sceneCount);
+
+/// Writes the .mfrds file. Checked first as readDataset checks (nothing is written then): 1..65536
+/// scenes with names of 1..4096 bytes of UTF-8, metadataProblem (model_file.hpp), every sample's
+/// datasetSampleProblem. Errors: those, or the file cannot be written.
 Result<void> writeDataset(const std::string& path, const Dataset& data);
-/// Checks magic, version, feature count, lengths, scene indices, finite values; errors name path.
-/// Sets Dataset::fileHash.
+/// Reads the file, opened once (openRegularFile: every check on its descriptor). Checks magic,
+/// version, feature count, lengths, scene names (UTF-8), metadata (metadataProblem), every
+/// sample (datasetSampleProblem); errors name path. Sets Dataset::fileHash.
 Result<Dataset> readDataset(const std::string& path);
 
 /// Checks that a dataset's metadata, where it declares a feature set ("features") or a target
