@@ -111,7 +111,7 @@ def test_save_dataset_refuses_what_load_dataset_refuses(tmp_path):
     out = tmp_path / "two.mfrds"
     with pytest.raises(ValueError) as e:
         mfr.save_dataset(out, np.zeros((3, 12)), np.array([0.5, 2.0, 1.0]))
-    assert str(e.value) == "targets[1]: target is 2, outside [0, 1]"
+    assert str(e.value) == "save_dataset(): targets[1]: target is 2, outside [0, 1]"
     with pytest.raises(ValueError, match=r"targets\[0\]: target is -0\.5, outside \[0, 1\]"):
         mfr.save_dataset(out, np.zeros((1, 12)), np.array([-0.5]))
     features = np.zeros((2, 12))
