@@ -71,7 +71,8 @@ class Reader {
   }
   size_t remaining() const { return bytes_.size() - pos_; }
   Error error(const std::string& what) const {
-    return makeError("dataset " + path_ + ": " + what + " (at byte " + std::to_string(pos_) + ")");
+    return makeError("dataset " + echoPath(path_) + ": " + what + " (at byte " +
+                     std::to_string(pos_) + ")");
   }
 
  private:
@@ -250,14 +251,15 @@ Result<void> writeDataset(const std::string& path, const Dataset& data) {
 Result<Dataset> readDataset(const std::string& path) {
   std::error_code ec;  // a FIFO or device would block or never end: regular files only
   if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-    return makeError("dataset " + path + ": not a regular file");
+    return makeError("dataset " + echoPath(path) + ": not a regular file");
   std::ifstream file(path, std::ios::binary);
-  if (!file) return makeError("dataset " + path + ": cannot open (missing or unreadable)");
+  if (!file)
+    return makeError("dataset " + echoPath(path) + ": cannot open (missing or unreadable)");
   const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
   Reader in(bytes, path);
   std::string magic;
   if (!in.getString(magic, sizeof kMagic) || std::memcmp(magic.data(), kMagic, sizeof kMagic) != 0)
-    return makeError("dataset " + path + ": not an mfr dataset (bad magic)");
+    return makeError("dataset " + echoPath(path) + ": not an mfr dataset (bad magic)");
   uint32_t version = 0, features = 0, targets = 0, sceneCount = 0;
   if (!in.get(version)) return in.error("truncated header");
   if (version != kDatasetVersion)
@@ -322,7 +324,7 @@ Result<Compositing> datasetRule(const Dataset& data, const std::string& path) {
     auto rule = parseCompositing(declared.get<std::string>());
     if (rule && kBufferFamilyRule(rule.value())) return rule.value();
   }
-  return makeError("dataset " + path + ": its metadata declares the compositing rule " +
+  return makeError("dataset " + echoPath(path) + ": its metadata declares the compositing rule " +
                    oneLine(declared.dump(), 60) + ", expected \"hybrid\" or \"kbuffer\"");
 }
 
@@ -343,7 +345,7 @@ Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& pat
     const auto it = meta.find(key);
     if (it == meta.end()) continue;
     if (!it->is_string() || it->get<std::string>() != value)
-      return makeError("dataset " + path + ": its metadata declares " + key + " " +
+      return makeError("dataset " + echoPath(path) + ": its metadata declares " + key + " " +
                        oneLine(it->dump(), 120) + ", this build computes \"" + value +
                        "\" (regenerate it with mfr dataset)");
   }

@@ -17,6 +17,7 @@
 #include <system_error>
 
 #include "mfr/core/atomic_file.hpp"
+#include "mfr/core/quote.hpp"
 
 namespace mfr::learn {
 namespace {
@@ -56,7 +57,7 @@ std::string cat(const Parts&... parts) {
 
 template <typename... Parts>
 Error fail(const std::string& name, const Parts&... parts) {
-  return makeError(cat(name, ": ", parts...));
+  return makeError(cat(echoPath(name), ": ", parts...));  // a path of any length, cut
 }
 
 std::string truncated(size_t expected, size_t actual, bool atLeast) {
