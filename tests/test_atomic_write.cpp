@@ -134,6 +134,28 @@ TEST_F(AtomicWrite, ProcessKilledMidWriteLeavesTheOldFile) {
   }
 }
 
+// The temporary name fits wherever the destination's does: a name of NAME_MAX (255) bytes, ASCII
+// or multi-byte UTF-8 (the temporary keeps at most 128 bytes of it, cut between characters), is
+// written and replaced; a longer name is the file system's refusal, named.
+TEST_F(AtomicWrite, WritesAndReplacesFilesWhoseNamesAre255Bytes) {
+  std::string utf8 = "x";
+  for (int i = 0; i < 127; ++i) utf8 += "\xc3\xa9";  // U+00E9: 2 bytes each
+  for (const std::string& name : {std::string(251, 'n') + ".png", utf8}) {
+    ASSERT_EQ(name.size(), 255u);
+    const std::string file = path(name);
+    ASSERT_TRUE(mfr::writeFileAtomically(file, "first").ok());
+    auto second = mfr::writeFileAtomically(file, "second");
+    ASSERT_TRUE(second.ok()) << second.error().message;
+    EXPECT_EQ(readAll(file), "second");
+    EXPECT_EQ(entries(dir()), std::set<std::string>{name});
+    fs::remove(file);
+  }
+  auto tooLong = mfr::writeFileAtomically(path(std::string(256, 'n')), "x");
+  ASSERT_FALSE(tooLong.ok());
+  EXPECT_NE(tooLong.error().message.find("File name too long"), std::string::npos)
+      << tooLong.error().message;
+}
+
 TEST_F(AtomicWrite, KeepsPermissionsAndWritesSpecialFilesInPlace) {
   const std::string file = path("private.txt");
   ASSERT_TRUE(mfr::writeFileAtomically(file, "a").ok());

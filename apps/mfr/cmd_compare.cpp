@@ -110,8 +110,8 @@ std::string psnrCell(double psnr) {
 }
 
 void printSummary(const CompareResult& r) {
-  std::fprintf(stderr, "%s %dx%d, ground truth: %llu fragments, %s, %.1f ms\n", r.scene.c_str(),
-               r.width, r.height,
+  std::fprintf(stderr, "%s %dx%d, ground truth: %llu fragments, %s, %.1f ms\n",
+               echoPath(r.scene).c_str(), r.width, r.height,
                static_cast<unsigned long long>(r.groundTruth.stats.fragmentsGenerated),
                formatBytes(r.groundTruth.stats.bytesUsed).c_str(), r.groundTruth.stats.totalMs());
   std::fprintf(stderr, "  %-20s %8s %11s %9s %7s %10s %9s %10s %8s %9s\n", "method", "budget",
@@ -164,13 +164,14 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
   progress.clear();
   if (!a.scene.quiet) {
     std::fprintf(stderr, "%s, %d frames %.3g degrees apart; ground truth flicker %.4f\n",
-                 a.scene.source.c_str(), frames, step, t.groundTruthFlicker);
+                 echoPath(a.scene.source).c_str(), frames, step, t.groundTruthFlicker);
     std::fprintf(stderr, "  %-20s %8s %9s %9s %12s\n", "method", "budget", "flicker", "excess",
                  "error change");
     for (const TemporalSeries& s : t.series)
       std::fprintf(stderr, "  %-20s %8s %9.4f %9.4f %12.4f\n", s.method.c_str(),
                    s.budgetLabel.c_str(), s.flicker, s.excessFlicker, s.meanErrorChange);
-    std::fprintf(stderr, "report: %s\n", (fs::path(a.out) / "report.html").string().c_str());
+    std::fprintf(stderr, "report: %s\n",
+                 echoPath((fs::path(a.out) / "report.html").string()).c_str());
   }
   if (a.scene.json) std::fputs(jsonText.c_str(), stdout);
   return 0;
@@ -316,7 +317,7 @@ int run(const CompareArgs& a, const std::string& version) {
 
   if (!a.scene.quiet) {
     printSummary(r);
-    std::fprintf(stderr, "report: %s\n", (dir / "report.html").string().c_str());
+    std::fprintf(stderr, "report: %s\n", echoPath((dir / "report.html").string()).c_str());
   }
   if (a.scene.json) std::fputs(jsonText.c_str(), stdout);
   return 0;

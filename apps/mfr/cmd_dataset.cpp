@@ -34,6 +34,9 @@ int runDataset(DatasetArgs& a) {
     return fail("--budget-steps " + std::to_string(a.budgetSteps) + ": must be in [1, 64]");
   if (!(a.sample > 0.0 && a.sample <= 1.0)) return fail("--sample: must be in (0, 1]");
   if (a.out.empty()) return fail("--out: empty path");
+  if (auto distinct = checkDistinctOutputs({{"--out", a.out}, {"--curve-out", a.curveOut}});
+      !distinct)
+    return fail(distinct.error().message);
   if (a.scene.samples != "1" || a.scene.sampleStorage != "pixel")
     return fail(
         "--samples / --sample-storage: mfr dataset samples one fragment set per pixel "

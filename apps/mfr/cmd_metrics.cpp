@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/quote.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
 
@@ -52,16 +53,20 @@ int run(const MetricsArgs& a) {
     message += std::to_string(a.pixelsPerDegree);
     return fail(message);
   }
+  if (auto distinct =
+          checkDistinctOutputs({{"--flip-map", a.flipMap}, {"--error-map", a.errorMap}});
+      !distinct)
+    return fail(distinct.error().message);
   auto reference = readPng(a.reference);
   if (!reference) return fail(reference.error().message);
   auto test = readPng(a.test);
   if (!test) return fail(test.error().message);
   if (reference->width != test->width || reference->height != test->height) {
-    std::string message = a.reference;
+    std::string message = echoPath(a.reference);
     message += " is ";
     message += sizeText(*reference);
     message += " but ";
-    message += a.test;
+    message += echoPath(a.test);
     message += " is ";
     message += sizeText(*test);
     message += ": images must have the same size";

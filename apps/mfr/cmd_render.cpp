@@ -124,7 +124,30 @@ Result<void> writeViewImages(const RenderArgs& a, Engine& engine, const Rendered
   return {};
 }
 
+/// Every file the options ask for (the importance factors: each file in their folder, and the
+/// folder itself), for checkDistinctOutputs.
+std::vector<OutputFile> outputFiles(const RenderArgs& a) {
+  std::vector<OutputFile> files{{"--out", a.out},
+                                {"--depth-complexity", a.depthComplexity},
+                                {"--k-map", a.kMap},
+                                {"--overflow-map", a.overflowMap},
+                                {"--stats-json", a.statsJson},
+                                {"--importance-map", a.importanceMap}};
+  if (!a.importanceFactors.empty()) {
+    files.push_back({"--importance-factors", a.importanceFactors});
+    for (const char* name : {"importance", "depth", "periphery", "fresnel", "noise"})
+      files.push_back(
+          {"--importance-factors",
+           (std::filesystem::path(a.importanceFactors) / (std::string(name) + ".png")).string()});
+  }
+  return files;
+}
+
 int run(const RenderArgs& a) {
+  // two outputs at one path: refused before any work (with --orbit every name gets the same
+  // view suffix, so distinct names stay distinct)
+  if (auto distinct = checkDistinctOutputs(outputFiles(a)); !distinct)
+    return fail(distinct.error().message);
   auto method = buildMethod(a);
   if (!method) return fail(method.error().message);
   RenderOptions options;
@@ -185,7 +208,7 @@ int run(const RenderArgs& a) {
           std::fprintf(stderr,
                        "%s: %s  %llu fragments, %llu captured (%.2f%% lost), k %u-%u, %s, "
                        "%.1f ms%s\n",
-                       method->name.c_str(), viewPath(a.out, r.index, views).c_str(),
+                       method->name.c_str(), echoPath(viewPath(a.out, r.index, views)).c_str(),
                        static_cast<unsigned long long>(s.fragmentsGenerated),
                        static_cast<unsigned long long>(s.captured), s.lostPercent(), s.kMin, s.kMax,
                        formatBytes(s.bytesUsed).c_str(), s.totalMs(), skipped.c_str());

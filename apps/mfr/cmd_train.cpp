@@ -161,6 +161,10 @@ int runTrain(TrainArgs& a) {
   if (a.out.empty()) return fail("--out: empty path");
   if (a.log.empty()) a.log = a.out + ".log.csv";
   if (a.lossCurve.empty()) a.lossCurve = a.out + ".loss.png";
+  if (auto distinct =
+          checkDistinctOutputs({{"--out", a.out}, {"--log", a.log}, {"--loss-curve", a.lossCurve}});
+      !distinct)
+    return fail(distinct.error().message);
 
   auto split = loadSplit(a);
   if (!split) return fail(split.error().message);

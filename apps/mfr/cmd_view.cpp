@@ -46,6 +46,10 @@ Runner addViewCommand(CLI::App& app) {
   return [args] {
     if (!args->listMethods && args->scene.source.empty())
       return fail("view: a scene is needed (e.g. procedural:bottles)");
+    if (auto distinct = checkDistinctOutputs(
+            {{"--screenshot", args->screenshot}, {"--stats-json", args->statsJson}});
+        !distinct)
+      return fail(distinct.error().message);
     return view::runViewer(*args);
   };
 }

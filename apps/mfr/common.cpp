@@ -1,11 +1,15 @@
 #include "common.hpp"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <system_error>
 
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
@@ -15,6 +19,25 @@
 #include "mfr/method/make_method.hpp"
 
 namespace mfr::cli {
+namespace {
+
+/// CLI11's check that an index option (--view, --scene, --orbit-view) is not negative: -1 is the
+/// options' "not given", which a typed -1 must not silently mean.
+CLI::Validator nonNegativeIndex(const std::string& what) {
+  return CLI::Validator(
+      [what](std::string& text) -> std::string {
+        const char* begin = text.c_str();
+        while (*begin == ' ' || *begin == '\t') ++begin;
+        if (*begin != '-') return {};
+        char* end = nullptr;
+        const long long value = std::strtoll(begin, &end, 0);
+        if (end == begin || value == 0) return {};  // not a number: CLI11 says so; -0 is 0
+        return "must be 0 or more (" + what + ", 0-based), got " + quoteInput(text, 40);
+      },
+      "");
+}
+
+}  // namespace
 
 void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
   if (sceneArgument)
@@ -25,11 +48,14 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
   app.add_option("--height", height, "Image height in pixels (1-16384)");
   app.add_option("--camera", camera,
                  "EX,EY,EZ,TX,TY,TZ[,UX,UY,UZ[,FOV]]: eye, target, up, fov (deg)");
-  app.add_option("--view", view, "Use the scene file's camera number N (0-based)");
+  app.add_option("--view", view, "Use the scene file's camera number N (0-based)")
+      ->check(nonNegativeIndex("a camera of the scene file"));
   app.add_option("--scene", gltfScene,
-                 "Which of a glTF file's scenes to load, N (0-based; default: the file's own)");
+                 "Which of a glTF file's scenes to load, N (0-based; default: the file's own)")
+      ->check(nonNegativeIndex("a scene of the glTF file"));
   app.add_option("--orbit", orbit, "Render N views on a circle around the scene");
-  app.add_option("--orbit-view", orbitView, "With --orbit N: only view I of the N (0-based)");
+  app.add_option("--orbit-view", orbitView, "With --orbit N: only view I of the N (0-based)")
+      ->check(nonNegativeIndex("a view of the orbit"));
   app.add_option("--zoom", zoom,
                  "Move the camera Z times closer to its target (default 1; 2 = half the distance)");
   app.add_option("--threads", threads,
@@ -221,8 +247,85 @@ std::string presetHelp() {
 }
 
 int fail(const std::string& message) {
-  std::fprintf(stderr, "mfr: error: %s\n", message.c_str());
+  std::fprintf(stderr, "mfr: error: %s\n", oneLine(message, kMaxErrorMessage).c_str());
   return 1;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+/// What `path` names once `.`, `..` and the symbolic links of its existing part are resolved.
+std::string resolvedOutput(const std::string& path) {
+  std::error_code ec;
+  fs::path p = fs::absolute(path, ec);
+  if (ec) p = path;
+  fs::path resolved = fs::weakly_canonical(p, ec);
+  if (ec) resolved = p.lexically_normal();
+  std::string key = resolved.string();
+  while (key.size() > 1 && key.back() == '/') key.pop_back();  // "DIR/" is "DIR"
+  return key;
+}
+
+/// An existing device, FIFO or socket: written in place, so two outputs there lose nothing.
+bool isSpecialFile(const std::string& resolved) {
+  struct stat st {};
+  return ::stat(resolved.c_str(), &st) == 0 && !S_ISREG(st.st_mode) && !S_ISDIR(st.st_mode);
+}
+
+}  // namespace
+
+Result<void> checkDistinctOutputs(const std::vector<OutputFile>& outputs) {
+  std::vector<std::pair<const OutputFile*, std::string>> seen;
+  for (const OutputFile& output : outputs) {
+    if (output.path.empty()) continue;
+    const std::string resolved = resolvedOutput(output.path);
+    if (isSpecialFile(resolved)) continue;
+    for (const auto& [earlier, key] : seen)
+      if (key == resolved)
+        return makeError(earlier->option + " " + quoteInput(earlier->path, 256) + " and " +
+                         output.option + " " + quoteInput(output.path, 256) +
+                         " are the same file: one output would replace the other (give each its "
+                         "own path)");
+    seen.emplace_back(&output, resolved);
+  }
+  return {};
+}
+
+namespace {
+
+/// The check guardIntegerOptions adds: "" when `text` converts within 64 bits (and, `isUnsigned`,
+/// is not negative); malformed text is left to CLI11's own conversion and its message.
+std::string integerRangeProblem(const std::string& text, bool isUnsigned) {
+  const char* begin = text.c_str();
+  while (*begin == ' ' || *begin == '\t' || *begin == '\n') ++begin;
+  char* end = nullptr;
+  errno = 0;
+  if (isUnsigned) {
+    const unsigned long long value = std::strtoull(begin, &end, 0);
+    if (end == begin) return {};
+    if (errno == ERANGE) return "out of range (more than 64 bits), got " + quoteInput(text, 40);
+    if (*begin == '-' && value != 0) return "must be 0 or more, got " + quoteInput(text, 40);
+    return {};
+  }
+  (void)std::strtoll(begin, &end, 0);
+  if (end != begin && errno == ERANGE)
+    return "out of range (more than 64 bits), got " + quoteInput(text, 40);
+  return {};
+}
+
+}  // namespace
+
+void guardIntegerOptions(CLI::App& app) {
+  for (CLI::Option* option : app.get_options()) {
+    const std::string type = option->get_type_name();
+    const std::string base = type.substr(0, type.find(':'));  // "UINT:..." with a validator
+    if (base != "UINT" && base != "INT") continue;
+    const bool isUnsigned = base == "UINT";
+    option->check(CLI::Validator(
+        [isUnsigned](std::string& text) { return integerRangeProblem(text, isUnsigned); }, ""));
+  }
+  for (CLI::App* sub : app.get_subcommands({})) guardIntegerOptions(*sub);
 }
 
 }  // namespace mfr::cli

@@ -116,7 +116,30 @@ std::string appliesTo(MethodOption option);
 /// "Method: zbuffer, abuffer, ... (each bounded one also NAME+occupancy)" from the preset list.
 std::string presetHelp();
 
-/// Prints "mfr: error: <message>" and returns the exit code 1.
+/// Prints "mfr: error: <message>" (one line, cut at kMaxErrorMessage characters) and returns the
+/// exit code 1.
 int fail(const std::string& message);
+inline constexpr size_t kMaxErrorMessage = 1000;
+
+/// One file a command writes: the option that names it and its path as given.
+struct OutputFile {
+  std::string option;
+  std::string path;
+};
+
+/// Refuses two outputs of one run that are the same file (one would silently replace the other):
+/// paths are compared absolute, with `.`, `..` and symbolic links resolved as far as they exist
+/// (std::filesystem::weakly_canonical), so `X`, `./X`, `a/../X` and a link to X's folder are one
+/// file. Empty paths (an output not asked for) are skipped, and so are existing special files
+/// (`/dev/null`, `/dev/stdout`: written in place, nothing is replaced). The error names both
+/// options and the paths: "--out 'X' and --stats-json './X' are the same file: ...". Every command
+/// writing several files calls it before any work.
+Result<void> checkDistinctOutputs(const std::vector<OutputFile>& outputs);
+
+/// Adds to every integer option of `app` and its subcommands (CLI11 type INT or UINT) a check of
+/// the text before CLI11 converts it, which would silently saturate: an unsigned option refuses a
+/// negative value (strtoull wraps -1 to 2^64 - 1), and any value beyond 64 bits is refused
+/// (strtoull and strtoll saturate). Syntax errors, like the other malformed values.
+void guardIntegerOptions(CLI::App& app);
 
 }  // namespace mfr::cli

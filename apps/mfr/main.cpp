@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "commands.hpp"
+#include "common.hpp"
 #include "mfr/core/quote.hpp"
 #ifdef MFR_HAS_GL
 #include "mfr/gl/gl_render_engine.hpp"
@@ -67,6 +68,7 @@ int run(int argc, char** argv) {
 #ifdef MFR_HAS_VIEW
   const mfr::cli::Runner view = mfr::cli::addViewCommand(app);
 #endif
+  mfr::cli::guardIntegerOptions(app);  // --seed -1 or 2^64 refused, not saturated
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -92,7 +94,8 @@ int run(int argc, char** argv) {
                  commands.empty() ? "" : commands.front()->get_name().c_str());
     return 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "mfr: error: %s\n", e.what());
+    std::fprintf(stderr, "mfr: error: %s\n",
+                 mfr::oneLine(e.what(), mfr::cli::kMaxErrorMessage).c_str());
     return 1;
   }
   return kSyntaxErrorExit;

@@ -62,10 +62,19 @@ std::string foreignEntry(const fs::path& dir, int depth = 0) {
   return "";
 }
 
-/// ".NAME.compare-tmp." (+ PID.N): the staging folders of `destination`.
+/// ".NAME.compare-tmp." (+ PID.N): the staging folders of `destination`, NAME cut to 128 bytes
+/// (at a UTF-8 boundary) so that the staging name (at most 1 + 128 + 13 + 10 + 1 + 20 + 4 for
+/// ".old" = 177 bytes) fits wherever the destination's own name does (NAME_MAX, 255).
 std::string stagingPrefix(const fs::path& destination) {
+  constexpr size_t kMaxNameHead = 128;
+  std::string name = destination.filename().string();
+  if (name.size() > kMaxNameHead) {
+    size_t cut = kMaxNameHead;
+    while (cut > 0 && (static_cast<unsigned char>(name[cut]) & 0xC0) == 0x80) --cut;
+    name.resize(cut);
+  }
   std::string prefix = ".";  // appended piece by piece (GCC 12 warns on "." + string, PR 105329)
-  prefix += destination.filename().string();
+  prefix += name;
   prefix += ".compare-tmp.";
   return prefix;
 }
@@ -87,7 +96,7 @@ void removeStaleStaging(const fs::path& destination) {
 
 /// "DIR: holds 'NAME', which a comparison does not write: ...": never replaced.
 Error foreignRefusal(const std::string& dir, const std::string& foreign) {
-  return makeError(dir + ": holds " + quoteInput(foreign) +
+  return makeError(echoPath(dir) + ": holds " + quoteInput(foreign) +
                    ", which a comparison does not write: not replacing it (choose another "
                    "folder)");
 }
@@ -124,17 +133,18 @@ Result<OutputFolder> OutputFolder::begin(const std::string& out) {
   if (!destination.has_filename()) destination = destination.parent_path();  // "DIR/" -> "DIR"
   if (!ec && fs::is_symlink(fs::symlink_status(destination, ignored)))  // its folder is replaced
     destination = fs::canonical(destination, ec);
-  if (ec) return makeError(out + ": cannot create the output folder (" + ec.message() + ")");
+  if (ec)
+    return makeError(echoPath(out) + ": cannot create the output folder (" + ec.message() + ")");
   const fs::file_status st = fs::status(destination, ignored);
   if (fs::exists(st)) {
     if (!fs::is_directory(st))
-      return makeError(out + ": cannot create the output folder (not a directory)");
+      return makeError(echoPath(out) + ": cannot create the output folder (not a directory)");
     if (const std::string foreign = foreignEntry(destination); !foreign.empty())
       return foreignRefusal(out, foreign);
   } else {
     fs::create_directories(destination.parent_path(), ec);
     if (ec || !fs::is_directory(destination.parent_path()))
-      return makeError(out + ": cannot create the output folder" +
+      return makeError(echoPath(out) + ": cannot create the output folder" +
                        (ec ? " (" + ec.message() + ")" : std::string(" (not a directory)")));
   }
   removeStaleStaging(destination);
@@ -148,16 +158,17 @@ Result<OutputFolder> OutputFolder::begin(const std::string& out) {
     if (::mkdir(staging.c_str(), 0777) == 0)
       return OutputFolder(out, destination.string(), staging.string());
     if (errno != EEXIST)
-      return makeError(out + ": output folder is not writable (" + std::strerror(errno) + ")");
+      return makeError(echoPath(out) + ": output folder is not writable (" + std::strerror(errno) +
+                       ")");
   }
-  return makeError(out + ": cannot create a staging folder beside it");
+  return makeError(echoPath(out) + ": cannot create a staging folder beside it");
 }
 
 Result<void> OutputFolder::commit() {
-  if (staging_.empty()) return makeError(name_ + ": already written");
+  if (staging_.empty()) return makeError(echoPath(name_) + ": already written");
   const fs::path destination(destination_), staging(staging_);
   const auto failed = [this](const std::string& why) {
-    return makeError(name_ + ": cannot put the comparison in place (" + why + ")");
+    return makeError(echoPath(name_) + ": cannot put the comparison in place (" + why + ")");
   };
   for (int attempt = 0; attempt < 16; ++attempt) {
     // absent or an empty folder: one rename
@@ -195,10 +206,10 @@ Result<void> prepareOutputFolder(const std::string& out) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec || !fs::is_directory(dir))
-    return makeError(out + ": cannot create the output folder" +
+    return makeError(echoPath(out) + ": cannot create the output folder" +
                      (ec ? " (" + ec.message() + ")" : std::string(" (not a directory)")));
   const fs::path probe = dir / ".mfr_compare_write_test";
-  if (!std::ofstream(probe)) return makeError(out + ": output folder is not writable");
+  if (!std::ofstream(probe)) return makeError(echoPath(out) + ": output folder is not writable");
   fs::remove(probe, ec);
   return {};
 }

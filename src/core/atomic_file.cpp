@@ -14,6 +14,8 @@
 #include <optional>
 #include <string>
 
+#include "mfr/core/quote.hpp"
+
 namespace mfr {
 namespace {
 
@@ -27,7 +29,7 @@ WriteFailureInjection& injection() {
 }
 
 Error ioError(const std::string& path, const char* what, int err) {
-  return makeError(path + ": " + what + " (" + std::strerror(err) + ")");
+  return makeError(echoPath(path) + ": " + what + " (" + std::strerror(err) + ")");
 }
 
 /// Writes all of `bytes` to `fd` in chunks (the test hook may fail it after any chunk).
@@ -42,12 +44,27 @@ Result<void> writeAll(int fd, const std::string& path, std::string_view bytes) {
       done += static_cast<uint64_t>(w);
     }
     if (injection() && injection()(path, done))
-      return makeError(path + ": write error (injected after " + std::to_string(done) + " bytes)");
+      return makeError(echoPath(path) + ": write error (injected after " + std::to_string(done) +
+                       " bytes)");
   } while (done < bytes.size());
   return {};
 }
 
-/// A fresh temporary name next to the destination: ".NAME.tmp.PID.N".
+/// The destination's name as the head of its temporary name: at most kMaxNameHead bytes, cut at a
+/// UTF-8 character boundary.
+constexpr size_t kMaxNameHead = 128;
+
+std::string nameHead(const std::string& name) {
+  if (name.size() <= kMaxNameHead) return name;
+  size_t cut = kMaxNameHead;
+  while (cut > 0 && (static_cast<unsigned char>(name[cut]) & 0xC0) == 0x80) --cut;
+  return name.substr(0, cut);
+}
+
+/// A fresh temporary name next to the destination: ".NAME.tmp.PID.N.TICK", NAME cut to
+/// kMaxNameHead bytes, so that it fits wherever the destination's own name does (NAME_MAX, 255
+/// bytes on Linux, for a destination of any legal name): at most 1 + 128 + 5 + 10 + 1 + 20 + 1 + 8
+/// = 174 bytes; PID and the counter keep it unique.
 fs::path temporaryName(const fs::path& target) {
   static std::atomic<uint64_t> counter{0};
   const auto tick =
@@ -55,7 +72,7 @@ fs::path temporaryName(const fs::path& target) {
   fs::path dir = target.parent_path();
   if (dir.empty()) dir = ".";
   std::string name = ".";  // appended piece by piece (GCC 12 warns on "." + string, PR 105329)
-  name += target.filename().string();
+  name += nameHead(target.filename().string());
   name += ".tmp.";
   name += std::to_string(::getpid());
   name += '.';
@@ -128,7 +145,7 @@ Result<void> writeNamed(const std::string& path, std::string_view bytes,
     }
     return renameIntoPlace(temporary, path);
   }
-  return makeError(path + ": cannot create a temporary file next to it");
+  return makeError(echoPath(path) + ": cannot create a temporary file next to it");
 }
 
 /// Special files (a terminal, /dev/stdout, a pipe) have nothing to replace: written directly.
@@ -149,7 +166,7 @@ Result<void> writeFileAtomically(const std::string& path, std::string_view bytes
   std::optional<mode_t> mode;  // an existing file keeps its permissions
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0) {
-    if (S_ISDIR(st.st_mode)) return makeError(path + ": is a directory");
+    if (S_ISDIR(st.st_mode)) return makeError(echoPath(path) + ": is a directory");
     if (!S_ISREG(st.st_mode)) return writeSpecial(path, bytes);
     mode = st.st_mode & 07777;
   }

@@ -55,7 +55,8 @@ ImageRGB decodeSrgb(const Image8& image) {
 }
 
 Result<void> writePng(const std::string& path, const Image8& image) {
-  if (image.width <= 0 || image.height <= 0) return makeError(path + ": empty image");
+  const std::string what = echoPath(path);  // a path of any length, cut for the message
+  if (image.width <= 0 || image.height <= 0) return makeError(what + ": empty image");
   // encoded in memory, then written atomically: never a truncated PNG at `path`
   std::string encoded;
   const auto append = [](void* context, void* data, int size) {
@@ -64,15 +65,15 @@ Result<void> writePng(const std::string& path, const Image8& image) {
   };
   if (!stbi_write_png_to_func(append, &encoded, image.width, image.height, 4, image.rgba.data(),
                               image.width * 4))
-    return makeError(path + ": cannot encode PNG");
+    return makeError(what + ": cannot encode PNG");
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   std::error_code ec;
   if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   auto written = writeFileAtomically(path, encoded);
   if (!written) {  // "PATH: cannot open for writing (...)" -> "PATH: cannot write PNG (...)"
     std::string reason = written.error().message;
-    if (reason.rfind(path + ": ", 0) == 0) reason.erase(0, path.size() + 2);
-    return makeError(path + ": cannot write PNG: " + reason);
+    if (reason.rfind(what + ": ", 0) == 0) reason.erase(0, what.size() + 2);
+    return makeError(what + ": cannot write PNG: " + reason);
   }
   return {};
 }
@@ -108,23 +109,24 @@ Result<void> checkPngChunks(const uint8_t* bytes, size_t size, const std::string
 
 Result<Image8> readPng(const std::string& path) {
   // a regular file (a FIFO is refused, not waited on) of less than 2 GiB
-  auto bytes = readRegularFileBytes(path, path, std::numeric_limits<int>::max());
+  const std::string what = echoPath(path);  // a path of any length, cut for the message
+  auto bytes = readRegularFileBytes(path, what, std::numeric_limits<int>::max());
   if (!bytes) return bytes.error();
   static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
   if (bytes->size() < 8 || !std::equal(bytes->begin(), bytes->begin() + 8, kSignature))
-    return makeError(path + ": not a PNG file");
-  MFR_TRY(checkPngChunks(bytes->data(), bytes->size(), path));
+    return makeError(what + ": not a PNG file");
+  MFR_TRY(checkPngChunks(bytes->data(), bytes->size(), what));
   const auto size = static_cast<int>(bytes->size());
   int w = 0, h = 0, n = 0;
   if (!stbi_info_from_memory(bytes->data(), size, &w, &h, &n)) {
     const char* reason = stbi_failure_reason();
-    return makeError(path + ": not a readable image" +
+    return makeError(what + ": not a readable image" +
                      (reason ? " (" + oneLine(reason) + ")" : std::string()));
   }
-  MFR_TRY(checkImageDimensions(w, h, path));  // from the header, before decoding
+  MFR_TRY(checkImageDimensions(w, h, what));  // from the header, before decoding
   unsigned char* data = stbi_load_from_memory(bytes->data(), size, &w, &h, &n, 4);
   // stb quotes the bytes of an unknown chunk type: keep the message on one line
-  if (!data) return makeError(path + ": " + oneLine(stbi_failure_reason()));
+  if (!data) return makeError(what + ": " + oneLine(stbi_failure_reason()));
   Image8 image;
   image.width = w;
   image.height = h;

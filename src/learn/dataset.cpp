@@ -74,7 +74,8 @@ class Reader {
   }
   size_t remaining() const { return bytes_.size() - pos_; }
   Error error(const std::string& what) const {
-    return makeError("dataset " + path_ + ": " + what + " (at byte " + std::to_string(pos_) + ")");
+    return makeError("dataset " + echoPath(path_) + ": " + what + " (at byte " +
+                     std::to_string(pos_) + ")");
   }
 
  private:
@@ -265,7 +266,7 @@ std::vector<DatasetSample> sampleDfaoitView(const RasterFrame& frame, uint32_t s
 Result<void> writeDataset(const std::string& path, const Dataset& data) {
   // what readDataset refuses is never written
   const auto refuse = [&](const std::string& problem) {
-    return makeError("dataset " + path + ": cannot write it: " + problem);
+    return makeError("dataset " + echoPath(path) + ": cannot write it: " + problem);
   };
   if (data.targetCount != 1 && data.targetCount != kCurveOutputs &&
       data.targetCount != kDfaoitTargetCount)
@@ -317,7 +318,7 @@ Result<void> writeDataset(const std::string& path, const Dataset& data) {
 
 Result<Dataset> readDataset(const std::string& path) {
   // opened once, every check on the descriptor (a FIFO or device would block or never end)
-  auto file = openRegularFile(path, "dataset " + path);
+  auto file = openRegularFile(path, "dataset " + echoPath(path));
   if (!file) return file.error();
   auto read = file->readText();
   if (!read) return read.error();
@@ -325,7 +326,7 @@ Result<Dataset> readDataset(const std::string& path) {
   Reader in(bytes, path);
   std::string magic;
   if (!in.getString(magic, sizeof kMagic) || std::memcmp(magic.data(), kMagic, sizeof kMagic) != 0)
-    return makeError("dataset " + path + ": not an mfr dataset (bad magic)");
+    return makeError("dataset " + echoPath(path) + ": not an mfr dataset (bad magic)");
   uint32_t version = 0, features = 0, targets = 0, sceneCount = 0;
   if (!in.get(version)) return in.error("truncated header");
   if (version != kDatasetVersion)
@@ -349,7 +350,7 @@ Result<Dataset> readDataset(const std::string& path) {
     if (!in.get(length) || length == 0 || length > kMaxName || !in.getString(name, length))
       return in.error("truncated or bad scene name");
     if (std::string problem = sceneNameProblem(name, i); !problem.empty())
-      return makeError("dataset " + path + ": " + problem);
+      return makeError("dataset " + echoPath(path) + ": " + problem);
     data.scenes.push_back(std::move(name));
   }
   uint32_t metadataLength = 0;
@@ -357,7 +358,7 @@ Result<Dataset> readDataset(const std::string& path) {
       !in.getString(data.metadata, metadataLength))
     return in.error("truncated or bad metadata");
   if (std::string problem = metadataProblem(data.metadata); !problem.empty())
-    return makeError("dataset " + path + ": " + problem);
+    return makeError("dataset " + echoPath(path) + ": " + problem);
   uint64_t count = 0;
   if (!in.get(count)) return in.error("truncated sample count");
   if (count > in.remaining() / perSample)
@@ -383,7 +384,7 @@ Result<Dataset> readDataset(const std::string& path) {
 
 Result<Compositing> datasetRule(const Dataset& data, const std::string& path) {
   if (std::string problem = metadataProblem(data.metadata); !problem.empty())
-    return makeError("dataset " + path + ": " + problem);
+    return makeError("dataset " + echoPath(path) + ": " + problem);
   const auto meta = nlohmann::json::parse(data.metadata, nullptr, false);
   if (!meta.is_object() || !meta.contains("composite")) return Compositing::Hybrid;
   const auto& declared = meta["composite"];
@@ -391,13 +392,13 @@ Result<Compositing> datasetRule(const Dataset& data, const std::string& path) {
     auto rule = parseCompositing(declared.get<std::string>());
     if (rule && kBufferFamilyRule(rule.value())) return rule.value();
   }
-  return makeError("dataset " + path + ": its metadata declares the compositing rule " +
+  return makeError("dataset " + echoPath(path) + ": its metadata declares the compositing rule " +
                    jsonExcerpt(declared, 60) + ", expected \"hybrid\" or \"kbuffer\"");
 }
 
 Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& path) {
   if (std::string problem = metadataProblem(data.metadata); !problem.empty())
-    return makeError("dataset " + path + ": " + problem);
+    return makeError("dataset " + echoPath(path) + ": " + problem);
   const auto meta = nlohmann::json::parse(data.metadata, nullptr, false);
   if (!meta.is_object()) return {};
   const bool dfaoit = data.targetCount == kDfaoitTargetCount;
@@ -414,7 +415,7 @@ Result<void> checkDatasetDefinitions(const Dataset& data, const std::string& pat
     const auto it = meta.find(key);
     if (it == meta.end()) continue;
     if (!it->is_string() || it->get<std::string>() != value)
-      return makeError("dataset " + path + ": its metadata declares " + key + " " +
+      return makeError("dataset " + echoPath(path) + ": its metadata declares " + key + " " +
                        jsonExcerpt(*it, 120) + ", this build computes \"" + value +
                        "\" (regenerate it with mfr dataset)");
   }

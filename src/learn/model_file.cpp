@@ -15,6 +15,7 @@
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/json_limits.hpp"
+#include "mfr/core/quote.hpp"
 
 namespace mfr::learn {
 namespace {
@@ -54,7 +55,7 @@ std::string cat(const Parts&... parts) {
 
 template <typename... Parts>
 Error fail(const std::string& name, const Parts&... parts) {
-  return makeError(cat(name, ": ", parts...));
+  return makeError(cat(echoPath(name), ": ", parts...));  // a path of any length, cut
 }
 
 std::string truncated(size_t expected, size_t actual, bool atLeast) {
@@ -261,7 +262,7 @@ Result<void> writeModel(const std::string& path, const Model& model) {
 
 Result<Model> readModel(const std::string& path) {
   // opened once, every check on the descriptor (a FIFO, device or directory is refused there)
-  auto file = openRegularFile(path, path);
+  auto file = openRegularFile(path, echoPath(path));
   if (!file) return file.error();
   if (file->size() > kMaxFileBytes) {
     return fail(path, "larger than any valid model file (at most ", kMaxFileBytes, " bytes)");

@@ -45,7 +45,7 @@ constexpr ModelKind curveKind(Compositing rule) {
 Result<void> checkModelFits(const learn::Model& model, const std::string& name,
                             const ModelKind& kind, bool requireTarget) {
   if (model.net.inputs() != kDkbFeatureCount || model.net.outputs() != kind.outputs)
-    return makeError("model " + name + ": " + kind.method + " needs 12 inputs and " +
+    return makeError("model " + echoPath(name) + ": " + kind.method + " needs 12 inputs and " +
                      std::to_string(kind.outputs) + (kind.outputs == 1 ? " output" : " outputs") +
                      ", not " + std::to_string(model.net.inputs()) + " and " +
                      std::to_string(model.net.outputs()));
@@ -58,17 +58,20 @@ Result<void> checkModelFits(const learn::Model& model, const std::string& name,
   };
   const std::string features = declared("features"), target = declared("target");
   if (features.empty())
-    return makeError("model " + name + ": its metadata does not declare the feature set \"" +
-                     kind.features + "\" (was it written by mfr train?)");
+    return makeError("model " + echoPath(name) +
+                     ": its metadata does not declare the feature set \"" + kind.features +
+                     "\" (was it written by mfr train?)");
   if (features != kind.features)
-    return makeError("model " + name + ": trained on the feature set \"" + oneLine(features, 80) +
-                     "\", this build computes \"" + kind.features + "\" (retrain it)");
+    return makeError("model " + echoPath(name) + ": trained on the feature set \"" +
+                     oneLine(features, 80) + "\", this build computes \"" + kind.features +
+                     "\" (retrain it)");
   if (target.empty() && requireTarget)
-    return makeError("model " + name + ": its metadata does not declare the target \"" +
+    return makeError("model " + echoPath(name) + ": its metadata does not declare the target \"" +
                      kind.target + "\" (retrain it)");
   if (!target.empty() && target != kind.target)
-    return makeError("model " + name + ": trained for the target \"" + oneLine(target, 120) +
-                     "\", this build's target is \"" + kind.target + "\" (retrain it)");
+    return makeError("model " + echoPath(name) + ": trained for the target \"" +
+                     oneLine(target, 120) + "\", this build's target is \"" + kind.target +
+                     "\" (retrain it)");
   return {};
 }
 
@@ -122,7 +125,7 @@ Result<Compositing> dkbModelRule(const learn::Model& model, const std::string& n
     auto rule = parseCompositing(declared.get<std::string>());
     if (rule && kBufferFamilyRule(rule.value())) return rule.value();
   }
-  return makeError("model " + name + ": its metadata declares the compositing rule " +
+  return makeError("model " + echoPath(name) + ": its metadata declares the compositing rule " +
                    jsonExcerpt(declared, 60) + ", expected \"hybrid\" or \"kbuffer\"");
 }
 
@@ -131,7 +134,7 @@ Result<void> checkDkbModelRule(const learn::Model& model, const std::string& nam
   auto declared = dkbModelRule(model, name);
   if (!declared) return declared.error();
   if (declared.value() != rule)
-    return makeError("model " + name + ": trained on " + toString(declared.value()) +
+    return makeError("model " + echoPath(name) + ": trained on " + toString(declared.value()) +
                      " compositing targets, the method composites " + toString(rule) +
                      " (use --composite " + toString(declared.value()) +
                      " or a model trained for " + toString(rule) + ")");

@@ -15,7 +15,8 @@ namespace mfr {
 
 /// Writes `bytes` to `path` atomically (its folder must exist): the data goes to a temporary file
 /// in the same folder (an unnamed O_TMPFILE where the file system has them, so a
-/// killed process leaves nothing behind; otherwise ".NAME.tmp.XXXXXX", removed on failure), is
+/// killed process leaves nothing behind; otherwise ".NAME.tmp.PID.N.T", removed on failure; NAME
+/// cut to 128 bytes, so that any name the file system takes, up to NAME_MAX, can be written), is
 /// fsync'ed, and replaces `path` by rename (an existing file's permissions are kept). A special
 /// file (a terminal, /dev/stdout, a pipe) has nothing to replace and is written directly.
 /// Errors ("PATH: cannot open for writing (...)", "PATH: write error (...)") name `path`; on error
