@@ -106,7 +106,8 @@ Result<void> checkPngChunks(const uint8_t* bytes, size_t size, const std::string
   return {};
 }
 
-Result<Image8> readPng(const std::string& path) {
+Result<Image8> readPng(const std::string& path,
+                       const std::function<Result<void>(int width, int height)>& beforeDecode) {
   // a regular file (a FIFO is refused, not waited on) of less than 2 GiB
   auto bytes = readRegularFileBytes(path, path, std::numeric_limits<int>::max());
   if (!bytes) return bytes.error();
@@ -122,6 +123,7 @@ Result<Image8> readPng(const std::string& path) {
                      (reason ? " (" + oneLine(reason) + ")" : std::string()));
   }
   MFR_TRY(checkImageDimensions(w, h, path));  // from the header, before decoding
+  if (beforeDecode) MFR_TRY(beforeDecode(w, h));
   unsigned char* data = stbi_load_from_memory(bytes->data(), size, &w, &h, &n, 4);
   // stb quotes the bytes of an unknown chunk type: keep the message on one line
   if (!data) return makeError(path + ": " + oneLine(stbi_failure_reason()));
