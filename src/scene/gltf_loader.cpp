@@ -460,6 +460,7 @@ class GltfSceneBuilder {
   Result<ElementRange> elementRange(int bufferViewIndex, size_t byteOffset, size_t count,
                                     size_t elementSize, bool allowStride,
                                     const std::string& what) const;
+  Result<void> checkAccessor(int index, int expectedType, const std::string& what) const;
   Result<std::vector<double>> readAccessor(int index, int expectedType,
                                            const std::string& what) const;
   Result<std::vector<double>> readColors(int index, size_t vertexCount,
@@ -520,10 +521,32 @@ Result<ElementRange> GltfSceneBuilder::elementRange(int bufferViewIndex, size_t 
   return ElementRange{data.data() + view.byteOffset + byteOffset, stride};
 }
 
+/// readAccessor's checks of accessor `index`, without reading it: it exists, has the type, and its
+/// count fits its bufferView (without one: the cap).
+Result<void> GltfSceneBuilder::checkAccessor(int index, int expectedType,
+                                             const std::string& what) const {
+  if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
+    return fail(what + ": accessor " + std::to_string(index) + " does not exist");
+  const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(index)];
+  const std::string where = what + " (accessor " + std::to_string(index) + ")";
+  if (accessor.type != expectedType) return fail(where + ": unexpected element type");
+  const size_t csize = componentSize(accessor.componentType);
+  if (csize == 0) return fail(where + ": invalid component type");
+  const size_t elementSize = csize * static_cast<size_t>(componentCount(accessor.type));
+  if (accessor.bufferView >= 0) {
+    auto range = elementRange(accessor.bufferView, accessor.byteOffset, accessor.count, elementSize,
+                              true, where);
+    return range ? Result<void>() : Result<void>(range.error());
+  }
+  if (accessor.count > (size_t{1} << 22)) return fail(where + ": count too large");
+  return {};
+}
+
 /// All components of accessor `index` as doubles (count * components values), sparse substitution
 /// applied. An accessor without a bufferView reads as zeros.
 Result<std::vector<double>> GltfSceneBuilder::readAccessor(int index, int expectedType,
                                                            const std::string& what) const {
+  MFR_TRY(checkAccessor(index, expectedType, what));
   if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
     return fail(what + ": accessor " + std::to_string(index) + " does not exist");
   const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(index)];
@@ -740,17 +763,36 @@ Result<void> GltfSceneBuilder::checkExpansion() {
     const tinygltf::Node& node = model_.nodes[static_cast<size_t>(index)];
     stack.insert(stack.end(), node.children.rbegin(), node.children.rend());
     if (node.mesh < 0 || static_cast<size_t>(node.mesh) >= model_.meshes.size()) continue;
+    if (const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
+        ext != node.extensions.end() && ext->second.Has("attributes") &&
+        ext->second.Get("attributes").IsObject()) {  // each count fits its bufferView
+      const tinygltf::Value& attributes = ext->second.Get("attributes");
+      const std::string what = "node " + std::to_string(index) + " EXT_mesh_gpu_instancing ";
+      const std::pair<const char*, int> kinds[3] = {{"TRANSLATION", TINYGLTF_TYPE_VEC3},
+                                                    {"ROTATION", TINYGLTF_TYPE_VEC4},
+                                                    {"SCALE", TINYGLTF_TYPE_VEC3}};
+      for (const auto& [name, type] : kinds)
+        if (attributes.Has(name) && attributes.Get(name).IsInt())
+          MFR_TRY(checkAccessor(attributes.Get(name).GetNumberAsInt(), type, what + name));
+    }
     const uint64_t instances = instanceCount(model_, node);
     // translation, rotation and scale read as doubles
     transient = std::max(transient, saturatingMul(instances, 10 * sizeof(double)));
-    for (const tinygltf::Primitive& primitive :
-         model_.meshes[static_cast<size_t>(node.mesh)].primitives) {
+    const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(node.mesh)];
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+      const tinygltf::Primitive& primitive = mesh.primitives[p];
+      const std::string what = "mesh " + std::to_string(node.mesh) + " (" +
+                               quoteInput(mesh.name, 60) + ") primitive " + std::to_string(p);
       const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
       const auto position = primitive.attributes.find("POSITION");
       if ((mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
            mode != TINYGLTF_MODE_TRIANGLE_FAN) ||
           position == primitive.attributes.end())
         continue;
+      // a count the file cannot hold is that error, not a memory one (as addPrimitive reads it)
+      MFR_TRY(checkAccessor(position->second, TINYGLTF_TYPE_VEC3, what + " POSITION"));
+      if (primitive.indices >= 0)
+        MFR_TRY(checkAccessor(primitive.indices, TINYGLTF_TYPE_SCALAR, what + " indices"));
       const std::optional<uint64_t> v = accessorCount(position->second);
       if (!v) continue;
       const uint64_t corners =
