@@ -418,6 +418,25 @@ def issue49_seeds():
     write("mfrds", "issue49_valid_v2.mfrds", dataset([b"procedural:layers"], meta, [0.0, 0.5, 1.0]))
 
 
+def issue49_memory_seeds():
+    """Issue 49 rows 4 and 5: small glTFs that expand past any memory limit (refused before they
+    are built, tests/test_reliability_memory.cpp)."""
+    accessor = {"componentType": 5126, "count": 4194304, "type": "VEC3",
+                "min": [0, 0, 0], "max": [0, 0, 0]}
+    nodes = [{"mesh": 0, "translation": [i, 0, 0]} for i in range(1024)]
+    write("gltf", "issue49_shared_zero_accessor.gltf", json.dumps({
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": list(range(len(nodes)))}],
+        "nodes": nodes, "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [accessor]}))
+    write("gltf", "issue49_instancing_zero_accessor.gltf", json.dumps({
+        "asset": {"version": "2.0"}, "extensionsUsed": ["EXT_mesh_gpu_instancing"], "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "extensions": {"EXT_mesh_gpu_instancing": {
+            "attributes": {"TRANSLATION": 1}}}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [accessor, {"componentType": 5126, "count": 4194304, "type": "VEC3"}]}))
+
+
 if __name__ == "__main__":
     gltf_seeds()
     obj_seeds()
@@ -431,4 +450,5 @@ if __name__ == "__main__":
     png_seeds()
     issue29_seeds()
     issue49_seeds()
+    issue49_memory_seeds()
     print("seeds written to", SEEDS)

@@ -107,7 +107,7 @@ TEST(Preflight, MemoryLimitOptionIsParsedAndDocumented) {
             static_cast<uint64_t>(static_cast<double>(bounds.physical) * 0.75));
   // a limit that fits renders
   const CliRun fits = mfr::test::runCliTimed(
-      "render procedural:spheres --width 64 --height 64 --memory-limit 64MB -q -o " +
+      "render procedural:spheres --width 64 --height 64 --memory-limit 128MB -q -o " +
           (scratch() / "fits.png").string(),
       scratch());
   EXPECT_EQ(fits.exitCode, 0) << fits.err;

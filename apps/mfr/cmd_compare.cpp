@@ -199,8 +199,8 @@ int run(const CompareArgs& a, const std::string& version) {
   options.seed = a.scene.seed;
   options.flipPixelsPerDegree = a.pixelsPerDegree;
   options.sampleStorage = a.scene.storage();
-  if (!(a.pixelsPerDegree > 0.0 && std::isfinite(a.pixelsPerDegree)))
-    return fail("--ppd: must be a positive number");
+  if (auto ppd = checkFlipPixelsPerDegree(a.pixelsPerDegree); !ppd)
+    return fail(ppd.error().message);
 
   // methods
   for (const std::string& name : splitList(a.methods)) {

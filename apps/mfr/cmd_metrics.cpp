@@ -10,7 +10,10 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
+#include "mfr/core/units.hpp"
+#include "mfr/method/make_method.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/metrics/image_metrics.hpp"
 
@@ -23,6 +26,7 @@ struct MetricsArgs {
   std::string flipMap;
   std::string errorMap;
   double pixelsPerDegree = kFlipDefaultPixelsPerDegree;
+  std::string memoryLimit;  // --memory-limit (empty: defaultMemoryLimit())
   bool json = false;
   bool quiet = false;
 };
@@ -45,21 +49,41 @@ std::string sizeText(const Image8& image) {
   return s;
 }
 
+/// What `mfr metrics` holds at its peak for two width x height images: both decoded (RGBA8),
+/// stb_image's buffers while the second decodes (its inflated rows and its output), FLIP's planes
+/// and error map, a copy of the map for the percentiles and the maps it writes.
+uint64_t metricsBytes(int width, int height) {
+  const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
+  return saturatingAdd(flipWorkingBytes(width, height), saturatingMul(pixels, 4 + 4 + 8 + 4 + 8));
+}
+
 int run(const MetricsArgs& a) {
   if (a.reference.empty() || a.test.empty())
     return fail("metrics: expected two images, REFERENCE.png TEST.png");
-  if (!std::isfinite(a.pixelsPerDegree) || a.pixelsPerDegree <= 0.0) {
-    std::string message = "--ppd must be a positive number, got ";
-    message += std::to_string(a.pixelsPerDegree);
-    return fail(message);
+  if (auto ppd = checkFlipPixelsPerDegree(a.pixelsPerDegree); !ppd)
+    return fail(ppd.error().message);
+  uint64_t limit = defaultMemoryLimit();
+  if (!a.memoryLimit.empty()) {
+    auto parsed = parseMemoryLimitOption(a.memoryLimit);
+    if (!parsed) return fail(parsed.error().message);
+    limit = parsed.value();
   }
   if (auto distinct =
           checkDistinctOutputs({{"--flip-map", a.flipMap}, {"--error-map", a.errorMap}});
       !distinct)
     return fail(distinct.error().message);
-  auto reference = readPng(a.reference);
+  // from each header, before its pixels are decoded (images of one size: the first check counts
+  // both)
+  const auto preflight = [limit](const std::string& path) {
+    return [limit, path](int width, int height) {
+      return checkMemory(metricsBytes(width, height), limit,
+                         echoPath(path) + ": " + std::to_string(width) + " x " +
+                             std::to_string(height) + " pixels: the two images and FLIP's buffers");
+    };
+  };
+  auto reference = readPng(a.reference, preflight(a.reference));
   if (!reference) return fail(reference.error().message);
-  auto test = readPng(a.test);
+  auto test = readPng(a.test, preflight(a.test));
   if (!test) return fail(test.error().message);
   if (reference->width != test->width || reference->height != test->height) {
     std::string message = echoPath(a.reference);
@@ -143,6 +167,12 @@ Runner addMetricsCommand(CLI::App& app) {
                   "Write the per-pixel squared sRGB error (magma, scaled to its maximum) as PNG");
   cmd->add_option("--ppd", args->pixelsPerDegree,
                   "FLIP pixels per degree (default 67.02: 0.7 m from a 0.7 m wide 4K display)");
+  cmd->add_option("--memory-limit", args->memoryLimit,
+                  "Refuse images whose decoding and FLIP need more than this, e.g. 8GB (default: " +
+                      std::to_string(static_cast<int>(kDefaultMemoryShare * 100)) +
+                      "% of the physical memory, of the address-space limit (ulimit -v) or of "
+                      "the cgroup's memory limit, whichever is least: " +
+                      formatBytes(defaultMemoryLimit()) + ")");
   cmd->add_flag("--json", args->json, "Print machine-readable JSON on stdout");
   cmd->add_flag("--quiet,-q", args->quiet, "Print nothing (errors still go to stderr)");
   return [args] { return run(*args); };

@@ -87,11 +87,17 @@ int run(int argc, char** argv) {
 #endif
   } catch (const std::bad_alloc&) {
     // the memory pre-flights let it through: named, never "std::bad_alloc"
+    // what to try instead, in the options the command takes
     const auto commands = app.get_subcommands();
-    std::fprintf(stderr,
-                 "mfr: error: out of memory in 'mfr %s' (smaller --width/--height or budgets, or "
-                 "a --memory-limit to refuse such runs before they allocate)\n",
-                 commands.empty() ? "" : commands.front()->get_name().c_str());
+    const std::string command = commands.empty() ? "" : commands.front()->get_name();
+    const bool sceneOptions = command == "render" || command == "info" || command == "compare" ||
+                              command == "dataset" || command == "view";
+    const char* advice = command == "metrics" ? " (smaller images, or a --memory-limit to refuse "
+                                                "such runs before they allocate)"
+                         : sceneOptions       ? " (smaller --width/--height or budgets, or a "
+                                                "--memory-limit to refuse such runs before they allocate)"
+                                              : "";
+    std::fprintf(stderr, "mfr: error: out of memory in 'mfr %s'%s\n", command.c_str(), advice);
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "mfr: error: %s\n",

@@ -32,7 +32,7 @@ Image8 imageOrPath(const py::object& image, const char* what) {
 }
 
 double pixelsPerDegree(double ppd) {
-  if (!(std::isfinite(ppd) && ppd > 0.0)) throw LibraryError("ppd: must be a positive number");
+  unwrap(checkFlipPixelsPerDegree(ppd, Spelling::Python));
   return ppd;
 }
 

@@ -278,8 +278,7 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   MFR_TRY(checkBudgetList(options.budgets));
   const bool anyRelative = std::any_of(options.budgets.begin(), options.budgets.end(),
                                        [](const BudgetSpec& b) { return b.isRelative(); });
-  if (!(options.flipPixelsPerDegree > 0.0 && std::isfinite(options.flipPixelsPerDegree)))
-    return makeError("FLIP pixels per degree: must be finite and positive");
+  MFR_TRY(checkFlipPixelsPerDegree(options.flipPixelsPerDegree));
 
   const int w = view.width(), h = view.height();
   CompareProgress progress{options, 1 + static_cast<int>(methods->size() * options.budgets.size())};

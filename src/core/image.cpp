@@ -107,7 +107,8 @@ Result<void> checkPngChunks(const uint8_t* bytes, size_t size, const std::string
   return {};
 }
 
-Result<Image8> readPng(const std::string& path) {
+Result<Image8> readPng(const std::string& path,
+                       const std::function<Result<void>(int width, int height)>& beforeDecode) {
   // a regular file (a FIFO is refused, not waited on) of less than 2 GiB
   const std::string what = echoPath(path);  // a path of any length, cut for the message
   auto bytes = readRegularFileBytes(path, what, std::numeric_limits<int>::max());
@@ -124,6 +125,7 @@ Result<Image8> readPng(const std::string& path) {
                      (reason ? " (" + oneLine(reason) + ")" : std::string()));
   }
   MFR_TRY(checkImageDimensions(w, h, what));  // from the header, before decoding
+  if (beforeDecode) MFR_TRY(beforeDecode(w, h));
   unsigned char* data = stbi_load_from_memory(bytes->data(), size, &w, &h, &n, 4);
   // stb quotes the bytes of an unknown chunk type: keep the message on one line
   if (!data) return makeError(what + ": " + oneLine(stbi_failure_reason()));

@@ -51,6 +51,10 @@ struct ClipVertex {
   glm::vec4 color;  // linear RGBA (white without vertex colours)
 };
 
+// what sceneMemoryBytes (mfr/scene/scene.hpp) counts for a frame
+static_assert(sizeof(ClipVertex) <= kSceneBytesPerVertex - 48);
+static_assert(2 * (sizeof(TriangleSetup) + sizeof(TriangleColors)) <= kSceneBytesPerTriangle - 16);
+
 ClipVertex lerp(const ClipVertex& a, const ClipVertex& b, float t) {
   return {glm::mix(a.clip, b.clip, t), glm::mix(a.normal, b.normal, t), glm::mix(a.uv, b.uv, t),
           glm::mix(a.color, b.color, t)};
@@ -297,6 +301,7 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
     tbb::parallel_for(size_t{0}, chunks, [&](size_t chunk) {
       std::vector<TriangleSetup>& out = chunkSetups[chunk];
       const size_t end = std::min(triangleCount, (chunk + 1) * kChunk);
+      out.reserve(end - chunk * kChunk);  // one set-up a triangle, not twice that by doubling
       for (size_t tri = chunk * kChunk; tri < end; ++tri) {
         const uint32_t prim = static_cast<uint32_t>(tri);
         const uint32_t material = scene.triangleMaterial[tri];

@@ -27,11 +27,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "mfr/core/memory_limit.hpp"
 #include "mfr/metrics/magma.hpp"
 
 namespace mfr {
@@ -322,9 +324,7 @@ Result<void> checkFlipInputs(const Image8& reference, const Image8& test, double
   const size_t n = static_cast<size_t>(reference.width) * static_cast<size_t>(reference.height);
   if (reference.rgba.size() != n * 4 || test.rgba.size() != n * 4)
     return makeError("FLIP: image pixel data does not match its size");
-  if (!std::isfinite(pixelsPerDegree) || pixelsPerDegree <= 0.0)
-    return makeError("FLIP: pixels per degree must be finite and positive");
-  return {};
+  return checkFlipPixelsPerDegree(pixelsPerDegree);
 }
 
 // Stage 2a: spatial (CSF) filtering along rows: Y, Cx and the two Cz terms of both images
@@ -447,6 +447,27 @@ void featureErrors(const RowPlanes& rows, const FeatureFilters& ff, const Plane&
 }
 
 }  // namespace
+
+Result<void> checkFlipPixelsPerDegree(double pixelsPerDegree, Spelling spelling) {
+  if (pixelsPerDegree >= kFlipMinPixelsPerDegree && pixelsPerDegree <= kFlipMaxPixelsPerDegree)
+    return {};  // false for NaN
+  char text[160];
+  std::snprintf(text, sizeof text,
+                " %g: FLIP's pixels per degree must be in [%g, %g] (its filters are 0.27 ppd "
+                "pixels wide; the default is %.2f)",
+                pixelsPerDegree, kFlipMinPixelsPerDegree, kFlipMaxPixelsPerDegree,
+                kFlipDefaultPixelsPerDegree);
+  return makeError(spell(spelling, "--ppd") + text);
+}
+
+uint64_t flipWorkingBytes(int width, int height) {
+  // per pixel: both images' Y, Cx, Cz planes (6 floats), the eight filtered planes, the colour
+  // difference and the error map
+  constexpr uint64_t kPerPixel = (6 + 8 + 1 + 1) * sizeof(float);
+  return saturatingMul(
+      static_cast<uint64_t>(std::max(width, 0)) * static_cast<uint64_t>(std::max(height, 0)),
+      kPerPixel);
+}
 
 Result<FlipResult> computeFlip(const Image8& reference, const Image8& test,
                                double pixelsPerDegree) {

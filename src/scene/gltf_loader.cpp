@@ -466,11 +466,14 @@ class GltfSceneBuilder {
   Result<ElementRange> elementRange(int bufferViewIndex, size_t byteOffset, size_t count,
                                     size_t elementSize, bool allowStride,
                                     const std::string& what) const;
+  Result<void> checkAccessor(int index, int expectedType, const std::string& what) const;
   Result<std::vector<double>> readAccessor(int index, int expectedType,
                                            const std::string& what) const;
   Result<std::vector<double>> readColors(int index, size_t vertexCount,
                                          const std::string& what) const;
   Result<UvTransform> baseColorUvTransform(int gltfMaterial) const;
+  Result<std::vector<int>> rootNodes() const;
+  Result<void> checkExpansion();
   Result<void> visitNodes();
   Result<void> addMeshInstances(const tinygltf::Node& node, int nodeIndex, const glm::dmat4& world);
   Result<void> addMesh(int meshIndex, const glm::dmat4& world);
@@ -524,10 +527,32 @@ Result<ElementRange> GltfSceneBuilder::elementRange(int bufferViewIndex, size_t 
   return ElementRange{data.data() + view.byteOffset + byteOffset, stride};
 }
 
+/// readAccessor's checks of accessor `index`, without reading it: it exists, has the type, and its
+/// count fits its bufferView (without one: the cap).
+Result<void> GltfSceneBuilder::checkAccessor(int index, int expectedType,
+                                             const std::string& what) const {
+  if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
+    return fail(what + ": accessor " + std::to_string(index) + " does not exist");
+  const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(index)];
+  const std::string where = what + " (accessor " + std::to_string(index) + ")";
+  if (accessor.type != expectedType) return fail(where + ": unexpected element type");
+  const size_t csize = componentSize(accessor.componentType);
+  if (csize == 0) return fail(where + ": invalid component type");
+  const size_t elementSize = csize * static_cast<size_t>(componentCount(accessor.type));
+  if (accessor.bufferView >= 0) {
+    auto range = elementRange(accessor.bufferView, accessor.byteOffset, accessor.count, elementSize,
+                              true, where);
+    return range ? Result<void>() : Result<void>(range.error());
+  }
+  if (accessor.count > (size_t{1} << 22)) return fail(where + ": count too large");
+  return {};
+}
+
 /// All components of accessor `index` as doubles (count * components values), sparse substitution
 /// applied. An accessor without a bufferView reads as zeros.
 Result<std::vector<double>> GltfSceneBuilder::readAccessor(int index, int expectedType,
                                                            const std::string& what) const {
+  MFR_TRY(checkAccessor(index, expectedType, what));
   if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
     return fail(what + ": accessor " + std::to_string(index) + " does not exist");
   const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(index)];
@@ -678,35 +703,145 @@ glm::dmat4 localTransform(const tinygltf::Node& node) {
   return m;
 }
 
-/// Walks the chosen scene's node trees (iteratively: depth is not bounded by the stack). The glTF
-/// node hierarchy must be disjoint strict trees, so a node reached twice (cycle or shared child)
-/// makes the file invalid.
-Result<void> GltfSceneBuilder::visitNodes() {
-  std::vector<int> roots;
+/// The chosen scene's root nodes: `--scene N`, else the file's `scene`, else its first, else every
+/// node that is no other node's child.
+Result<std::vector<int>> GltfSceneBuilder::rootNodes() const {
   if (options_.sceneIndex) {
     const int n = *options_.sceneIndex;
     if (n < 0 || static_cast<size_t>(n) >= model_.scenes.size())
       return fail("scene " + std::to_string(n) + ": the file has " +
                   std::to_string(model_.scenes.size()) + " scene(s)");
-    roots = model_.scenes[static_cast<size_t>(n)].nodes;
-  } else if (model_.defaultScene >= 0 &&
-             static_cast<size_t>(model_.defaultScene) < model_.scenes.size())
-    roots = model_.scenes[static_cast<size_t>(model_.defaultScene)].nodes;
-  else if (!model_.scenes.empty())
-    roots = model_.scenes[0].nodes;
-  else {
-    std::vector<char> isChild(model_.nodes.size(), 0);
-    for (const tinygltf::Node& node : model_.nodes)
-      for (int child : node.children)
-        if (child >= 0 && static_cast<size_t>(child) < isChild.size())
-          isChild[static_cast<size_t>(child)] = 1;
-    for (size_t i = 0; i < model_.nodes.size(); ++i)
-      if (!isChild[i]) roots.push_back(static_cast<int>(i));
+    return model_.scenes[static_cast<size_t>(n)].nodes;
   }
+  if (model_.defaultScene >= 0 && static_cast<size_t>(model_.defaultScene) < model_.scenes.size())
+    return model_.scenes[static_cast<size_t>(model_.defaultScene)].nodes;
+  if (!model_.scenes.empty()) return model_.scenes[0].nodes;
+  std::vector<int> roots;
+  std::vector<char> isChild(model_.nodes.size(), 0);
+  for (const tinygltf::Node& node : model_.nodes)
+    for (int child : node.children)
+      if (child >= 0 && static_cast<size_t>(child) < isChild.size())
+        isChild[static_cast<size_t>(child)] = 1;
+  for (size_t i = 0; i < model_.nodes.size(); ++i)
+    if (!isChild[i]) roots.push_back(static_cast<int>(i));
+  return roots;
+}
 
+/// The instances EXT_mesh_gpu_instancing gives a node: its first attribute accessor's count (1
+/// without the extension; addMeshInstances checks the attributes themselves).
+size_t instanceCount(const tinygltf::Model& model, const tinygltf::Node& node) {
+  const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
+  if (ext == node.extensions.end() || !ext->second.Has("attributes") ||
+      !ext->second.Get("attributes").IsObject())
+    return 1;
+  const tinygltf::Value& attributes = ext->second.Get("attributes");
+  for (const char* name : {"TRANSLATION", "ROTATION", "SCALE"}) {
+    if (!attributes.Has(name) || !attributes.Get(name).IsInt()) continue;
+    const int accessor = attributes.Get(name).GetNumberAsInt();
+    if (accessor >= 0 && static_cast<size_t>(accessor) < model.accessors.size())
+      return model.accessors[static_cast<size_t>(accessor)].count;
+  }
+  return 1;
+}
+
+/// What the node tree expands into, before any of it is built: the vertices and triangles of
+/// every mesh as often as nodes and EXT_mesh_gpu_instancing place it (a 4-million-vertex accessor
+/// of zeros is 622 bytes of JSON; used by 16 nodes it would be 6.5 GB), times their bytes
+/// (sceneMemoryBytes), plus the largest primitive's and instance list's read-out (doubles), against
+/// the memory limit. The scene's arrays are then reserved once at their final size.
+Result<void> GltfSceneBuilder::checkExpansion() {
+  auto roots = rootNodes();
+  if (!roots) return roots.error();
+  const auto accessorCount = [&](int index) -> std::optional<uint64_t> {
+    if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size()) return std::nullopt;
+    return model_.accessors[static_cast<size_t>(index)].count;
+  };
+  uint64_t vertices = 0, triangles = 0, transient = 0;
+  std::vector<char> visited(model_.nodes.size(), 0);
+  std::vector<int> stack(roots->rbegin(), roots->rend());
+  while (!stack.empty()) {
+    const int index = stack.back();
+    stack.pop_back();
+    if (index < 0 || static_cast<size_t>(index) >= model_.nodes.size() ||
+        visited[static_cast<size_t>(index)])
+      continue;  // visitNodes names it
+    visited[static_cast<size_t>(index)] = 1;
+    const tinygltf::Node& node = model_.nodes[static_cast<size_t>(index)];
+    stack.insert(stack.end(), node.children.rbegin(), node.children.rend());
+    if (node.mesh < 0 || static_cast<size_t>(node.mesh) >= model_.meshes.size()) continue;
+    if (const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
+        ext != node.extensions.end() && ext->second.Has("attributes") &&
+        ext->second.Get("attributes").IsObject()) {  // each count fits its bufferView
+      const tinygltf::Value& attributes = ext->second.Get("attributes");
+      const std::string what = "node " + std::to_string(index) + " EXT_mesh_gpu_instancing ";
+      const std::pair<const char*, int> kinds[3] = {{"TRANSLATION", TINYGLTF_TYPE_VEC3},
+                                                    {"ROTATION", TINYGLTF_TYPE_VEC4},
+                                                    {"SCALE", TINYGLTF_TYPE_VEC3}};
+      for (const auto& [name, type] : kinds)
+        if (attributes.Has(name) && attributes.Get(name).IsInt())
+          MFR_TRY(checkAccessor(attributes.Get(name).GetNumberAsInt(), type, what + name));
+    }
+    const uint64_t instances = instanceCount(model_, node);
+    // translation, rotation and scale read as doubles
+    transient = std::max(transient, saturatingMul(instances, 10 * sizeof(double)));
+    const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(node.mesh)];
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) {
+      const tinygltf::Primitive& primitive = mesh.primitives[p];
+      const std::string what = "mesh " + std::to_string(node.mesh) + " (" +
+                               quoteInput(mesh.name, 60) + ") primitive " + std::to_string(p);
+      const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
+      const auto position = primitive.attributes.find("POSITION");
+      if ((mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+           mode != TINYGLTF_MODE_TRIANGLE_FAN) ||
+          position == primitive.attributes.end())
+        continue;
+      // a count the file cannot hold is that error, not a memory one (as addPrimitive reads it)
+      MFR_TRY(checkAccessor(position->second, TINYGLTF_TYPE_VEC3, what + " POSITION"));
+      if (primitive.indices >= 0)
+        MFR_TRY(checkAccessor(primitive.indices, TINYGLTF_TYPE_SCALAR, what + " indices"));
+      const std::optional<uint64_t> v = accessorCount(position->second);
+      if (!v) continue;
+      const uint64_t corners =
+          primitive.indices >= 0 ? accessorCount(primitive.indices).value_or(0) : *v;
+      const uint64_t t =
+          mode == TINYGLTF_MODE_TRIANGLES ? corners / 3 : (corners > 2 ? corners - 2 : 0);
+      vertices = saturatingAdd(vertices, saturatingMul(*v, instances));
+      triangles = saturatingAdd(triangles, saturatingMul(t, instances));
+      // addPrimitive's read-out: position, normal, uv and colour as doubles, the indices as doubles
+      // and twice as 32-bit corners
+      transient = std::max(transient, saturatingAdd(saturatingMul(*v, (3 + 3 + 2 + 7) * 8),
+                                                    saturatingMul(corners, 8 + 4 + 4)));
+    }
+  }
+  const uint64_t needed = saturatingAdd(sceneMemoryBytes(vertices, triangles), transient);
+  if (auto fits =
+          checkMemory(needed, memoryLimit_,
+                      "the " + std::to_string(vertices) + " vertices and " +
+                          std::to_string(triangles) + " triangles its nodes and instances place");
+      !fits)
+    return fail(fits.error().message);
+  if (vertices > std::numeric_limits<uint32_t>::max())
+    return fail("more than 2^32 vertices in the scene (" + std::to_string(vertices) +
+                " after node references and instancing)");
+  scene_.positions.reserve(vertices);
+  scene_.normals.reserve(vertices);
+  scene_.uvs.reserve(vertices);
+  scene_.colors.reserve(vertices);
+  scene_.indices.reserve(saturatingMul(triangles, 3));
+  scene_.triangleMaterial.reserve(triangles);
+  return {};
+}
+
+/// Walks the chosen scene's node trees (iteratively: depth is not bounded by the stack). The glTF
+/// node hierarchy must be disjoint strict trees, so a node reached twice (cycle or shared child)
+/// makes the file invalid.
+Result<void> GltfSceneBuilder::visitNodes() {
+  auto roots = rootNodes();
+  if (!roots) return roots.error();
   std::vector<char> visited(model_.nodes.size(), 0);
   std::vector<std::pair<int, glm::dmat4>> stack;
-  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.emplace_back(*it, glm::dmat4(1.0));
+  for (auto it = roots->rbegin(); it != roots->rend(); ++it)
+    stack.emplace_back(*it, glm::dmat4(1.0));
   while (!stack.empty()) {
     const auto [index, parent] = stack.back();
     stack.pop_back();
@@ -754,12 +889,7 @@ Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int 
     values[a] = std::move(*read);
   }
   if (!count) return addMesh(node.mesh, world);
-  // the scene's vertex data (positions, normals, uvs, colours) and index data (indices, materials)
-  const auto sceneBytes = [this] {
-    return scene_.positions.size() * (sizeof(glm::vec3) * 3 + sizeof(glm::vec4)) +
-           scene_.indices.size() * sizeof(uint32_t) * 2;
-  };
-  const size_t before = sceneBytes();
+  // their vertices and triangles were checked against the memory limit (checkExpansion)
   for (size_t i = 0; i < *count; ++i) {
     glm::dmat4 instance(1.0);
     if (!values[0].empty())
@@ -776,13 +906,6 @@ Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int 
       instance = glm::scale(
           instance, glm::dvec3(values[2][3 * i], values[2][3 * i + 1], values[2][3 * i + 2]));
     MFR_TRY(addMesh(node.mesh, world * instance));
-    if (i == 0) {  // what one instance costs, times the count, against the memory limit
-      if (auto fits =
-              checkMemory(saturatingAdd(before, saturatingMul(sceneBytes() - before, *count)),
-                          memoryLimit_, "its " + std::to_string(*count) + " instances");
-          !fits)
-        return fail(what + ": " + fits.error().message);
-    }
   }
   return {};
 }
@@ -1189,10 +1312,11 @@ Result<Scene> GltfSceneBuilder::build() {
     if (!isImplementedExtension(extension))
       return fail("requires extension " + quoteInput(extension) + ", which mfr does not implement");
   MFR_TRY(readSamplers());
+  MFR_TRY(checkExpansion());
   MFR_TRY(visitNodes());
   MFR_TRY(decodeTextures());
-  if (!anyUvs_) scene_.uvs.clear();
-  if (!anyColors_) scene_.colors.clear();
+  if (!anyUvs_) std::vector<glm::vec2>().swap(scene_.uvs);  // freed, not only emptied
+  if (!anyColors_) std::vector<glm::vec4>().swap(scene_.colors);
   MFR_TRY(addCameras());
   MFR_TRY(validateScene(scene_));
   return std::move(scene_);

@@ -80,10 +80,11 @@ Result<Scene> loadScene(const std::string& source, const LoadOptions& options) {
   if (options.sceneIndex && source.rfind(prefix, 0) == 0)
     return makeError(echoPath(source) + ": scene " + std::to_string(*options.sceneIndex) +
                      ": only glTF files hold several scenes");
-  Result<Scene> loaded = source.rfind(prefix, 0) == 0
-                             ? makeProceduralScene(source.substr(prefix.size()), options.seed,
-                                                   options.maxProceduralTriangles)
-                             : loadFile(source, options);
+  Result<Scene> loaded =
+      source.rfind(prefix, 0) == 0
+          ? makeProceduralScene(source.substr(prefix.size()), options.seed,
+                                options.maxProceduralTriangles, options.memoryLimitBytes)
+          : loadFile(source, options);
   if (!loaded) {  // make sure the message names the source (procedural errors may not)
     std::string message = loaded.error().message;
     if (message.find(source) == std::string::npos)

@@ -2,6 +2,7 @@
 // (one file each: procedural_layers/hairball/smoke/bottles/spheres.cpp) and the helpers they share
 // (parameter reader, colours, framing, tube / lathe / sphere mesh builders).
 #include "mfr/scene/procedural.hpp"
+#include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 
 #include <algorithm>
@@ -108,6 +109,12 @@ Result<void> checkTriangleBudget(const ParamReader& params, double triangles) {
   if (!(triangles <= params.maxTriangles()))
     return params.fail("parameters produce " + formatNumber(std::round(triangles)) +
                        " triangles (limit " + formatNumber(params.maxTriangles()) + ")");
+  const auto count = static_cast<uint64_t>(std::ceil(triangles));  // within the cap above
+  if (auto fits = checkMemory(sceneMemoryBytes(2 * count, count), params.memoryLimit(),
+                              "its " + std::to_string(count) + " triangles and up to " +
+                                  std::to_string(2 * count) + " vertices");
+      !fits)
+    return params.fail(fits.error().message);
   return {};
 }
 
@@ -362,7 +369,8 @@ std::vector<std::string> proceduralSceneNames() {
   return names;
 }
 
-Result<Scene> makeProceduralScene(const std::string& spec, uint64_t seed, double maxTriangles) {
+Result<Scene> makeProceduralScene(const std::string& spec, uint64_t seed, double maxTriangles,
+                                  std::optional<uint64_t> memoryLimitBytes) {
   using namespace procedural;
   std::string_view text = spec;
   if (text.starts_with("procedural:")) text.remove_prefix(std::string_view("procedural:").size());
@@ -417,7 +425,7 @@ Result<Scene> makeProceduralScene(const std::string& spec, uint64_t seed, double
     blend = *mode;
   }
 
-  ParamReader reader(prefix, params, maxTriangles);
+  ParamReader reader(prefix, params, maxTriangles, memoryLimitBytes.value_or(defaultMemoryLimit()));
   Result<Scene> scene = def->build(reader, seed);
   if (!scene) return scene.error();
   if (blend)

@@ -98,8 +98,11 @@ class Rng {
 class ParamReader {
  public:
   ParamReader(std::string prefix, const ProceduralParams& params,
-              double maxTriangles = kMaxTriangles)
-      : prefix_(std::move(prefix)), params_(params), maxTriangles_(maxTriangles) {}
+              double maxTriangles = kMaxTriangles, uint64_t memoryLimit = UINT64_MAX)
+      : prefix_(std::move(prefix)),
+        params_(params),
+        maxTriangles_(maxTriangles),
+        memoryLimit_(memoryLimit) {}
 
   /// Integer in [lo, hi].
   int64_t integer(std::string_view key, int64_t fallback, int64_t lo, int64_t hi);
@@ -110,6 +113,8 @@ class ParamReader {
   const std::string& prefix() const { return prefix_; }
   /// The triangle cap checkTriangleBudget applies.
   double maxTriangles() const { return maxTriangles_; }
+  /// The memory limit checkTriangleBudget applies (sceneMemoryBytes).
+  uint64_t memoryLimit() const { return memoryLimit_; }
   /// An error whose message is "<prefix>: <message>".
   Error fail(const std::string& message) const { return makeError(prefix_ + ": " + message); }
 
@@ -120,11 +125,15 @@ class ParamReader {
   std::string prefix_;
   const ProceduralParams& params_;
   double maxTriangles_;
+  uint64_t memoryLimit_;
   std::optional<Error> error_;
 };
 
 /// Error unless `triangles` (computed in floating point so it cannot overflow) is within the cap
-/// (params.maxTriangles()).
+/// (params.maxTriangles()) and the scene they make fits the memory limit (params.memoryLimit()):
+/// sceneMemoryBytes of the triangles and twice as many vertices (no scene makes more: a billboard
+/// quad has 4 vertices and 2 triangles, a box 24 and 12, a tube or lathe fewer). Every builder
+/// calls it before it allocates.
 Result<void> checkTriangleBudget(const ParamReader& params, double triangles);
 
 /// Shortest round-trip decimal form of a double ("0.5", "1e-06").

@@ -4,9 +4,22 @@
 #include <cstdio>
 #include <limits>
 
+#include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 
 namespace mfr {
+
+uint64_t sceneMemoryBytes(uint64_t vertices, uint64_t triangles) {
+  return saturatingAdd(saturatingMul(vertices, kSceneBytesPerVertex),
+                       saturatingMul(triangles, kSceneBytesPerTriangle));
+}
+
+Result<void> checkSceneMemory(uint64_t vertices, uint64_t triangles, uint64_t limit,
+                              const std::string& what) {
+  return checkMemory(sceneMemoryBytes(vertices, triangles), limit,
+                     what + ": its " + std::to_string(vertices) + " vertices and " +
+                         std::to_string(triangles) + " triangles");
+}
 
 Bounds sceneBounds(const Scene& scene) {
   Bounds b;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,9 @@ ImageRGB decodeSrgb(const Image8& image);
 Result<void> checkPngChunks(const uint8_t* bytes, size_t size, const std::string& what);
 
 Result<void> writePng(const std::string& path, const Image8& image);
-Result<Image8> readPng(const std::string& path);
+/// `beforeDecode`, when given, is called with the header's width and height before the pixels are
+/// decoded (a caller's memory pre-flight): its error is readPng's.
+Result<Image8> readPng(const std::string& path,
+                       const std::function<Result<void>(int width, int height)>& beforeDecode = {});
 
 }  // namespace mfr

@@ -27,7 +27,9 @@ struct LoadOptions {
   /// is opened (mfr/core/file_access.hpp). True lifts the folder rule (CLI
   /// `--allow-outside-references`); FIFOs, devices and other non-regular files stay refused.
   bool allowOutsideReferences = false;
-  /// Memory pre-flight for what a file makes the loader allocate (decoded textures); none:
+  /// Memory pre-flight for what a source makes the loader allocate: decoded textures, and the
+  /// scene it expands into (sceneMemoryBytes of its vertices and triangles after glTF node
+  /// references, instancing and procedural parameters), checked before it is built; none:
   /// defaultMemoryLimit() (mfr/core/memory_limit.hpp).
   std::optional<uint64_t> memoryLimitBytes;
   /// glTF: which of the file's scenes (`--scene N`); none: the file's `scene`, else its first.

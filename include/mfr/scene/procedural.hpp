@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,8 +23,10 @@ inline constexpr double kMaxProceduralTriangles = 50'000'000.0;
 
 /// Builds "NAME[?key=value&...]" (the part after "procedural:"). Unknown names or parameters, and
 /// values that do not parse or are out of range, are errors naming them, as are parameters that
-/// would produce more than `maxTriangles` triangles (checked before anything is built).
+/// would produce more than `maxTriangles` triangles or a scene whose sceneMemoryBytes exceed
+/// `memoryLimitBytes` (none: defaultMemoryLimit()), both checked before anything is built.
 Result<Scene> makeProceduralScene(const std::string& spec, uint64_t seed,
-                                  double maxTriangles = kMaxProceduralTriangles);
+                                  double maxTriangles = kMaxProceduralTriangles,
+                                  std::optional<uint64_t> memoryLimitBytes = std::nullopt);
 
 }  // namespace mfr

@@ -135,6 +135,23 @@ inline constexpr float kMaxCoordinate = 1e18f;
 /// +-kMaxCoordinate, at least one triangle). The message names the scene.
 Result<void> validateScene(const Scene& scene);
 
+/// What a scene costs per vertex and per triangle once loaded and set up for a view: its own arrays
+/// (a position, normal, uv and colour, 48 bytes; three indices and a material, 16 bytes) and the
+/// CPU raster's copies (RasterFrame::build: a transformed vertex; a triangle set-up and its vertex
+/// colours, held twice while the set-ups are gathered). The loaders compute a file's or a
+/// procedural scene's vertices and triangles, after node references, instancing and parameters,
+/// and check sceneMemoryBytes against the memory limit before they build anything.
+inline constexpr uint64_t kSceneBytesPerVertex = 48 + 64;
+inline constexpr uint64_t kSceneBytesPerTriangle = 16 + 384;
+
+/// vertices * kSceneBytesPerVertex + triangles * kSceneBytesPerTriangle, saturating.
+uint64_t sceneMemoryBytes(uint64_t vertices, uint64_t triangles);
+
+/// checkMemory (mfr/core/memory_limit.hpp) of sceneMemoryBytes: "<what>: its 16777216 vertices and
+/// 5592405 triangles need 3.83 GiB (...), more than the memory limit of 256.00 MiB (...)".
+Result<void> checkSceneMemory(uint64_t vertices, uint64_t triangles, uint64_t limit,
+                              const std::string& what);
+
 /// Fills `normals` with area-weighted vertex normals when empty.
 void computeVertexNormals(Scene& scene);
 
