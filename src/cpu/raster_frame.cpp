@@ -262,6 +262,7 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   frame.camera_ = fitClipPlanes(cameraIn, sceneBounds(scene));
   frame.materials_ = resolveMaterials(scene);
   frame.cull_ = scene.cull;
+  frame.sceneBytes_ = sceneMemoryBytes(scene.vertexCount(), scene.triangleCount());
 
   const glm::mat4 view = viewMatrix(frame.camera_);
   const glm::mat4 viewProj = projectionMatrix(frame.camera_, options.width, options.height) * view;

@@ -154,15 +154,21 @@ uint64_t perPixelBytes(const MethodDesc& method, const MemoryModel& memory) {
   return bytes;
 }
 
-/// checkPixelBuffers against `limit`.
+/// " and the scene's N" for a pre-flight message that counts the scene's `sceneBytes` too.
+std::string besideScene(uint64_t sceneBytes) {
+  return sceneBytes == 0 ? std::string() : " and the scene's " + formatBytes(sceneBytes);
+}
+
+/// checkPixelBuffers against `limit`, beside the `sceneBytes` the scene already holds.
 Result<void> checkPixelBytes(int width, int height, const MethodDesc& method, CaptureMode capture,
-                             uint64_t limit) {
+                             uint64_t limit, uint64_t sceneBytes = 0) {
   if (width < 1 || height < 1 || width > kMaxImageSize || height > kMaxImageSize)
     return {};  // RasterFrame::build names a bad size
   const uint64_t pixels = static_cast<uint64_t>(width) * static_cast<uint64_t>(height);
   const MemoryModel memory = MemoryModel::of(method, capture == CaptureMode::FragmentParallel);
-  return checkMemory(saturatingMul(pixels, perPixelBytes(method, memory)), limit,
-                     renderWhat(width, height, method) + ": its per-pixel buffers");
+  return checkMemory(
+      saturatingAdd(saturatingMul(pixels, perPixelBytes(method, memory)), sceneBytes), limit,
+      renderWhat(width, height, method) + ": its per-pixel buffers" + besideScene(sceneBytes));
 }
 
 }  // namespace
@@ -276,7 +282,7 @@ Result<void> checkNodePool(const RasterFrame& frame, const MethodDesc& method,
       saturatingMul(alloc.slots, ownNodes ? memory.node : sizeof(FragmentNode));
   const uint64_t perPixel = 4 + sizeof(glm::vec3) + memory.lock + memory.occupancy + memory.tail +
                             memory.accum + memory.head;
-  uint64_t held = ledger.total();
+  uint64_t held = saturatingAdd(ledger.total(), frame.sceneBytes());
   for (const char* freed : {"oracle_prepass", "allocation_scratch"})
     if (auto it = ledger.byCategory().find(freed); it != ledger.byCategory().end())
       held -= it->second;
@@ -285,7 +291,7 @@ Result<void> checkNodePool(const RasterFrame& frame, const MethodDesc& method,
                     saturatingMul(frame.pixelCount(), perPixel));
   return checkMemory(needed, memoryLimit,
                      renderWhat(frame, method) + ": its " + std::to_string(alloc.slots) +
-                         " fragment slots and buffers");
+                         " fragment slots and buffers" + besideScene(frame.sceneBytes()));
 }
 
 /// `n` copies of `value` in `v`, which keeps its block (from an earlier frame, FrameBuffers) only
@@ -381,7 +387,8 @@ static Result<RenderOutput> renderPasses(const RasterFrame& frame, const MethodD
       MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
   // memory pre-flight: the per-pixel buffers here (callers may have checked them before
   // building the frame), the node pool after allocate
-  MFR_TRY(checkPixelBytes(frame.width(), frame.height(), method, options.capture, memoryLimit));
+  MFR_TRY(checkPixelBytes(frame.width(), frame.height(), method, options.capture, memoryLimit,
+                          frame.sceneBytes()));
 
   // the passes before the allocation: n(p), the importance map, the oracle's k(p)
   AllocationInputs inputs;

@@ -146,6 +146,9 @@ class RasterFrame {
   const Camera& camera() const { return camera_; }
   /// The scene's cull mode (Scene::cull), recorded in the statistics.
   CullMode cull() const { return cull_; }
+  /// What the scene and this frame's copies of it hold (sceneMemoryBytes of its vertices and
+  /// triangles): the render's memory pre-flight counts it beside its own buffers.
+  uint64_t sceneBytes() const { return sceneBytes_; }
 
   int tileSize() const { return tileSize_; }
   int tileCount() const { return tilesX_ * tilesY_; }
@@ -207,6 +210,7 @@ class RasterFrame {
   int32_t sampleX_[kMaxSamples] = {}, sampleY_[kMaxSamples] = {};  // offsets in 1/256 pixel
   Camera camera_;
   CullMode cull_ = CullMode::Auto;
+  uint64_t sceneBytes_ = 0;
   std::vector<TriangleSetup> setups_;
   std::vector<TriangleColors>
       colors_;  // one per set-up when the scene has vertex colours, else empty
