@@ -437,6 +437,23 @@ def issue49_memory_seeds():
         "accessors": [accessor, {"componentType": 5126, "count": 4194304, "type": "VEC3"}]}))
 
 
+def issue49_image_seeds():
+    """Images cut short (issue 49): stb_image left the missing texels as heap memory."""
+    texels = bytes(range(256)) * 3
+    ppm = b"P6\n16 16\n255\n" + texels
+    tga = bytes([0, 0, 2]) + bytes(9) + struct.pack("<HH", 16, 16) + bytes([24, 0x20]) + texels
+    for name, data in (("ppm", ppm), ("tga", tga)):
+        for kind, image in (("whole", data), ("cut", data[:len(data) - 768 + 48])):
+            write("gltf", "issue49_%s_%s.gltf" % (name, kind), json.dumps(triangle_gltf(
+                "buffer.bin", {"uri": data_uri("image/png", image)})))
+    write("gltf", "issue49_ppm_16384.gltf", json.dumps(triangle_gltf(
+        "buffer.bin", {"uri": data_uri("image/png", b"P6\n16384 16384\n255\n" + b"\x7f" * 100)})))
+    pgm16 = b"P5 16 16 65535\n" + bytes(range(256)) * 2
+    write("gltf", "issue49_pgm16.gltf", json.dumps(triangle_gltf(
+        "buffer.bin", {"uri": data_uri("image/png", pgm16)})))
+    write("png", "issue49_cut_before_iend.png", TEXTURE[:-12])
+
+
 if __name__ == "__main__":
     gltf_seeds()
     obj_seeds()
@@ -451,4 +468,5 @@ if __name__ == "__main__":
     issue29_seeds()
     issue49_seeds()
     issue49_memory_seeds()
+    issue49_image_seeds()
     print("seeds written to", SEEDS)

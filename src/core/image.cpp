@@ -11,6 +11,7 @@
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/color.hpp"
 #include "mfr/core/file_access.hpp"
+#include "mfr/core/image_check.hpp"
 #include "mfr/core/quote.hpp"
 
 #include <stb_image.h>
@@ -117,23 +118,22 @@ Result<Image8> readPng(const std::string& path,
   if (bytes->size() < 8 || !std::equal(bytes->begin(), bytes->begin() + 8, kSignature))
     return makeError(what + ": not a PNG file");
   MFR_TRY(checkPngChunks(bytes->data(), bytes->size(), what));
+  MFR_TRY(checkImageData(bytes->data(), bytes->size(), what));  // every chunk, up to IEND
   const auto size = static_cast<int>(bytes->size());
   int w = 0, h = 0, n = 0;
   if (!stbi_info_from_memory(bytes->data(), size, &w, &h, &n)) {
     const char* reason = stbi_failure_reason();
     return makeError(what + ": not a readable image" +
-                     (reason ? " (" + oneLine(reason) + ")" : std::string()));
+                     (reason && *reason ? " (" + oneLine(reason) + ")" : std::string()));
   }
   MFR_TRY(checkImageDimensions(w, h, what));  // from the header, before decoding
   if (beforeDecode) MFR_TRY(beforeDecode(w, h));
-  unsigned char* data = stbi_load_from_memory(bytes->data(), size, &w, &h, &n, 4);
-  // stb quotes the bytes of an unknown chunk type: keep the message on one line
-  if (!data) return makeError(what + ": " + oneLine(stbi_failure_reason()));
+  auto decoded = decodeImageUnchecked(bytes->data(), bytes->size(), what);
+  if (!decoded) return decoded.error();
   Image8 image;
-  image.width = w;
-  image.height = h;
-  image.rgba.assign(data, data + static_cast<size_t>(w) * h * 4);
-  stbi_image_free(data);
+  image.width = decoded->width;
+  image.height = decoded->height;
+  image.rgba = std::move(decoded->bytes);
   return image;
 }
 

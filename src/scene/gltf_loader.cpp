@@ -42,6 +42,7 @@
 #include "file_loaders.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/image_check.hpp"
 #include "mfr/core/json_limits.hpp"
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
@@ -1209,7 +1210,7 @@ Result<Texture> toRgba8(const tinygltf::Image& image) {
   return texture;
 }
 
-/// Decodes the images that base colour textures use, in parallel, with tinygltf's stb_image loader.
+/// Decodes the images that base colour textures use, in parallel, with stb_image.
 Result<void> GltfSceneBuilder::decodeTextures() {
   std::vector<int> images(imageMap_.size());
   for (const auto& [image, slot] : imageMap_) images[static_cast<size_t>(slot)] = image;
@@ -1227,6 +1228,8 @@ Result<void> GltfSceneBuilder::decodeTextures() {
     const std::vector<unsigned char>& bytes = images_.bytes[imageIndex];
     if (auto chunks = checkPngChunks(bytes.data(), bytes.size(), nameOf(imageIndex)); !chunks)
       return fail(chunks.error().message);  // before stb allocates what a chunk declares
+    if (auto data = checkImageData(bytes.data(), bytes.size(), nameOf(imageIndex)); !data)
+      return fail(data.error().message);  // a truncated file: refused before any decoding
     int width = 0, height = 0, channels = 0;
     if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max()) ||
         !stbi_info_from_memory(bytes.data(), static_cast<int>(bytes.size()), &width, &height,
@@ -1250,14 +1253,19 @@ Result<void> GltfSceneBuilder::decodeTextures() {
       return;
     }
     const std::vector<unsigned char>& bytes = images_.bytes[imageIndex];
-    tinygltf::Image image;
-    std::string err, warn;
-    if (bytes.size() > static_cast<size_t>(std::numeric_limits<int>::max()) ||
-        !tinygltf::LoadImageData(&image, static_cast<int>(imageIndex), &err, &warn, 0, 0,
-                                 bytes.data(), static_cast<int>(bytes.size()), nullptr)) {
-      decoded[i] = fail(name + ": " + (err.empty() ? "cannot decode" : firstLine(err)));
+    // stb_image as tinygltf's LoadImageData calls it (RGBA, 16 bits kept), through callbacks that
+    // never let a read past the end reach a texture
+    auto pixels = decodeImageUnchecked(bytes.data(), bytes.size(), name, true);
+    if (!pixels) {
+      decoded[i] = fail(pixels.error().message);
       return;
     }
+    tinygltf::Image image;
+    image.width = pixels->width;
+    image.height = pixels->height;
+    image.component = 4;
+    image.bits = pixels->bits;
+    image.image = std::move(pixels->bytes);
     auto texture = toRgba8(image);
     decoded[i] =
         texture ? std::move(texture) : Result<Texture>(fail(name + ": " + texture.error().message));

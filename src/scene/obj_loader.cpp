@@ -43,12 +43,13 @@
 #include "file_loaders.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/image_check.hpp"
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/scene/load.hpp"
 #include "polygon.hpp"
 
-#include <stb_image.h>  // Debian libstb (linked by the library)
+#include <stb_image.h>  // Debian libstb (linked by the library): image headers
 
 namespace mfr {
 namespace {
@@ -146,6 +147,7 @@ Result<Texture> loadTexture(const OpenFile& file, const std::string& what, uint6
   auto bytes = file.read(std::min<uint64_t>(memoryLimit, std::numeric_limits<int>::max()));
   if (!bytes) return bytes.error();
   MFR_TRY(checkPngChunks(bytes->data(), bytes->size(), what));  // before stb trusts a chunk length
+  MFR_TRY(checkImageData(bytes->data(), bytes->size(), what));  // all the data its header declares
   const auto size = static_cast<int>(bytes->size());
   int width = 0, height = 0, channels = 0;
   if (stbi_info_from_memory(bytes->data(), size, &width, &height, &channels)) {
@@ -154,19 +156,15 @@ Result<Texture> loadTexture(const OpenFile& file, const std::string& what, uint6
                                  static_cast<uint64_t>(width) * static_cast<uint64_t>(height) * 4);
     MFR_TRY(checkMemory(decodedBytes, memoryLimit, "its decoded textures"));
   }
-  stbi_uc* pixels = stbi_load_from_memory(bytes->data(), size, &width, &height, &channels, 4);
-  if (!pixels) {
-    const char* reason = stbi_failure_reason();
-    return makeError("cannot load texture " + what + " (" + quoteInput(file.path().string(), 200) +
-                     ")" + (reason ? ": " + oneLine(reason) : std::string()));
-  }
-  if (fileChannels) *fileChannels = channels;
+  auto decoded =
+      decodeImageUnchecked(bytes->data(), bytes->size(),
+                           "texture " + what + " (" + quoteInput(file.path().string(), 200) + ")");
+  if (!decoded) return decoded.error();
+  if (fileChannels) *fileChannels = decoded->fileChannels;
   Texture texture;
-  texture.width = width;
-  texture.height = height;
-  texture.rgba.assign(pixels,
-                      pixels + static_cast<size_t>(width) * static_cast<size_t>(height) * 4);
-  stbi_image_free(pixels);
+  texture.width = decoded->width;
+  texture.height = decoded->height;
+  texture.rgba = std::move(decoded->bytes);
   return texture;
 }
 
