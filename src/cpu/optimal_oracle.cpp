@@ -23,6 +23,7 @@
 #include <tbb/task_arena.h>
 
 #include "mfr/core/memory_limit.hpp"
+#include "mfr/core/units.hpp"
 #include "mfr/cpu/fragment.hpp"
 #include "mfr/cpu/render.hpp"
 #include "mfr/method/allocation.hpp"
@@ -42,13 +43,16 @@ Result<FrameErrorCurves> frameErrorCurves(const RasterFrame& frame, glm::vec3 ba
   const uint64_t perPixel =
       sizeof(std::vector<double>) + sizeof(uint32_t) + (firstK == 0 ? sizeof(double) : 0);
   const auto needed = [&](uint64_t fragments) {
-    return saturatingAdd(saturatingMul(fragments, sizeof(double)), saturatingMul(pixels, perPixel));
+    // beside the scene's bytes, as the render's own pre-flight counts them
+    return saturatingAdd(
+        saturatingAdd(saturatingMul(fragments, sizeof(double)), saturatingMul(pixels, perPixel)),
+        frame.sceneBytes());
   };
   const auto check = [&](uint64_t fragments) {
     return checkMemory(needed(fragments), limit,
                        "the error curves of " + std::to_string(fragments) + " fragments at " +
                            std::to_string(frame.width()) + " x " + std::to_string(frame.height()) +
-                           " pixels");
+                           " pixels and the scene's " + formatBytes(frame.sceneBytes()));
   };
   // fragments per tile; kUncounted until a tile is rasterized or counted
   constexpr uint64_t kUncounted = UINT64_MAX;
