@@ -380,7 +380,7 @@ TEST(DkbDataset, BadFilesAreRejectedWithTheirName) {
   std::string nan = bytes;
   const float qnan = std::nanf("");
   std::memcpy(nan.data() + bytes.size() - 8, &qnan, 4);  // last sample's last feature
-  expectError(nan, "non-finite");
+  expectError(nan, "not a finite number");
   auto missing = learn::readDataset(tempPath("does-not-exist.mfrds"));
   ASSERT_FALSE(missing);
   EXPECT_NE(missing.error().message.find("does-not-exist"), std::string::npos);
