@@ -75,7 +75,7 @@ attempt(lambda: mfr.make_model(w, b, metadata=deep).check_dkb())
     for line in lines[:2]:
         assert line.startswith("Error: ") and "deep.mfrnn" in line and TOO_DEEP in line, line
     # a model made in memory is refused when made: check_dkb and render never see it
-    assert lines[2].startswith("ValueError: metadata: " + TOO_DEEP), lines[2]
+    assert lines[2].startswith("ValueError: make_model(): metadata: " + TOO_DEEP), lines[2]
 
 
 def test_deep_dataset_metadata_is_an_error_not_a_crash(tmp_path):

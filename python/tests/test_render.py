@@ -373,10 +373,11 @@ def test_errors_carry_the_librarys_messages(tmp_path, cli_error):
          ["render", "procedural:bottles", "-m", "fkb", "-M", "12 parsecs", "-o", out]),
         (lambda: mfr.render("procedural:bottles", composite="sideways", width=W, height=H),
          ["render", "procedural:bottles", "--composite", "sideways", "-o", out]),
+        # the per-pixel buffers fit, the scene's expansion does not: refused as it loads
         (lambda: mfr.render("procedural:bottles", method="fkb", k=2, width=W, height=H,
-                            memory_limit="1KB"),
+                            memory_limit="1MB"),
          ["render", "procedural:bottles", "-m", "fkb", "--k", 2, "--width", W, "--height", H,
-          "--memory-limit", "1KB", "-o", out]),
+          "--memory-limit", "1MB", "-o", out]),
         # the image size alone does not fit: refused before the frame is set up (fast)
         (lambda: mfr.render("procedural:hairball", width=16384, height=16384, memory_limit="1GB"),
          ["render", "procedural:hairball", "--width", 16384, "--height", 16384,
