@@ -324,10 +324,10 @@ TEST(ReliabilityMemory, PeakResidentMemoryOfAnAcceptedSceneStaysUnderTheLimitPlu
 TEST(ReliabilityMemory, RenderBuffersAreCheckedBesideTheSceneNotAgainstTheWholeLimit) {
   // 200,000 particles hold 238 MiB by sceneMemoryBytes; at 1024 x 1024 the A-buffer's per-pixel
   // buffers take tens of MiB more: each fits 256 MB alone, together they do not
-  const MeasuredRun both = runMeasured(
-      {"render", "procedural:smoke?count=200000", "--width", "1024", "--height", "1024",
-       "--memory-limit", "256MB", "-q", "-o", (scratch() / "never.png").string()},
-      60);
+  const MeasuredRun both =
+      runMeasured({"render", "procedural:smoke?count=200000", "--width", "1024", "--height", "1024",
+                   "--memory-limit", "256MB", "-q", "-o", (scratch() / "never.png").string()},
+                  60);
   EXPECT_TRUE(both.exitCode == 1 && contains(both.err, "per-pixel buffers and the scene's") &&
               contains(both.err, "256.00 MiB"))
       << both.err;
