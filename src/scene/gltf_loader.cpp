@@ -553,14 +553,10 @@ Result<void> GltfSceneBuilder::checkAccessor(int index, int expectedType,
 /// applied. An accessor without a bufferView reads as zeros.
 Result<std::vector<double>> GltfSceneBuilder::readAccessor(int index, int expectedType,
                                                            const std::string& what) const {
-  MFR_TRY(checkAccessor(index, expectedType, what));
-  if (index < 0 || static_cast<size_t>(index) >= model_.accessors.size())
-    return fail(what + ": accessor " + std::to_string(index) + " does not exist");
+  MFR_TRY(checkAccessor(index, expectedType, what));  // index, type, component type, count
   const tinygltf::Accessor& accessor = model_.accessors[static_cast<size_t>(index)];
   const std::string where = what + " (accessor " + std::to_string(index) + ")";
-  if (accessor.type != expectedType) return fail(where + ": unexpected element type");
   const size_t csize = componentSize(accessor.componentType);
-  if (csize == 0) return fail(where + ": invalid component type");
   const auto components = static_cast<size_t>(componentCount(accessor.type));
   const size_t elementSize = csize * components;
 
@@ -575,9 +571,8 @@ Result<std::vector<double>> GltfSceneBuilder::readAccessor(int index, int expect
         values[i * components + c] = readComponent(range->data + i * range->stride + c * csize,
                                                    accessor.componentType, accessor.normalized);
   } else {
-    // No bufferView: zeros (possibly overridden by sparse values). Nothing in the file bounds the
-    // count here, so it is capped.
-    if (accessor.count > (size_t{1} << 22)) return fail(where + ": count too large");
+    // No bufferView: zeros (possibly overridden by sparse values); checkAccessor capped the
+    // count, which nothing in the file bounds here.
     values.assign(accessor.count * components, 0.0);
   }
 
