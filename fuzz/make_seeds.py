@@ -454,6 +454,59 @@ def issue49_image_seeds():
     write("png", "issue49_cut_before_iend.png", TEXTURE[:-12])
 
 
+def issue49_camera_seeds():
+    """Issue 49's camera and face inputs (tests/test_reliability_camera.cpp), small versions."""
+    def set_perspective(**fields):
+        return lambda d: d["cameras"][0]["perspective"].update(fields)
+    write("gltf", "issue49_zfar_1e300.gltf", json.dumps(triangle_gltf(
+        "buffer.bin", {"uri": "texture.png"}, extra=set_perspective(zfar=1e300))))
+    write("gltf", "issue49_znear_1e20.gltf", json.dumps(triangle_gltf(
+        "buffer.bin", {"uri": "texture.png"}, extra=set_perspective(znear=1e20))))
+    write("gltf", "issue49_yfov_1e-10.gltf", json.dumps(triangle_gltf(
+        "buffer.bin", {"uri": "texture.png"}, extra=set_perspective(yfov=1e-10))))
+
+    def cameras_out_of_order(d):
+        # file camera 0 placed by the last node, 1 orthographic, 2 placed first, 3 by no node
+        d["cameras"] = [{"type": "perspective", "perspective": {"yfov": 0.9, "znear": 0.1}},
+                        {"type": "orthographic",
+                         "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}},
+                        {"type": "perspective", "perspective": {"yfov": 0.5, "znear": 0.1}},
+                        {"type": "perspective", "perspective": {"yfov": 0.7}}]
+        d["nodes"][2]["camera"] = 2
+        d["nodes"] += [{"camera": 1, "translation": [0, 0, 4]},
+                       {"camera": 0, "translation": [0, 1, 3]}]
+        d["scenes"][0]["nodes"] += [3, 4]
+    write("gltf", "issue49_cameras_out_of_order.gltf", json.dumps(triangle_gltf(
+        "buffer.bin", {"uri": "texture.png"}, extra=cameras_out_of_order)))
+    write("gltf", "issue49_byte_offset_negative.gltf", json.dumps(triangle_gltf(
+        "buffer.bin", {"uri": "texture.png"},
+        extra=lambda d: d["accessors"][0].update({"byteOffset": -4}))))
+    write("gltf", "issue49_sparse_count_negative.gltf", json.dumps(triangle_gltf(
+        "buffer.bin", {"uri": "texture.png"},
+        extra=lambda d: d["accessors"][0].update({"sparse": {
+            "count": -1, "indices": {"bufferView": 2, "componentType": 5123},
+            "values": {"bufferView": 0}}}))))
+    quad = "v 0 0 0\nv 1 1 0\nv 1 0 0\nv 0 1 0\n"
+    write("obj", "issue49_bowtie_quad.obj", quad + "f 1 2 3 4\n")
+    write("obj", "issue49_concave_quad.obj", "v 0 0 0\nv 2 0 0\nv 0.5 0.5 0\nv 0 2 0\nf 1 2 3 4\n")
+    ply_header = ("ply\nformat ascii 1.0\nelement vertex 4\ncomment inside the element\n"
+                  "property float x\nproperty float y\nobj_info between properties\n"
+                  "property float z\nelement face 1\ncomment before the list\n"
+                  "property list uchar int vertex_indices\nend_header\n")
+    write("ply", "issue49_comment_in_element.ply",
+          ply_header + "0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n")
+    write("ply", "issue49_bowtie_quad.ply",
+          ply_header + "0 0 0\n1 1 0\n1 0 0\n0 1 0\n4 0 1 2 3\n")
+    write("json_scene", "issue49_far_3e38.json", json.dumps(
+        {"mesh": "mesh.obj", "cameras": [{"eye": [0, 0, 3], "target": [0, 0, 0], "far": 3e38}]}))
+    write("json_scene", "issue49_fov_1e-10.json", json.dumps(
+        {"mesh": "mesh.obj", "cameras": [{"eye": [0, 0, 3], "target": [0, 0, 0], "fov": 1e-10}]}))
+    write("json_scene", "issue49_near_1e20.json", json.dumps(
+        {"mesh": "mesh.obj", "cameras": [{"eye": [0, 0, 3], "target": [0, 0, 0], "near": 1e20}]}))
+    write("camera", "issue49_fov_1e-10", "0,0,3,0,0,0,0,1,0,1e-10")
+    write("camera", "issue49_fov_at_bound", "0,0,3,0,0,0,0,1,0,0.112")
+
+
 if __name__ == "__main__":
     gltf_seeds()
     obj_seeds()
@@ -469,4 +522,5 @@ if __name__ == "__main__":
     issue49_seeds()
     issue49_memory_seeds()
     issue49_image_seeds()
+    issue49_camera_seeds()
     print("seeds written to", SEEDS)

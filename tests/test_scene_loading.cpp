@@ -545,10 +545,13 @@ TEST_F(SceneLoading, GltfCameraNodeGivesPerspectiveCamera) {
   // (-0.5, 0.5, -5) looking down +z, towards the quad.
   const int cameraNode = gltf.addNode({{"camera", 0}, {"translation", {0.5, 0.5, 5}}}, false);
   gltf.addNode({{"children", {cameraNode}}, {"rotation", {0, 1, 0, 0}}});
-  gltf.addNode({{"camera", 1}});  // orthographic: not supported, skipped
+  gltf.addNode({{"camera", 1}});  // orthographic: listed, refused by --view (issue 49)
   auto scene = mfr::loadScene(dir.write("camera.gltf", gltf.gltfText()));
   ASSERT_LOADED(scene);
-  ASSERT_EQ(scene->cameras.size(), 1u);
+  ASSERT_EQ(scene->cameras.size(), 2u);
+  ASSERT_EQ(scene->cameraProblems.size(), 2u);
+  EXPECT_EQ(scene->cameraProblems[0], "");
+  EXPECT_NE(scene->cameraProblems[1].find("orthographic"), std::string::npos);
   const mfr::Camera& camera = scene->cameras[0];
   EXPECT_NEAR(camera.eye.x, -0.5f, 1e-5f);
   EXPECT_NEAR(camera.eye.y, 0.5f, 1e-5f);

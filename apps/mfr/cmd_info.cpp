@@ -55,6 +55,21 @@ int run(const SceneOptions& o) {
          {"mean_depth_complexity", covered ? double(total) / covered : 0.0},
          {"abuffer_bytes", abuffer.overhead((*view)->pixelCount()) + total * kNodeBytes}});
   }
+  // the file's cameras as --view N numbers them (fileCamera): the same list, the same index
+  nlohmann::json fileCameras = nlohmann::json::array();
+  for (size_t i = 0; i < scene.cameras.size(); ++i) {
+    auto chosen = fileCamera(scene, o.source, static_cast<int>(i));
+    const Camera& c = scene.cameras[i];
+    nlohmann::json entry = {{"camera", i}};
+    if (chosen)
+      entry.update({{"eye", {c.eye.x, c.eye.y, c.eye.z}},
+                    {"target", {c.target.x, c.target.y, c.target.z}},
+                    {"up", {c.up.x, c.up.y, c.up.z}},
+                    {"fov", c.fovYDegrees}});
+    else
+      entry["refused"] = oneLine(scene.cameraProblems[i], 300);
+    fileCameras.push_back(entry);
+  }
   nlohmann::json j = {{"scene", o.source},
                       {"triangles", scene.triangleCount()},
                       {"vertices", scene.vertexCount()},
@@ -64,6 +79,7 @@ int run(const SceneOptions& o) {
                       {"materials_opaque", opaque},
                       {"textures", scene.textures.size()},
                       {"cameras_in_file", scene.cameras.size()},
+                      {"file_cameras", fileCameras},
                       {"width", o.width},
                       {"height", o.height},
                       {"engine", (*engine)->describe()},
@@ -82,6 +98,14 @@ int run(const SceneOptions& o) {
   for (const auto& [key, value] : (*engine)->describe())
     engineText += (engineText.empty() ? "" : ", ") + key + " " + value;
   std::printf("engine      %s\n", engineText.c_str());
+  for (const auto& c : fileCameras)
+    if (c.contains("refused"))
+      std::printf("camera %-3d  --view %d refused: %s\n", c["camera"].get<int>(),
+                  c["camera"].get<int>(), c["refused"].get<std::string>().c_str());
+    else
+      std::printf("camera %-3d  --view %d: eye %g, %g, %g, fov %g degrees\n",
+                  c["camera"].get<int>(), c["camera"].get<int>(), c["eye"][0].get<double>(),
+                  c["eye"][1].get<double>(), c["eye"][2].get<double>(), c["fov"].get<double>());
   for (const auto& v : views)
     std::printf(
         "view %-3d    %dx%d: %llu fragments on %llu pixels, depth complexity max %u mean "

@@ -260,6 +260,7 @@ Result<RasterFrame> RasterFrame::build(const Scene& scene, const Camera& cameraI
   }
   frame.tilesY_ = (options.height + options.tileSize - 1) / options.tileSize;
   frame.camera_ = fitClipPlanes(cameraIn, sceneBounds(scene));
+  MFR_TRY(checkProjection(cameraIn, frame.camera_));
   frame.materials_ = resolveMaterials(scene);
   frame.cull_ = scene.cull;
   frame.sceneBytes_ = sceneMemoryBytes(scene.vertexCount(), scene.triangleCount());

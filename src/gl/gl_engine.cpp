@@ -386,6 +386,7 @@ Result<void> checkCreateArgs(const Scene& scene, const Camera& cameraIn, int wid
     return makeError(
         "camera: eye != target, up not parallel to the view direction and a field "
         "of view in (0, 180) degrees needed");
+  MFR_TRY(checkProjection(c, fitClipPlanes(c, sceneBounds(scene))));  // as RasterFrame::build
   return {};
 }
 

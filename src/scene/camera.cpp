@@ -2,12 +2,55 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "mfr/scene/scene.hpp"
 
 namespace mfr {
+namespace {
+
+/// Eye and target farther apart than this are refused by checkProjection: the view transform
+/// (glm::lookAt) and fitClipPlanes normalise target - eye in single precision, squaring the
+/// distance, which overflows beyond 1.8e19 (the view direction became zero and the image empty).
+constexpr double kMaxEyeTargetDistance = 1e19;
+
+}  // namespace
+
+bool validFovYDegrees(double degrees) {
+  return degrees >= kMinFovYDegrees && degrees < 180.0;
+}
+
+float maxFarPlane(float zNear) {
+  return std::numeric_limits<float>::max() / 4.0f / std::max(zNear, 1.0f);
+}
+
+Result<void> checkProjection(const Camera& camera, const Camera& fitted) {
+  char text[160];
+  if (!validFovYDegrees(camera.fovYDegrees)) {
+    std::snprintf(text, sizeof text, "camera: field of view %g degrees ", camera.fovYDegrees);
+    if (!(camera.fovYDegrees > 0.0f && camera.fovYDegrees < 180.0f))
+      return makeError(std::string(text) + "must be in (0, 180)");
+    return makeError(std::string(text) + "is narrower than " + kMinFovText + " (" +
+                     kNarrowFovReason + ")");
+  }
+  const double distance = glm::length(glm::dvec3(camera.target) - glm::dvec3(camera.eye));
+  if (!(distance <= kMaxEyeTargetDistance)) {
+    std::snprintf(text, sizeof text, "camera: eye and target %g apart, beyond 1e19", distance);
+    return makeError(std::string(text) +
+                     ": the view transform squares their distance in single precision");
+  }
+  if (!(fitted.zNear <= kMaxNearPlane)) {
+    std::snprintf(text, sizeof text, "camera: near plane %g%s is beyond 1e18", fitted.zNear,
+                  camera.zNear > 0.0f ? "" : " (fitted to the scene's distance from the eye)");
+    return makeError(std::string(text) +
+                     ": the projection's 2 far near would overflow single precision");
+  }
+  return {};
+}
 
 Camera frameBounds(const Bounds& bounds, float fovYDegrees) {
   Camera camera;
@@ -29,6 +72,7 @@ Camera fitClipPlanes(const Camera& camera, const Bounds& bounds) {
   if (fitted.zNear <= 0.0f) fitted.zNear = std::max(centerDepth - radius * 1.01f, radius * 1e-3f);
   if (fitted.zFar <= 0.0f)
     fitted.zFar = std::max(centerDepth + radius * 1.01f, fitted.zNear * 2.0f);
+  fitted.zFar = std::min(fitted.zFar, maxFarPlane(fitted.zNear));
   return fitted;
 }
 

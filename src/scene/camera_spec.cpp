@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <system_error>
 #include <vector>
@@ -45,6 +46,12 @@ Result<Camera> cameraFromNumbers(std::span<const double> numbers, const std::str
     camera.fovYDegrees = static_cast<float>(fov);
     if (!(camera.fovYDegrees > 0.0f && camera.fovYDegrees < 180.0f))
       return makeError(what + ": field of view must be in (0, 180) degrees");
+    if (!validFovYDegrees(camera.fovYDegrees)) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%g", fov);
+      return makeError(what + ": field of view " + value + " degrees is narrower than " +
+                       kMinFovText + " (" + kNarrowFovReason + ")");
+    }
   }
   const glm::dvec3 view = glm::dvec3(camera.target) - glm::dvec3(camera.eye);
   if (!(length(view) > 0.0)) return makeError(what + ": eye and target must differ");

@@ -268,6 +268,42 @@ bool isImplementedExtension(const std::string& name) {
          name == "EXT_mesh_gpu_instancing" || name == "KHR_texture_transform";
 }
 
+/// Offsets, lengths, counts and indices of accessors and buffer views that must be non-negative
+/// integers (glTF 2.0 sections 5.1, 5.11): tinygltf reads an unsigned field that is not one
+/// (accessor byteOffset -4) as absent, 0, and keeps a negative sparse count or index (-1: "none"),
+/// so the loader would read another range or none, silently.
+Result<void> checkNonNegative(const nlohmann::json& doc) {
+  const auto check = [](const nlohmann::json& object, const std::string& where,
+                        std::initializer_list<const char*> fields) -> Result<void> {
+    if (!object.is_object()) return {};
+    for (const char* field : fields) {
+      const auto it = object.find(field);
+      if (it == object.end() || it->is_number_unsigned()) continue;
+      return makeError(where + "." + field + " " + oneLine(it->dump(), 40) +
+                       ": must be a non-negative integer");
+    }
+    return {};
+  };
+  if (auto it = doc.find("bufferViews"); it != doc.end() && it->is_array())
+    for (size_t i = 0; i < it->size(); ++i)
+      MFR_TRY(check((*it)[i], "bufferViews[" + std::to_string(i) + "]",
+                    {"buffer", "byteOffset", "byteLength"}));
+  if (auto it = doc.find("accessors"); it != doc.end() && it->is_array())
+    for (size_t i = 0; i < it->size(); ++i) {
+      const nlohmann::json& accessor = (*it)[i];
+      const std::string where = "accessors[" + std::to_string(i) + "]";
+      MFR_TRY(check(accessor, where, {"bufferView", "byteOffset", "count"}));
+      if (!accessor.is_object() || !accessor.contains("sparse")) continue;
+      const nlohmann::json& sparse = accessor["sparse"];
+      MFR_TRY(check(sparse, where + ".sparse", {"count"}));
+      if (!sparse.is_object()) continue;
+      for (const char* part : {"indices", "values"})
+        if (sparse.contains(part))
+          MFR_TRY(check(sparse[part], where + ".sparse." + part, {"bufferView", "byteOffset"}));
+    }
+  return {};
+}
+
 /// What the JSON says before tinygltf reads it: required extensions mfr implements, buffer views'
 /// strides, data URIs' lengths; then every external uri opened and read once (regular files
 /// inside the folder unless allowed outside, a buffer's file exactly its byteLength), kept for the
@@ -292,6 +328,7 @@ Result<void> checkReferences(const nlohmann::json& doc, GltfFiles& files) {
         return makeError("bufferViews[" + std::to_string(i) + "].byteStride " +
                          jsonExcerpt(stride, 40) + ": must be a multiple of 4 in [4, 252]");
     }
+  MFR_TRY(checkNonNegative(doc));
   // an item's uri, when it has one
   const auto uriOf = [](const nlohmann::json& item) -> const std::string* {
     if (!item.is_object()) return nullptr;
@@ -1272,40 +1309,73 @@ Result<void> GltfSceneBuilder::decodeTextures() {
   return {};
 }
 
-/// Perspective cameras of the visited nodes: eye at the node origin looking down its -Z axis with
-/// +Y up. The target is put on the view axis at the depth of the scene centre so that orbits
-/// around it (see orbit()) circle the scene.
+/// The file's cameras in the file's order (glTF `cameras`): --view N is camera N, as `mfr info`
+/// lists them. A perspective camera is placed by the first node of the scene that names it: eye at
+/// the node origin looking down its -Z axis with +Y up; the target is put on the view axis at the
+/// depth of the scene centre so that orbits around it (see orbit()) circle the scene. Orthographic
+/// cameras and cameras no node of the scene places keep a placeholder and a reason in
+/// Scene::cameraProblems: --view refuses them (fileCamera, scene_request.hpp) rather than picking
+/// another.
 Result<void> GltfSceneBuilder::addCameras() {
   const Bounds bounds = sceneBounds(scene_);
-  for (const auto& [cameraIndex, world] : cameraNodes_) {
-    if (cameraIndex < 0 || static_cast<size_t>(cameraIndex) >= model_.cameras.size()) continue;
-    const tinygltf::Camera& src = model_.cameras[static_cast<size_t>(cameraIndex)];
-    if (src.type != "perspective") continue;
-    // glTF 2.0 section 5.13: yfov > 0 (and below pi, a half-space at most)
-    const double yfov = src.perspective.yfov;
-    if (!(yfov > 0.0 && yfov < glm::pi<double>())) {
+  std::vector<const glm::dmat4*> placement(model_.cameras.size(), nullptr);
+  for (const auto& [cameraIndex, world] : cameraNodes_)  // node order: the first node wins
+    if (cameraIndex >= 0 && static_cast<size_t>(cameraIndex) < placement.size() &&
+        !placement[static_cast<size_t>(cameraIndex)])
+      placement[static_cast<size_t>(cameraIndex)] = &world;
+  bool anyProblem = false;
+  std::vector<std::string> problems(model_.cameras.size());
+  for (size_t i = 0; i < model_.cameras.size(); ++i) {
+    const tinygltf::Camera& src = model_.cameras[i];
+    const std::string name = "camera " + std::to_string(i);
+    Camera camera;  // a placeholder where --view refuses the camera
+    std::string& problem = problems[i];
+    if (src.type != "perspective") {
+      problem = "is " + quoteInput(src.type, 40) + " (mfr renders perspective cameras only)";
+    } else {
+      // glTF 2.0 section 5.13: yfov > 0 (and below pi, a half-space at most)
+      const double yfov = src.perspective.yfov;
       char value[32];
       std::snprintf(value, sizeof value, "%g", yfov);
-      return fail("camera " + std::to_string(cameraIndex) + ": perspective.yfov " + value +
-                  " must be in (0, pi) radians");
+      if (!(yfov > 0.0 && yfov < glm::pi<double>()))
+        return fail(name + ": perspective.yfov " + value + " must be in (0, pi) radians");
+      if (!validFovYDegrees(glm::degrees(yfov)))
+        return fail(name + ": perspective.yfov " + value + " radians is narrower than " +
+                    kMinFovText + " (" + kNarrowFovReason + ")");
+      std::snprintf(value, sizeof value, "%g", src.perspective.znear);
+      if (!(src.perspective.znear <= kMaxNearPlane))
+        return fail(name + ": perspective.znear " + value +
+                    " is beyond 1e18 (the projection's 2 far near would overflow single "
+                    "precision)");
+      if (!placement[i]) problem = "is placed by no node of the scene";
     }
-    const glm::vec3 eye(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
-    glm::dvec3 forward = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
-    glm::dvec3 up = glm::dmat3(world) * glm::dvec3(0.0, 1.0, 0.0);
-    if (!(glm::length(forward) > 0.0) || !(glm::length(up) > 0.0)) continue;
-    forward = glm::normalize(forward);
-    up = glm::normalize(up);
-    Camera camera;
-    camera.eye = eye;
-    float depth = glm::dot(bounds.center() - eye, glm::vec3(forward));
-    if (!(depth > 1e-6f)) depth = std::max(bounds.radius(), 1.0f);
-    camera.target = eye + glm::vec3(forward) * depth;
-    camera.up = glm::vec3(up);
-    camera.fovYDegrees = static_cast<float>(glm::degrees(src.perspective.yfov));
-    camera.zNear = std::max(0.0f, static_cast<float>(src.perspective.znear));
-    camera.zFar = std::max(0.0f, static_cast<float>(src.perspective.zfar));  // 0: infinite
+    if (problem.empty()) {
+      const glm::dmat4& world = *placement[i];
+      const glm::vec3 eye(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
+      glm::dvec3 forward = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
+      glm::dvec3 up = glm::dmat3(world) * glm::dvec3(0.0, 1.0, 0.0);
+      if (!(glm::length(forward) > 0.0) || !(glm::length(up) > 0.0)) {
+        problem = "is placed by a node whose transform collapses its view axes";
+      } else {
+        forward = glm::normalize(forward);
+        up = glm::normalize(up);
+        camera.eye = eye;
+        float depth = glm::dot(bounds.center() - eye, glm::vec3(forward));
+        if (!(depth > 1e-6f)) depth = std::max(bounds.radius(), 1.0f);
+        camera.target = eye + glm::vec3(forward) * depth;
+        camera.up = glm::vec3(up);
+        camera.fovYDegrees = static_cast<float>(glm::degrees(src.perspective.yfov));
+        camera.zNear = static_cast<float>(std::max(0.0, src.perspective.znear));
+        // 0: infinite (fitted); beyond single precision: clamped to maxFarPlane by fitClipPlanes
+        camera.zFar = static_cast<float>(std::clamp(
+            src.perspective.zfar, 0.0, static_cast<double>(std::numeric_limits<float>::max())));
+      }
+    }
+    if (!problem.empty() && !src.name.empty()) problem = quoteInput(src.name, 40) + " " + problem;
+    anyProblem = anyProblem || !problem.empty();
     scene_.cameras.push_back(camera);
   }
+  if (anyProblem) scene_.cameraProblems = std::move(problems);
   return {};
 }
 

@@ -10,6 +10,7 @@
 // Unknown keys, wrong types and out-of-range values are errors naming the key and the file.
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -80,9 +81,17 @@ Result<Camera> parseCamera(const Checker& check, const json& value, const std::s
       auto v = check.number(item, field, 0.0f, 180.0f);
       if (!v) return v.error();
       if (*v <= 0.0f || *v >= 180.0f) return check.fail(field, "must be in (0, 180) degrees");
+      if (!validFovYDegrees(*v)) {
+        char value[32];
+        std::snprintf(value, sizeof value, "%g", item.get<double>());
+        return check.fail(field, "is " + std::string(value) + " degrees, narrower than " +
+                                     kMinFovText + " (" + kNarrowFovReason + ")");
+      }
       camera.fovYDegrees = *v;
     } else if (name == "near" || name == "far") {
-      auto v = check.number(item, field, 0.0f, kHuge);
+      // a far plane beyond maxFarPlane(near) is clamped to it (fitClipPlanes); a near one beyond
+      // kMaxNearPlane cannot be projected in single precision
+      auto v = check.number(item, field, 0.0f, name == "near" ? kMaxNearPlane : kHuge);
       if (!v) return v.error();
       (name == "near" ? camera.zNear : camera.zFar) = *v;
     } else {
@@ -181,7 +190,10 @@ Result<Scene> loadJsonScene(const std::string& path, const OpenFile& file,
 
   Scene scene = std::move(*loaded);
   scene.name = path;
-  if (cameras) scene.cameras = std::move(*cameras);
+  if (cameras) {
+    scene.cameras = std::move(*cameras);
+    scene.cameraProblems.clear();  // the mesh file's cameras are replaced, their problems too
+  }
   if (background) scene.background = *background;
   if (alpha) scene.alphaOverride = *alpha;
   MFR_TRY(validateScene(scene));

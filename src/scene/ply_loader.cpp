@@ -342,6 +342,46 @@ class PlyChecker {
   uint64_t vertexCount_ = 0;
 };
 
+/// Moves the header's comment and obj_info lines up to just after the format line, in place (the
+/// header keeps its length, the body its offset). PLY allows them anywhere in the header, but
+/// assimp's reader ends an element's property list at a comment and then refuses the file for the
+/// wrong reason ("Vertices should be declared before faces"). Only for a file PlyChecker passed:
+/// "ply" first, one format line, an end_header line within kMaxHeaderLines.
+void hoistHeaderComments(std::string& bytes) {
+  std::string_view format;  // every line with its line end
+  std::vector<std::string_view> comments, others;
+  bool elementSeen = false, commentAfterElement = false;
+  for (size_t pos = 0; pos < bytes.size();) {
+    const size_t newline = bytes.find('\n', pos);
+    const size_t end = newline == std::string::npos ? bytes.size() : newline + 1;
+    const std::string_view line(bytes.data() + pos, end - pos);
+    pos = end;
+    const size_t first = line.find_first_not_of(" \t");
+    const std::string_view word =
+        first == std::string_view::npos
+            ? std::string_view()
+            : line.substr(first, line.find_first_of(" \t\r\n", first) - first);
+    if (others.empty()) {
+      others.push_back(line);  // "ply"
+    } else if (word == "comment" || word == "obj_info") {
+      comments.push_back(line);
+      commentAfterElement = commentAfterElement || elementSeen;
+    } else if (word == "format" && format.empty()) {
+      format = line;
+    } else {
+      elementSeen = elementSeen || word == "element";
+      others.push_back(line);
+    }
+    if (word == "end_header") break;
+  }
+  if (!commentAfterElement) return;
+  std::string header;
+  header.append(others.front()).append(format);
+  for (std::string_view line : comments) header.append(line);
+  for (size_t i = 1; i < others.size(); ++i) header.append(others[i]);
+  std::memcpy(bytes.data(), header.data(), header.size());  // the same lines: the same length
+}
+
 // ---------------------------------------------------------------------------------------------
 
 glm::mat4 toGlm(const aiMatrix4x4& m) {
@@ -431,10 +471,11 @@ Result<Scene> loadPly(const std::string& path, const OpenFile& file, const LoadO
   try {
     auto read = file.readText(options.memoryLimitBytes.value_or(defaultMemoryLimit()));
     if (!read) return read.error();
-    const std::string& bytes = *read;
+    std::string& bytes = *read;
     if (bytes.empty()) return makeError(path + ": empty file");
     if (std::string problem = PlyChecker(bytes).check(); !problem.empty())
       return makeError(path + ": " + problem);
+    hoistHeaderComments(bytes);
 
     Assimp::Importer importer;
     // Belt and braces: assimp validates its own output before the other post-processing steps.

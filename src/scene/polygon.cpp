@@ -97,6 +97,72 @@ Result<void> clipEars(const std::vector<Point>& p, std::vector<uint32_t>& out) {
   return {};
 }
 
+/// Whether segments (a, b) and (c, d) cross at a point inside both (each pair of ends strictly on
+/// either side of the other segment's line, beyond `tolerance`).
+bool segmentsCross(const Point& a, const Point& b, const Point& c, const Point& d,
+                   double tolerance) {
+  const auto side = [tolerance](double v) { return v > tolerance ? 1 : (v < -tolerance ? -1 : 0); };
+  const int abC = side(cross(a, b, c)), abD = side(cross(a, b, d));
+  const int cdA = side(cross(c, d, a)), cdB = side(cross(c, d, b));
+  return abC * abD < 0 && cdA * cdB < 0;
+}
+
+/// A quad: refused when it crosses itself (a bow-tie: two opposite edges cross, and any split
+/// gives two triangles overlapping at the crossing), split from its reflex corner when it is
+/// concave (the other diagonal lies outside it: the triangles would cover the notch and overlap),
+/// and otherwise as tinyobjloader splits it, along the shorter diagonal, so that scenes of convex
+/// quads load as they did. The test runs in the plane of the largest corner normal (a bow-tie's
+/// Newell normal can vanish: its two lobes' areas cancel).
+Result<void> splitQuad(const std::vector<glm::vec3>& corners, std::vector<uint32_t>& triangles) {
+  glm::dvec3 normal(0.0);
+  for (size_t i = 0; i < 4; ++i) {
+    const glm::dvec3 o(corners[i]), a(corners[(i + 1) % 4]), b(corners[(i + 3) % 4]);
+    const glm::dvec3 n = glm::cross(a - o, b - o);
+    if (glm::dot(n, n) > glm::dot(normal, normal)) normal = n;
+  }
+  const glm::dvec3 magnitude = glm::abs(normal);
+  const int drop = magnitude.x >= magnitude.y && magnitude.x >= magnitude.z ? 0
+                   : magnitude.y >= magnitude.z                             ? 1
+                                                                            : 2;
+  const int u = (drop + 1) % 3, v = (drop + 2) % 3;
+  Point p[4];
+  double largest = 0.0;
+  for (size_t i = 0; i < 4; ++i) {
+    const glm::dvec3 c(corners[i]);
+    p[i] = Point(c[u], c[v]);
+    largest = std::max({largest, std::abs(c[u]), std::abs(c[v])});
+  }
+  // a turn or a side within the corners' float rounding counts as straight (as isConvex)
+  const double rounding = 4.0 * std::numeric_limits<float>::epsilon() * largest;
+  const auto tolerance = [&](const Point& a, const Point& b, const Point& c) {
+    return 2.0 * rounding * (glm::length(b - a) + glm::length(c - a));
+  };
+  if (std::isfinite(largest) &&
+      (segmentsCross(p[0], p[1], p[2], p[3], tolerance(p[0], p[1], p[2])) ||
+       segmentsCross(p[1], p[2], p[3], p[0], tolerance(p[1], p[2], p[3]))))
+    return makeError("a face of 4 vertices crosses itself and cannot be triangulated");
+  // the signed area's sign is the winding; a corner turning the other way is reflex
+  double area = 0.0;
+  for (size_t i = 0; i < 4; ++i) area += p[i].x * p[(i + 1) % 4].y - p[(i + 1) % 4].x * p[i].y;
+  for (uint32_t r = 0; r < 4 && std::isfinite(area); ++r) {
+    const Point& a = p[(r + 3) % 4];
+    const Point& b = p[r];
+    const Point& c = p[(r + 1) % 4];
+    const double turn = cross(a, b, c) * (area < 0.0 ? -1.0 : 1.0);
+    if (turn < -tolerance(b, a, c)) {
+      const uint32_t r1 = (r + 1) % 4, r2 = (r + 2) % 4, r3 = (r + 3) % 4;
+      triangles.insert(triangles.end(), {r, r1, r2, r, r2, r3});
+      return {};
+    }
+  }
+  const glm::vec3 e02 = corners[2] - corners[0], e13 = corners[3] - corners[1];
+  if (glm::dot(e02, e02) < glm::dot(e13, e13))
+    triangles.insert(triangles.end(), {0u, 1u, 2u, 0u, 2u, 3u});
+  else
+    triangles.insert(triangles.end(), {0u, 1u, 3u, 1u, 2u, 3u});
+  return {};
+}
+
 }  // namespace
 
 Result<void> triangulatePolygon(const std::vector<glm::vec3>& corners,
@@ -107,14 +173,7 @@ Result<void> triangulatePolygon(const std::vector<glm::vec3>& corners,
     triangles.insert(triangles.end(), {0u, 1u, 2u});
     return {};
   }
-  if (n == 4) {  // tinyobjloader's split: along the shorter diagonal
-    const glm::vec3 e02 = corners[2] - corners[0], e13 = corners[3] - corners[1];
-    if (glm::dot(e02, e02) < glm::dot(e13, e13))
-      triangles.insert(triangles.end(), {0u, 1u, 2u, 0u, 2u, 3u});
-    else
-      triangles.insert(triangles.end(), {0u, 1u, 3u, 1u, 2u, 3u});
-    return {};
-  }
+  if (n == 4) return splitQuad(corners, triangles);
   // Newell's normal, then the plane of its largest component, oriented so that the polygon
   // winds counter-clockwise in it.
   glm::dvec3 normal(0.0);

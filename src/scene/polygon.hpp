@@ -1,7 +1,8 @@
 // Triangulating the polygons of OBJ faces, in time linear in the corners for convex ones.
 //
-// Triangles and quads are split as tinyobjloader splits them (a quad along its shorter diagonal),
-// so that scenes made of them load as before. Larger polygons are projected onto the plane of
+// Triangles and convex quads are split as tinyobjloader splits them (a quad along its shorter
+// diagonal), so that scenes made of them load as before; a concave quad is split from its reflex
+// corner, and one that crosses itself (a bow-tie) is refused. Larger polygons are projected onto the plane of
 // their Newell normal (Newell 1972; Sutherland, Sproull, Schumacker 1974); a convex one (every turn
 // the same way, and each axis direction changing sign at most twice, so a star polygon whose
 // turns all agree is not mistaken for one) becomes a fan, a non-convex one is ear-clipped (Meisters

@@ -51,6 +51,8 @@ Result<void> validateScene(const Scene& scene) {
   if (!scene.colors.empty() && scene.colors.size() != scene.positions.size())
     return makeError(name + ": one vertex colour per vertex expected");
   if (scene.materials.empty()) return makeError(name + ": scene has no materials");
+  if (!scene.cameraProblems.empty() && scene.cameraProblems.size() != scene.cameras.size())
+    return makeError(name + ": one camera problem per camera expected");
   for (uint32_t index : scene.indices)
     if (index >= scene.positions.size())
       return makeError(name + ": vertex index " + std::to_string(index) + " out of range");

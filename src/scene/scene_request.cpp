@@ -78,6 +78,21 @@ Result<void> applyToScene(const SceneRequest& r, Scene& scene, Spelling spelling
   return {};
 }
 
+Result<Camera> fileCamera(const Scene& scene, const std::string& source, int index,
+                          Spelling spelling) {
+  const std::string what =
+      echoPath(source) + ": " + spell(spelling, "--view") + " " + std::to_string(index);
+  if (index < 0) return makeError(what + ": must be a camera index (0-based)");
+  const size_t i = static_cast<size_t>(index);
+  if (i >= scene.cameras.size())
+    return makeError(what + " but the scene has " + std::to_string(scene.cameras.size()) +
+                     " camera(s)");
+  if (i < scene.cameraProblems.size() && !scene.cameraProblems[i].empty())
+    return makeError(what + ": camera " + std::to_string(index) + " " +
+                     oneLine(scene.cameraProblems[i], 300));
+  return scene.cameras[i];
+}
+
 Result<SceneViews> sceneViews(const Scene& scene, const std::string& source, const SceneRequest& r,
                               Spelling spelling) {
   Camera camera;
@@ -90,11 +105,9 @@ Result<SceneViews> sceneViews(const Scene& scene, const std::string& source, con
     if (!made) return made.error();
     camera = made.value();
   } else if (r.view >= 0) {
-    if (r.view >= static_cast<int>(scene.cameras.size()))
-      return makeError(echoPath(source) + ": " + spell(spelling, "--view") + " " +
-                       std::to_string(r.view) + " but the scene has " +
-                       std::to_string(scene.cameras.size()) + " camera(s)");
-    camera = scene.cameras[r.view];
+    auto chosen = fileCamera(scene, source, r.view, spelling);
+    if (!chosen) return chosen.error();
+    camera = chosen.value();
   } else if (scene.defaultCamera) {
     camera = *scene.defaultCamera;
   } else {

@@ -464,13 +464,12 @@ class ViewerSession {
 
   // the file camera `index` of the scene, with --zoom as `mfr render --view` applies it
   bool chooseFileCamera(int index) {
-    const std::vector<Camera>& cameras = prepared_.scene.cameras;
-    if (index < 0 || index >= static_cast<int>(cameras.size())) {
-      notice_ = echoPath(sceneOptions_.source) + ": no camera " + std::to_string(index) +
-                ", the scene has " + std::to_string(cameras.size()) + " camera(s)";
+    auto chosen = fileCamera(prepared_.scene, sceneOptions_.source, index);  // as --view picks
+    if (!chosen) {
+      notice_ = chosen.error().message;
       return false;
     }
-    Camera camera = cameras[index];
+    Camera camera = chosen.value();
     camera.eye = camera.target + (camera.eye - camera.target) / static_cast<float>(a_.scene.zoom);
     settings_.camera.restart(camera);
     fileCamera_ = index;

@@ -75,7 +75,13 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<Texture> textures;
 
-  std::vector<Camera> cameras;          // cameras the file defines (may be empty)
+  /// The cameras the file defines, in the file's order (may be empty): `--view N` renders
+  /// cameras[N] (fileCamera, scene_request.hpp) and `mfr info` lists them.
+  std::vector<Camera> cameras;
+  /// Empty, or one per camera: why --view refuses that camera ("" where it renders it), e.g. a
+  /// glTF orthographic camera or one no node of the scene places. Such a camera's entry in
+  /// `cameras` is a placeholder (the default Camera).
+  std::vector<std::string> cameraProblems;
   std::optional<Camera> defaultCamera;  // procedural scenes frame themselves
 
   glm::vec3 background{1.0f, 1.0f, 1.0f};  // linear RGB behind everything

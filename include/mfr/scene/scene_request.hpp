@@ -56,6 +56,13 @@ struct SceneViews {
   std::optional<Camera> previousCamera;
 };
 
+/// The scene file's camera `index` as --view names it: Scene::cameras[index], the file's
+/// index-th camera as `mfr info` lists it. One line naming `source` and the option otherwise: a
+/// negative index, one beyond the file's cameras, or a camera the scene cannot render
+/// (Scene::cameraProblems: a glTF orthographic camera, one no node places), never another camera.
+Result<Camera> fileCamera(const Scene& scene, const std::string& source, int index,
+                          Spelling spelling = Spelling::Cli);
+
 /// The camera as every front end picks it: --camera, else the file's camera --view, else the
 /// scene's own camera or one framing its bounds; moved --zoom times closer to its target; then
 /// --orbit views around it. `source` names the scene in errors.
