@@ -91,8 +91,15 @@ Result<Camera> parseCamera(const Checker& check, const json& value, const std::s
     } else if (name == "near" || name == "far") {
       // a far plane beyond maxFarPlane(near) is clamped to it (fitClipPlanes); a near one beyond
       // kMaxNearPlane cannot be projected in single precision
-      auto v = check.number(item, field, 0.0f, name == "near" ? kMaxNearPlane : kHuge);
+      auto v = check.number(item, field, 0.0f, kHuge);
       if (!v) return v.error();
+      if (name == "near" && *v > kMaxNearPlane) {
+        char value[32];
+        std::snprintf(value, sizeof value, "%g", item.get<double>());
+        return check.fail(field, "is " + std::string(value) +
+                                     ", beyond 1e18 (the projection's 2 far near would overflow "
+                                     "single precision)");
+      }
       (name == "near" ? camera.zNear : camera.zFar) = *v;
     } else {
       return check.fail(field, "is not a camera key (eye, target, up, fov, near, far)");
