@@ -19,6 +19,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_timeout.hpp"
+#include "error_assertions.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/scene/load.hpp"
@@ -27,7 +28,9 @@
 namespace {
 
 namespace fs = std::filesystem;
+using mfr::test::cleanError;
 using mfr::test::CliRun;
+using mfr::test::contains;
 using nlohmann::json;
 
 /// A fresh folder per test: `model/` holds the scene files, files beside `model/` are "outside".
@@ -105,10 +108,6 @@ std::string validPng(const fs::path& path) {
   return path.string();
 }
 
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
 /// A refused load: one line naming the scene file and `reference`, containing `problem`.
 ::testing::AssertionResult refused(const mfr::Result<mfr::Scene>& result, const std::string& file,
                                    const std::string& reference, const std::string& problem) {
@@ -118,20 +117,6 @@ bool contains(const std::string& text, const std::string& part) {
     return ::testing::AssertionFailure()
            << "message '" << m << "' should be one line naming '" << file << "' and '" << reference
            << "' with '" << problem << "'";
-  return ::testing::AssertionSuccess();
-}
-
-/// A CLI run that failed cleanly: exit 1, no signal or timeout, one "mfr: error:" line with all
-/// of `parts`.
-::testing::AssertionResult cleanError(const CliRun& r, std::initializer_list<std::string> parts) {
-  if (r.exitCode == 124) return ::testing::AssertionFailure() << "timed out (hung): " << r.err;
-  if (r.signaled || r.exitCode != 1)
-    return ::testing::AssertionFailure() << "exit " << r.exitCode << ", stderr: " << r.err;
-  if (r.err.rfind("mfr: error: ", 0) != 0 || r.err.find('\n') + 1 != r.err.size())
-    return ::testing::AssertionFailure() << "not one 'mfr: error:' line: " << r.err;
-  for (const std::string& part : parts)
-    if (!contains(r.err, part))
-      return ::testing::AssertionFailure() << "'" << r.err << "' lacks '" << part << "'";
   return ::testing::AssertionSuccess();
 }
 

@@ -25,6 +25,7 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "error_assertions.hpp"
 #include "gltf_quads.hpp"
 #include "mfr/scene/load.hpp"
 #include "scene/polygon.hpp"
@@ -33,36 +34,17 @@
 namespace {
 
 namespace fs = std::filesystem;
+using mfr::test::contains;
+using mfr::test::refused;
 using nlohmann::json;
 
 class HostileInputs : public mfr::test::ScratchFolderTest {
  protected:
   HostileInputs() : ScratchFolderTest("mfr_hostile") {}
   std::string write(const std::string& name, const std::string& bytes) const {
-    const fs::path path = model() / name;
-    std::ofstream(path, std::ios::binary) << bytes;
-    return path.string();
+    return mfr::test::writeFile(model() / name, bytes);
   }
 };
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
-/// A refused load: one line of bounded length naming `file`, with every one of `parts`.
-::testing::AssertionResult refused(const mfr::Result<mfr::Scene>& result, const std::string& file,
-                                   std::initializer_list<std::string> parts) {
-  if (result.ok()) return ::testing::AssertionFailure() << "loaded, expected a refusal";
-  const std::string& m = result.error().message;
-  if (!contains(m, file) || contains(m, "\n") || m.size() > 1500)
-    return ::testing::AssertionFailure()
-           << "message of " << m.size() << " bytes should be one short line naming " << file << ": "
-           << m.substr(0, 300);
-  for (const std::string& part : parts)
-    if (!contains(m, part))
-      return ::testing::AssertionFailure() << "'" << m << "' lacks '" << part << "'";
-  return ::testing::AssertionSuccess();
-}
 
 std::string floatBytes(const std::vector<float>& values) {
   return std::string(reinterpret_cast<const char*>(values.data()), values.size() * sizeof(float));

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "cli_timeout.hpp"
+#include "error_assertions.hpp"
 #include "mfr/core/file_access.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/memory_limit.hpp"
@@ -25,7 +26,9 @@
 namespace {
 
 namespace fs = std::filesystem;
+using mfr::test::cleanError;
 using mfr::test::CliRun;
+using mfr::test::contains;
 
 fs::path scratch() {
   static const fs::path dir = mfr::test::processTempDir("mfr_preflight_test");
@@ -33,30 +36,11 @@ fs::path scratch() {
 }
 
 std::string write(const std::string& name, const std::string& bytes) {
-  const fs::path p = scratch() / name;
-  std::ofstream(p, std::ios::binary) << bytes;
-  return p.string();
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
+  return mfr::test::writeFile(scratch() / name, bytes);
 }
 
 double secondsSince(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-/// exit 1, no signal or timeout, one "mfr: error:" line containing every part.
-::testing::AssertionResult cleanError(const CliRun& r, std::initializer_list<std::string> parts) {
-  if (r.exitCode == 124) return ::testing::AssertionFailure() << "timed out: " << r.err;
-  if (r.signaled || r.exitCode != 1)
-    return ::testing::AssertionFailure() << "exit " << r.exitCode << ", stderr: " << r.err;
-  if (r.err.rfind("mfr: error: ", 0) != 0 || r.err.find('\n') + 1 != r.err.size())
-    return ::testing::AssertionFailure() << "not one 'mfr: error:' line: " << r.err;
-  for (const std::string& part : parts)
-    if (!contains(r.err, part))
-      return ::testing::AssertionFailure() << "'" << r.err << "' lacks '" << part << "'";
-  return ::testing::AssertionSuccess();
 }
 
 /// The bytes an error says are needed ("... need 8.25 GiB (8858370048 bytes), ...").

@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_timeout.hpp"
+#include "error_assertions.hpp"
 #include "gltf_textured_quad.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/core/image_check.hpp"
@@ -27,7 +28,9 @@
 namespace {
 
 namespace fs = std::filesystem;
+using mfr::test::cleanError;
 using mfr::test::CliRun;
+using mfr::test::contains;
 
 fs::path scratch() {
   static const fs::path dir = mfr::test::processTempDir("mfr_reliability_images_test");
@@ -35,26 +38,7 @@ fs::path scratch() {
 }
 
 std::string write(const std::string& name, const std::string& bytes) {
-  const fs::path p = scratch() / name;
-  std::ofstream(p, std::ios::binary) << bytes;
-  return p.string();
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
-/// exit 1, no signal or timeout, one "mfr: error:" line containing every part.
-::testing::AssertionResult cleanError(const CliRun& r, std::initializer_list<std::string> parts) {
-  if (r.exitCode == 124) return ::testing::AssertionFailure() << "timed out: " << r.err;
-  if (r.signaled || r.exitCode != 1)
-    return ::testing::AssertionFailure() << "exit " << r.exitCode << ", stderr: " << r.err;
-  if (r.err.rfind("mfr: error: ", 0) != 0 || r.err.find('\n') + 1 != r.err.size())
-    return ::testing::AssertionFailure() << "not one 'mfr: error:' line: " << r.err;
-  for (const std::string& part : parts)
-    if (!contains(r.err, part))
-      return ::testing::AssertionFailure() << "'" << r.err << "' lacks '" << part << "'";
-  return ::testing::AssertionSuccess();
+  return mfr::test::writeFile(scratch() / name, bytes);
 }
 
 /// An error of the library: one line, "WHAT: <a reason>".

@@ -26,6 +26,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_timeout.hpp"
+#include "error_assertions.hpp"
 #include "gltf_quads.hpp"
 #include "mfr/core/json_limits.hpp"
 #include "mfr/learn/dataset.hpp"
@@ -38,7 +39,10 @@
 namespace {
 
 namespace fs = std::filesystem;
+using mfr::test::cleanError;
 using mfr::test::CliRun;
+using mfr::test::contains;
+using mfr::test::refused;
 using nlohmann::json;
 
 constexpr const char* kTooDeep = "JSON nested deeper than 64 levels";
@@ -47,48 +51,13 @@ class ReliabilityJson : public mfr::test::ScratchFolderTest {
  protected:
   ReliabilityJson() : ScratchFolderTest("mfr_reliability_json") {}
   std::string write(const std::string& name, const std::string& bytes) const {
-    const fs::path path = root() / name;
-    std::ofstream(path, std::ios::binary) << bytes;
-    return path.string();
+    return mfr::test::writeFile(root() / name, bytes);
   }
   std::string path(const std::string& name) const { return (root() / name).string(); }
   CliRun cli(const std::string& args) const {
     return mfr::test::runCliTimed(args, root(), mfr::test::inDir(root()));
   }
 };
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
-}
-
-/// An error of one bounded line naming `file`, with every one of `parts`.
-template <class T>
-::testing::AssertionResult refused(const mfr::Result<T>& result, const std::string& file,
-                                   std::initializer_list<std::string> parts) {
-  if (result.ok()) return ::testing::AssertionFailure() << "succeeded, expected a refusal";
-  const std::string& m = result.error().message;
-  if (!contains(m, file) || contains(m, "\n") || m.size() > 1000)
-    return ::testing::AssertionFailure()
-           << "message of " << m.size() << " bytes should be one short line naming " << file << ": "
-           << m.substr(0, 300);
-  for (const std::string& part : parts)
-    if (!contains(m, part))
-      return ::testing::AssertionFailure() << "'" << m << "' lacks '" << part << "'";
-  return ::testing::AssertionSuccess();
-}
-
-/// The CLI's refusal: exit code 1, one "mfr: error:" line with every one of `parts`.
-::testing::AssertionResult cleanError(const CliRun& r, std::initializer_list<std::string> parts) {
-  if (r.signaled || r.exitCode != 1)
-    return ::testing::AssertionFailure() << "exit " << r.exitCode << ", stderr: " << r.err;
-  if (r.err.rfind("mfr: error: ", 0) != 0 || r.err.find('\n') + 1 != r.err.size() ||
-      r.err.size() > 1000 || contains(r.err, "json.exception"))
-    return ::testing::AssertionFailure() << "not one short 'mfr: error:' line: " << r.err;
-  for (const std::string& part : parts)
-    if (!contains(r.err, part))
-      return ::testing::AssertionFailure() << "'" << r.err << "' lacks '" << part << "'";
-  return ::testing::AssertionSuccess();
-}
 
 /// `depth` arrays, one inside the other, around `inner`.
 std::string nested(size_t depth, const std::string& inner = "0") {

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "cli_runner.hpp"
+#include "error_assertions.hpp"
 #include "mfr/metrics/flip.hpp"
 #include "mfr/scene/load.hpp"
 #include "mfr/scene/procedural.hpp"
@@ -29,6 +30,7 @@
 namespace {
 
 namespace fs = std::filesystem;
+using mfr::test::contains;
 
 /// What the CLI may hold beyond the memory limit: its code and libraries, thread stacks, the
 /// file's bytes and parsed JSON, the per-pixel buffers of a small image (docs/ROBUSTNESS.md).
@@ -40,9 +42,7 @@ fs::path scratch() {
 }
 
 std::string write(const std::string& name, const std::string& bytes) {
-  const fs::path p = scratch() / name;
-  std::ofstream(p, std::ios::binary) << bytes;
-  return p.string();
+  return mfr::test::writeFile(scratch() / name, bytes);
 }
 
 std::string readText(const fs::path& path) {
@@ -50,10 +50,6 @@ std::string readText(const fs::path& path) {
   std::stringstream s;
   s << in.rdbuf();
   return s.str();
-}
-
-bool contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
 }
 
 struct MeasuredRun {
@@ -108,14 +104,9 @@ MeasuredRun runMeasured(const std::vector<std::string>& args, int timeoutSeconds
 /// exit 1 within a few seconds, one "mfr: error:" line containing every part.
 ::testing::AssertionResult fastOneLine(const MeasuredRun& r,
                                        std::initializer_list<std::string> parts) {
-  if (r.timedOut) return ::testing::AssertionFailure() << "timed out: " << r.err;
-  if (r.signaled || r.exitCode != 1)
-    return ::testing::AssertionFailure() << "exit " << r.exitCode << ", stderr: " << r.err;
-  if (r.err.rfind("mfr: error: ", 0) != 0 || r.err.find('\n') + 1 != r.err.size())
-    return ::testing::AssertionFailure() << "not one 'mfr: error:' line: " << r.err;
-  for (const std::string& part : parts)
-    if (!contains(r.err, part))
-      return ::testing::AssertionFailure() << "'" << r.err << "' lacks '" << part << "'";
+  ::testing::AssertionResult clean =
+      mfr::test::oneErrorLine(r.exitCode, r.signaled, r.timedOut, r.err, parts);
+  if (!clean) return clean;
   if (r.seconds > 5.0) return ::testing::AssertionFailure() << r.seconds << " s: " << r.err;
   return ::testing::AssertionSuccess();
 }
