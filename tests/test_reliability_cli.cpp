@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "cli_runner.hpp"
 #include "mfr/core/image.hpp"
 #include "temp_dir.hpp"
@@ -65,6 +67,26 @@ void expectOneLineError(const CliRun& r, int code, const std::vector<std::string
   for (const std::string& needle : needles)
     EXPECT_NE(r.err.find(needle), std::string::npos) << what << ": no '" << needle << "' in\n"
                                                      << r.err.substr(0, 2000);
+}
+
+// --- JSON outputs that name a path which is not UTF-8 ------------------------------------------
+TEST(ReliabilityCli, JsonOutputsNamingAPathThatIsNotUtf8AreWritten) {
+  // JSON carries Unicode text only: the byte 0xff of the scene's name is written as U+FFFD (it
+  // was nlohmann's "[json.exception.type_error.316]" and exit 1)
+  const mfr::test::TempDir dir("mfr_reliability_cli");
+  const fs::path d = folder(dir);
+  const std::string obj = (d / "quad\xff.obj").string();
+  std::ofstream(obj) << "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n";
+  const std::string shown = (d / "quad\xef\xbf\xbd.obj").string();
+  const CliRun info = runCli("info '" + obj + "' --json --width 16 --height 16");
+  ASSERT_EQ(info.exitCode, 0) << info.err;
+  EXPECT_EQ(nlohmann::json::parse(info.out).at("scene"), shown) << info.out;
+  const std::string stats = (d / "q.json").string();
+  const CliRun render = runCli("render '" + obj + "' --width 16 --height 16 -q -o '" +
+                               (d / "q.png").string() + "' --stats-json '" + stats + "'");
+  ASSERT_EQ(render.exitCode, 0) << render.err;
+  std::ifstream in(stats);
+  EXPECT_EQ(nlohmann::json::parse(in).at("scene"), shown);
 }
 
 // --- row 12: two outputs of one run at one path ------------------------------------------------
@@ -162,6 +184,33 @@ TEST(ReliabilityCli, TrainDatasetAndMetricsOutputsAtOnePathAreRefused) {
   // the check refuses only what collides: a missing dataset is still the error it was
   const CliRun missing = runCli("train " + D + "/none.mfrds -o " + D + "/m.mfrnn");
   expectOneLineError(missing, 1, {"none.mfrds"}, "missing dataset");
+}
+
+TEST(ReliabilityCli, AnOutputAtAnInputsPathIsRefusedAndTheInputKept) {
+  const mfr::test::TempDir dir("mfr_reliability_cli");
+  const fs::path d = folder(dir);
+  const std::string D = d.string();
+  for (const char* name : {"d.mfrds", "a.png", "b.png", "q.obj", "m.mfrnn"})
+    std::ofstream(d / name) << "kept";
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"train " + D + "/d.mfrds -o " + D + "/./d.mfrds", "is the dataset"},
+      {"metrics " + D + "/a.png " + D + "/b.png --flip-map " + D + "/x/../b.png",
+       "is the test image"},
+      {"metrics " + D + "/a.png " + D + "/b.png --error-map " + D + "/a.png", "is the reference"},
+      {"render " + D + "/q.obj --width 16 --height 16 -o " + D + "/q.obj", "is the scene"},
+      {"render procedural:spheres --width 16 --height 16 --method dkb --model " + D +
+           "/m.mfrnn --stats-json " + D + "/m.mfrnn",
+       "is the --model"},
+  };
+  for (const auto& [args, needle] : cases) {
+    expectOneLineError(runCli(args), 1, {needle, "would replace that input"}, args);
+    for (const char* name : {"d.mfrds", "a.png", "b.png", "q.obj", "m.mfrnn"}) {
+      std::ifstream in(d / name);
+      std::string text;
+      in >> text;
+      EXPECT_EQ(text, "kept") << args << ": " << name;
+    }
+  }
 }
 
 // --- row 13: output names up to NAME_MAX -----------------------------------------------------

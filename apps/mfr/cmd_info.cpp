@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/memory_model.hpp"
@@ -85,7 +86,7 @@ int run(const SceneOptions& o) {
                       {"engine", (*engine)->describe()},
                       {"views", views}};
   if (o.json) {
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", jsonText(j).c_str());
     return 0;
   }
   if (o.quiet) return 0;

@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
@@ -68,8 +69,8 @@ int run(const MetricsArgs& a) {
     if (!parsed) return fail(parsed.error().message);
     limit = parsed.value();
   }
-  if (auto distinct =
-          checkDistinctOutputs({{"--flip-map", a.flipMap}, {"--error-map", a.errorMap}});
+  if (auto distinct = checkDistinctOutputs({{"--flip-map", a.flipMap}, {"--error-map", a.errorMap}},
+                                           {{"reference", a.reference}, {"test image", a.test}});
       !distinct)
     return fail(distinct.error().message);
   // from each header, before its pixels are decoded (images of one size: the first check counts
@@ -136,7 +137,7 @@ int run(const MetricsArgs& a) {
       j["error_map"] = a.errorMap;
       j["error_map_scale"] = errorScale;
     }
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", jsonText(j).c_str());
     return 0;
   }
   if (a.quiet) return 0;

@@ -10,6 +10,7 @@
 #include "common.hpp"
 #include "mfr/core/atomic_file.hpp"
 #include "mfr/core/colormap.hpp"
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/cpu/render.hpp"
@@ -146,7 +147,9 @@ std::vector<OutputFile> outputFiles(const RenderArgs& a) {
 int run(const RenderArgs& a) {
   // two outputs at one path: refused before any work (with --orbit every name gets the same
   // view suffix, so distinct names stay distinct)
-  if (auto distinct = checkDistinctOutputs(outputFiles(a)); !distinct)
+  if (auto distinct = checkDistinctOutputs(
+          outputFiles(a), {{"scene", a.scene.source}, {"--model", a.overrides.modelPath}});
+      !distinct)
     return fail(distinct.error().message);
   auto method = buildMethod(a);
   if (!method) return fail(method.error().message);
@@ -219,10 +222,10 @@ int run(const RenderArgs& a) {
   if (!rendered) return fail(rendered.error().message);
   const nlohmann::json statsOut = views == 1 ? allStats[0] : allStats;
   if (!a.statsJson.empty()) {  // written atomically: never a truncated JSON file
-    auto written = writeFileAtomically(a.statsJson, statsOut.dump(2) + "\n");
+    auto written = writeFileAtomically(a.statsJson, jsonText(statsOut) + "\n");
     if (!written) return fail(written.error().message);
   }
-  if (a.scene.json) std::printf("%s\n", statsOut.dump(2).c_str());
+  if (a.scene.json) std::printf("%s\n", jsonText(statsOut).c_str());
   return 0;
 }
 

@@ -161,8 +161,10 @@ int runTrain(TrainArgs& a) {
   if (a.out.empty()) return fail("--out: empty path");
   if (a.log.empty()) a.log = a.out + ".log.csv";
   if (a.lossCurve.empty()) a.lossCurve = a.out + ".loss.png";
-  if (auto distinct =
-          checkDistinctOutputs({{"--out", a.out}, {"--log", a.log}, {"--loss-curve", a.lossCurve}});
+  std::vector<OutputFile> inputs;
+  for (const std::string& dataset : a.datasets) inputs.push_back({"dataset", dataset});
+  if (auto distinct = checkDistinctOutputs(
+          {{"--out", a.out}, {"--log", a.log}, {"--loss-curve", a.lossCurve}}, inputs);
       !distinct)
     return fail(distinct.error().message);
 

@@ -275,7 +275,8 @@ bool isSpecialFile(const std::string& resolved) {
 
 }  // namespace
 
-Result<void> checkDistinctOutputs(const std::vector<OutputFile>& outputs) {
+Result<void> checkDistinctOutputs(const std::vector<OutputFile>& outputs,
+                                  const std::vector<OutputFile>& inputs) {
   std::vector<std::pair<const OutputFile*, std::string>> seen;
   for (const OutputFile& output : outputs) {
     if (output.path.empty()) continue;
@@ -288,6 +289,16 @@ Result<void> checkDistinctOutputs(const std::vector<OutputFile>& outputs) {
                          " are the same file: one output would replace the other (give each its "
                          "own path)");
     seen.emplace_back(&output, resolved);
+  }
+  for (const OutputFile& input : inputs) {
+    if (input.path.empty()) continue;
+    const std::string resolved = resolvedOutput(input.path);
+    for (const auto& [output, key] : seen)
+      if (key == resolved)
+        return makeError(output->option + " " + quoteInput(output->path, 256) + " is the " +
+                         input.option + " " + quoteInput(input.path, 256) +
+                         " this run reads: writing it would replace that input (give the output "
+                         "its own path)");
   }
   return {};
 }

@@ -132,9 +132,12 @@ struct OutputFile {
 /// (std::filesystem::weakly_canonical), so `X`, `./X`, `a/../X` and a link to X's folder are one
 /// file. Empty paths (an output not asked for) are skipped, and so are existing special files
 /// (`/dev/null`, `/dev/stdout`: written in place, nothing is replaced). The error names both
-/// options and the paths: "--out 'X' and --stats-json './X' are the same file: ...". Every command
+/// options and the paths: "--out 'X' and --stats-json './X' are the same file: ...". An output
+/// that is one of the run's `inputs` (a dataset `mfr train` reads, an image `mfr metrics`
+/// compares, the scene or model `mfr render` reads) is refused the same way. Every command
 /// writing several files calls it before any work.
-Result<void> checkDistinctOutputs(const std::vector<OutputFile>& outputs);
+Result<void> checkDistinctOutputs(const std::vector<OutputFile>& outputs,
+                                  const std::vector<OutputFile>& inputs = {});
 
 /// Adds to every integer option of `app` and its subcommands (CLI11 type INT or UINT) a check of
 /// the text before CLI11 converts it, which would silently saturate: an unsigned option refuses a

@@ -1,5 +1,6 @@
 // Writing a comparison's folder (see mfr/compare/compare_output.hpp).
 #include "mfr/compare/compare_output.hpp"
+#include "mfr/core/json_limits.hpp"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -234,15 +235,13 @@ Result<std::string> writeComparison(const CompareResult& r, const std::string& o
     }
   // a scene or model path need not be UTF-8 (a file name is bytes); JSON text must be: such
   // bytes are written as U+FFFD rather than failing the whole comparison
-  const std::string jsonText =
-      compareToJson(r, mfrVersion).dump(2, ' ', false, nlohmann::json::error_handler_t::replace) +
-      "\n";
-  written.push_back(writeText(dir / "results.json", jsonText));
+  const std::string json = jsonText(compareToJson(r, mfrVersion)) + "\n";
+  written.push_back(writeText(dir / "results.json", json));
   written.push_back(writeText(dir / "results.csv", compareToCsv(r)));
   written.push_back(writeText(dir / "report.html", compareReportHtml(r, info)));
   for (const Result<void>& w : written)
     if (!w) return w.error();
-  return jsonText;
+  return json;
 }
 
 std::string utcTimestamp() {

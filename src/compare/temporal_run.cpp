@@ -1,5 +1,6 @@
 // runTemporalComparison (temporal_run.hpp).
 #include "mfr/compare/temporal_run.hpp"
+#include "mfr/core/json_limits.hpp"
 
 #include <cstdio>
 #include <filesystem>
@@ -86,7 +87,7 @@ Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest&
   j["plots"] = plots.value();
   j["temporal"] = temporalToJson(run.result);
   // a path that is not UTF-8: U+FFFD in the JSON, as compare_output.cpp
-  run.jsonText = j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+  run.jsonText = jsonText(j) + "\n";
   MFR_TRY(writeFileAtomically((dir / "results.json").string(), run.jsonText));
   MFR_TRY(writeFileAtomically((dir / "report.html").string(),
                               temporalReportHtml(run.result, r.source, r.width, r.height,

@@ -111,4 +111,8 @@ size_t invalidUtf8At(std::string_view s) {
   return std::string_view::npos;
 }
 
+std::string jsonText(const json& value, int indent) {
+  return value.dump(indent, ' ', false, json::error_handler_t::replace);
+}
+
 }  // namespace mfr

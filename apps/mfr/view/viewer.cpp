@@ -22,6 +22,7 @@
 #include "frame_renderer.hpp"
 #include "image_texture.hpp"
 #include "mfr/core/atomic_file.hpp"
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/method/method.hpp"
@@ -575,7 +576,7 @@ class ViewerSession {
                               {"max_ms", sorted.back()},
                               {"render_thread", renderThread_}};
     }
-    if (auto written = writeFileAtomically(a_.statsJson, out.dump(2) + "\n"); !written)
+    if (auto written = writeFileAtomically(a_.statsJson, jsonText(out) + "\n"); !written)
       exitCode_ = cli::fail(written.error().message);
   }
 

@@ -33,6 +33,12 @@ std::string jsonDepthProblem(std::string_view text);
 /// object by its size ("an array of 3 items"). One line; never serialises a nested value.
 std::string jsonExcerpt(const nlohmann::json& value, size_t maxLength = 60);
 
+/// `value` as JSON text for an output mfr writes (stats, info, metrics), indented by `indent`
+/// (-1: one line). Strings mfr put in it from the outside (a scene path, a camera's name) may hold
+/// bytes that are not UTF-8, which JSON cannot carry: they are written as U+FFFD where nlohmann's
+/// plain dump() throws type_error 316.
+std::string jsonText(const nlohmann::json& value, int indent = 2);
+
 /// Offset of the first byte of `text` that is not well-formed UTF-8 (RFC 3629: no overlong forms,
 /// no surrogates, nothing above U+10FFFF), or npos. JSON text must be UTF-8 (RFC 8259 section 8.1).
 size_t invalidUtf8At(std::string_view text);
