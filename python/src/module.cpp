@@ -8,6 +8,7 @@
 
 #include "common.hpp"
 #include "mfr/core/image.hpp"
+#include "mfr/core/json_limits.hpp"
 #include "mfr/core/memory_limit.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
@@ -33,8 +34,7 @@ namespace mfr::python {
 py::object toPython(const nlohmann::json& value) {
   // a scene or model path need not be UTF-8: such bytes become U+FFFD here (the "scene" of the
   // statistics is set from the path's bytes again, as os.fsdecode gives it)
-  return py::module_::import("json").attr("loads")(
-      value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace));
+  return py::module_::import("json").attr("loads")(mfr::jsonText(value, -1));
 }
 
 namespace {
@@ -283,10 +283,20 @@ void addSceneAndRender(py::module_& m) {
           "cameras",
           [](const Scene& s) {
             py::list l;
-            for (const Camera& c : s.cameras) l.append(cameraDict(c));
+            for (size_t i = 0; i < s.cameras.size(); ++i) {
+              if (i < s.cameraProblems.size() && !s.cameraProblems[i].empty()) {
+                py::dict refused;
+                refused["refused"] = s.cameraProblems[i];
+                l.append(refused);
+              } else {
+                l.append(cameraDict(s.cameras[i]));
+              }
+            }
             return l;
           },
-          "The file's cameras as dicts (eye, target, up, fov in degrees); render(view=i).")
+          "The file's cameras in the file's order, as dicts (eye, target, up, fov in degrees), "
+          "or {'refused': why} for one mfr cannot render (orthographic, placed by no node); "
+          "render(view=i) renders cameras[i], as `mfr info` lists them.")
       .def_property_readonly(
           "default_camera",
           [](const Scene& s) -> py::object {

@@ -356,6 +356,43 @@ def test_cli_camera_view_of_a_file_scene(tmp_path, run_cli, cli_error):
     assert mfr.load_scene(outside, allow_outside_references=True).triangle_count == 2
 
 
+def test_gltf_cameras_in_file_order_as_mfr_info_lists_them(tmp_path, run_cli, cli_error):
+    # camera 0 perspective, placed by the last node; camera 1 orthographic: listed as refused,
+    # so that view=i stays the file's camera i (issue 49 row 9)
+    import base64
+    import json
+    import struct
+    positions = struct.pack("<9f", -1, -1, 0, 1, -1, 0, 0, 1, 0)
+    doc = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0, 1, 2]}],
+        "nodes": [{"mesh": 0}, {"camera": 1, "translation": [0, 0, 4]},
+                  {"camera": 0, "translation": [0, 0.5, 3]}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [-1, -1, 0], "max": [1, 1, 0]}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}],
+        "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64," +
+                     base64.b64encode(positions).decode()}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}},
+                    {"type": "orthographic", "name": "top",
+                     "orthographic": {"xmag": 1, "ymag": 1, "znear": 0.1, "zfar": 10}}]}
+    path = tmp_path / "cameras.gltf"
+    path.write_text(json.dumps(doc))
+    s = mfr.load_scene(path)
+    listed = json.loads(run_cli("info", path, "--json", "--width", W, "--height", H).stdout)
+    listed = listed["file_cameras"]
+    assert len(s.cameras) == len(listed) == 2
+    assert s.cameras[0]["fov"] == pytest.approx(listed[0]["fov"]) and "refused" not in s.cameras[0]
+    assert s.cameras[0]["eye"] == pytest.approx(tuple(listed[0]["eye"]))
+    assert s.cameras[1] == {"refused": listed[1]["refused"]}
+    assert "orthographic" in s.cameras[1]["refused"]
+    with pytest.raises(mfr.Error) as e:
+        mfr.render(s, view=1, width=W, height=H)
+    assert "orthographic" in str(e.value)
+    assert "orthographic" in cli_error("render", path, "--view", 1, "-o", tmp_path / "x.png")
+    assert mfr.render(s, view=0, width=W, height=H).srgb.shape == (H, W, 4)
+
+
 def test_errors_carry_the_librarys_messages(tmp_path, cli_error):
     out = tmp_path / "x.png"
     cases = [
