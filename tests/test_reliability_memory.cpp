@@ -273,6 +273,16 @@ TEST(ReliabilityMemory, InstancingFromAZeroAccessorIsRefusedBeforeAnyInstanceIsB
       runMeasured({"render", write("few.gltf", instancingGltf(8)), "--width", "32", "--height",
                    "32", "--memory-limit", "64MB", "-q", "-o", (scratch() / "few.png").string()});
   EXPECT_EQ(fits.exitCode, 0) << fits.err;
+  // the node's mesh does not exist (found by fuzzing): refused before its 4 M instances are read,
+  // which the expansion check, counting no mesh, had not charged
+  std::string noMesh = instancingGltf(4194304);
+  noMesh.replace(noMesh.find(R"("mesh":0)"), 8, R"("mesh":5)");
+  const std::string missing = write("no_mesh.gltf", noMesh);
+  const MeasuredRun r2 =
+      runMeasured({"render", missing, "--width", "64", "--height", "64", "--memory-limit", "32MB",
+                   "-q", "-o", (scratch() / "never.png").string()});
+  EXPECT_TRUE(fastOneLine(r2, {missing + ": ", "mesh 5 does not exist"}));
+  EXPECT_LT(r2.peakRssBytes, (uint64_t{32} << 20) + kRssMarginBytes) << r2.err;
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -898,6 +898,9 @@ Result<void> GltfSceneBuilder::visitNodes() {
 /// possibly normalized integers) and SCALE accessors, each optional, all of one count.
 Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int nodeIndex,
                                                 const glm::dmat4& world) {
+  // before any instance is read: checkExpansion counted no instances for a mesh that is not there
+  if (static_cast<size_t>(node.mesh) >= model_.meshes.size())
+    return fail("mesh " + std::to_string(node.mesh) + " does not exist");
   const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
   if (ext == node.extensions.end() || !ext->second.Has("attributes") ||
       !ext->second.Get("attributes").IsObject())
@@ -943,9 +946,8 @@ Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int 
   return {};
 }
 
+// `meshIndex` exists: addMeshInstances checked it
 Result<void> GltfSceneBuilder::addMesh(int meshIndex, const glm::dmat4& world) {
-  if (static_cast<size_t>(meshIndex) >= model_.meshes.size())
-    return fail("mesh " + std::to_string(meshIndex) + " does not exist");
   const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(meshIndex)];
   for (size_t p = 0; p < mesh.primitives.size(); ++p) {
     const std::string what = "mesh " + std::to_string(meshIndex) + " (" +
