@@ -59,8 +59,7 @@ inline constexpr const char* kNarrowFovReason =
 /// What the engines check of a camera's projection beyond its orientation: the field of view
 /// (validFovYDegrees), eye and target at most 1e19 apart (the view transform squares their
 /// distance in single precision) and the near plane of `fitted` (fitClipPlanes of `camera`)
-/// within kMaxNearPlane. Errors are one line starting "camera:
-/// ".
+/// within kMaxNearPlane. Errors are one line starting "camera: ".
 Result<void> checkProjection(const Camera& camera, const Camera& fitted);
 
 /// A camera that frames the bounds from the +z side, slightly above, the whole sphere in view.
