@@ -165,6 +165,9 @@ int runTrain(TrainArgs& a) {
           checkDistinctOutputs({{"--out", a.out}, {"--log", a.log}, {"--loss-curve", a.lossCurve}});
       !distinct)
     return fail(distinct.error().message);
+  if (auto format = imageOutputFormat("--loss-curve", a.lossCurve, {OutputImageFormat::Png});
+      !format)
+    return fail(format.error().message);
 
   auto split = loadSplit(a);
   if (!split) return fail(split.error().message);
