@@ -1,19 +1,20 @@
 #!/usr/bin/env bash
 # One evaluation of the bounded allocations (docs/ALLOCATION_EVAL.md): every real scene in
-# ../shared/scenes (but the glTF conformance models of khronos-conformance/, which test the loader,
-# not transparency) x VIEWS orbit views x relative budgets {10%, 25%, 50%} (each method's own words
-# + that share of the exact A-buffer's node bytes) x both compositing rules, all bounded k-buffer
-# methods and optimal; writes the mfr compare folders and one summary (summary.md, summary.html:
-# per method the geometric mean of the MSE and FLIP ratios to optimal, win counts against each
-# other method, and per rule and budget the ratio with the cases that ran and were refused;
-# scripts/allocation_summary.py). Under hybrid compositing the per-pixel methods run at any share
-# (a pixel without a slot keeps its tail, issue 28); under kbuffer compositing a share below one
-# node per covered pixel is refused.
+# ../shared/scenes or --scenes DIR (but the glTF conformance models of khronos-conformance/, which
+# test the loader, not transparency) x VIEWS orbit views x relative budgets {10%, 25%, 50%} (each
+# method's own words + that share of the exact A-buffer's node bytes) x both compositing rules,
+# all bounded k-buffer methods and optimal; writes the mfr compare folders and one summary
+# (summary.md, summary.html: per method the geometric mean of the MSE and FLIP ratios to optimal,
+# win counts against each other method, and per rule and budget the ratio with the cases that ran
+# and were refused; scripts/allocation_summary.py). Under hybrid compositing the per-pixel methods
+# run at any share (a pixel without a slot keeps its tail); under kbuffer compositing a share below
+# one node per covered pixel is refused.
 #
 #   scripts/evaluate-allocation.sh [--mfr BIN] [--out DIR] [--size N] [--views V] [--zoom Z]
-#                                  [--budgets LIST] [--methods LIST] [--quick]
+#                                  [--budgets LIST] [--methods LIST] [--scenes DIR] [--quick]
 #   defaults: build/mfr, eval-allocation, 512, 3, 1.0, 10%,25%,50%,
-#             fkb,kplus-sb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,dkb-curve,mlab,optimal
+#             fkb,kplus-sb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,dkb-curve,mlab,optimal,
+#             ../shared/scenes (searched recursively for .gltf, .glb, .ply and .obj files)
 #   --quick: 128x128, one view (a smoke test of the whole pipeline, about a minute)
 #
 # Scenes are rendered fully transparent (--alpha 0.5), as the papers do. The relative budgets make
@@ -40,7 +41,7 @@ while [ $# -gt 0 ]; do
     --methods) METHODS=$2; shift 2 ;;
     --scenes) SCENES=$2; shift 2 ;;
     --quick) SIZE=128; VIEWS=1; shift ;;
-    -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
+    -h|--help) sed -n '2,/^set -euo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
     *) echo "evaluate-allocation: unknown option '$1' (see --help)" >&2; exit 2 ;;
   esac
 done

@@ -99,9 +99,10 @@ TEST(CliDefaults, CompareUsesEachPresetsRuleUnlessTold) {
   }
 }
 
-// One line on stderr naming `needle`, exit code 1, nothing written.
+// One line on stderr naming `needle`, exit code 1, nothing written (render: the image; compare:
+// the folder).
 void expectRefused(const std::string& args, const std::string& needle) {
-  const fs::path image = tempDir() / "never";
+  const fs::path image = tempDir() / (args.starts_with("render") ? "never.png" : "never");
   fs::remove_all(image);
   const test::CliRun r = test::runCli(args + " -o " + image.string(), tempDir());
   EXPECT_FALSE(r.signaled) << args;
@@ -154,6 +155,30 @@ TEST(CliDefaults, HelpListsTheTablesPresetsForEachOption) {
   EXPECT_EQ(presetsAccepting(MethodOption::Model), "dkb, dkb-fill, dkb-curve");
   for (const std::string& preset : presetNames())
     EXPECT_NE(squeezed.find(preset), std::string::npos) << preset;
+}
+
+// --engine's help states the command's own default, the one that runs: cpu for render, compare and
+// info, gl for view (its help said cpu while it, docs/VIEWER.md and its panel used gl).
+TEST(CliDefaults, EngineHelpStatesEachCommandsOwnDefault) {
+  const auto engineHelp = [](const std::string& command) {
+    const test::CliRun r = test::runCli(command + " --help", tempDir());
+    EXPECT_EQ(r.exitCode, 0) << command << "\n" << r.err;
+    std::string squeezed;
+    for (char c : r.out) {
+      if (c == '\n') c = ' ';
+      if (!(c == ' ' && !squeezed.empty() && squeezed.back() == ' ')) squeezed += c;
+    }
+    const size_t at = squeezed.find("Engine that renders: ");
+    if (at == std::string::npos) return std::string("(no --engine)");
+    return squeezed.substr(at, squeezed.find(')', at) + 1 - at);
+  };
+  for (const char* command : {"render", "compare", "info"})
+    EXPECT_TRUE(engineHelp(command).ends_with(" (default cpu)")) << engineHelp(command);
+  EXPECT_EQ(renderStats("--method fkb --budget 400KB")["engine"], "cpu");
+  // mfr view exists where the GL engine and the viewer are built
+  if (test::runCli("--help", tempDir()).out.find(" view ") != std::string::npos) {
+    EXPECT_TRUE(engineHelp("view").ends_with(" (default gl)")) << engineHelp("view");
+  }
 }
 
 }  // namespace

@@ -261,7 +261,8 @@ TEST_F(CompareLibrary, CsvHasOneRowPerRunAndTheGroundTruthFirst) {
   std::vector<std::string> rows;
   while (std::getline(in, line)) rows.push_back(line);
   ASSERT_EQ(rows.size(), 1 + kMethods.size() * 2);
-  EXPECT_EQ(rows[0].rfind(",abuffer,kbuffer,ok,ground_truth.png,", 0), 0u) << rows[0];
+  EXPECT_EQ(rows[0].rfind(",,abuffer,kbuffer,ok,ground_truth.png,", 0), 0u) << rows[0];
+  EXPECT_EQ(rows[1].rfind(std::to_string(kSmall) + ",200KB,fkb,", 0), 0u) << rows[1];
   for (const std::string& row : rows) {
     // no field of these rows is quoted except an error message; count the columns outside quotes
     size_t commas = 0;
@@ -551,6 +552,79 @@ TEST_F(CompareCli, SummaryAndReportPathOnStderrAndACsvRowPerRun) {
       EXPECT_NE(s.str().find(entry + p.summary.substr(0, 20)), std::string::npos);
     }
   }
+}
+
+// results.csv's header: every column a snake_case identifier (a pass named "peel 1" made the
+// column "time_peel 1_ms"), and budget_label beside budget_bytes with the budget as given.
+TEST(CompareCsv, ColumnsAreSnakeCaseIdentifiersWithTheBudgetLabel) {
+  CompareResult r;
+  r.groundTruth.method = "abuffer";
+  r.groundTruth.imageFile = "ground_truth.png";
+  r.groundTruth.stats.passes = {{"capture", 1.0}, {"peel 1", 2.0}};
+  const auto budget = [](uint64_t bytes, const std::string& label) {
+    CompareBudget b;
+    b.budgetBytes = bytes;
+    b.label = label;
+    CompareRun ok;
+    ok.method = "peel";
+    ok.budgetBytes = bytes;
+    ok.imageFile = "peel_" + label + ".png";
+    ok.stats.passes = {{"peel 1", 3.0}, {"Peel-1", 4.0}, {"dual peel 2 (far)", 5.0}};
+    CompareRun failed;
+    failed.method = "fkb";
+    failed.budgetBytes = bytes;
+    failed.error = "too small, by far";
+    b.runs = {ok, failed};
+    return b;
+  };
+  r.budgets = {budget(123456, "25%"), budget(8u << 20, "8MB")};
+  std::istringstream in(compareToCsv(r));
+  std::string header;
+  std::getline(in, header);
+  std::vector<std::string> columns;
+  for (std::istringstream h(header); std::getline(h, columns.emplace_back(), ',');) {
+  }
+  columns.pop_back();
+  for (const std::string& c : columns) {
+    EXPECT_FALSE(c.empty()) << header;
+    EXPECT_TRUE(std::all_of(c.begin(), c.end(), [](char ch) {
+      return (ch >= 'a' && ch <= 'z') || (ch >= '0' && ch <= '9') || ch == '_';
+    })) << c;
+  }
+  EXPECT_EQ(std::set<std::string>(columns.begin(), columns.end()).size(), columns.size()) << header;
+  ASSERT_GE(columns.size(), 3u);
+  EXPECT_EQ(columns[0], "budget_bytes");
+  EXPECT_EQ(columns[1], "budget_label");
+  EXPECT_EQ(columns[2], "method");
+  EXPECT_EQ(columns.back(), "error");
+  // the passes in order of first appearance; two names of one identifier get a suffix
+  const std::vector<std::string> times = {"time_capture_ms", "time_peel_1_ms", "time_peel_1_ms_2",
+                                          "time_dual_peel_2_far_ms"};
+  EXPECT_NE(header.find(",total_ms," + times[0] + "," + times[1] + "," + times[2] + "," + times[3] +
+                        ",error"),
+            std::string::npos)
+      << header;
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(in, line);) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows[0].rfind(",,abuffer,kbuffer,ok,ground_truth.png,", 0), 0u) << rows[0];
+  EXPECT_EQ(rows[1].rfind("123456,25%,peel,kbuffer,ok,peel_25%.png,", 0), 0u) << rows[1];
+  EXPECT_EQ(rows[2].rfind("123456,25%,fkb,kbuffer,error,", 0), 0u) << rows[2];
+  EXPECT_EQ(rows[3].rfind("8388608,8MB,peel,", 0), 0u) << rows[3];
+  EXPECT_EQ(rows[4].rfind("8388608,8MB,fkb,kbuffer,error,", 0), 0u) << rows[4];
+  // every row has the header's columns (the error message quoted: its comma is not a column)
+  for (const std::string& row : rows) {
+    size_t commas = 0;
+    bool quoted = false;
+    for (char c : row) {
+      if (c == '"') quoted = !quoted;
+      if (c == ',' && !quoted) ++commas;
+    }
+    EXPECT_EQ(commas + 1, columns.size()) << row;
+  }
+  EXPECT_NE(rows[2].find(",\"too small, by far\""), std::string::npos) << rows[2];
+  // the pass times land in their own columns: peel 1 = 3, Peel-1 = 4, dual peel 2 (far) = 5
+  EXPECT_NE(rows[1].find(",,3.000,4.000,5.000,"), std::string::npos) << rows[1];
 }
 
 // one line on stderr naming `needle`, exit code 1, nothing written

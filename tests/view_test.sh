@@ -33,6 +33,11 @@ set -e
   { echo "FAIL: bad scene: view and render errors differ"; cat err.txt err_render.txt; exit 1; }
 echo "ok: bad scene -> $(cat err.txt)"
 
+# --help states the viewer's own default engine (gl), as docs/VIEWER.md and the panel do
+"$MFR" view --help | tr -s ' \n' '  ' | grep -q -- 'Engine that renders: [a-z|]* (default gl)' ||
+  { echo "FAIL: view --help does not say --engine defaults to gl"; "$MFR" view --help; exit 1; }
+echo "ok: view --help: --engine (default gl)"
+
 command -v xvfb-run >/dev/null || skip "xvfb-run not installed (Debian: xvfb xauth)"
 "$MFR" render procedural:layers --engine gl --width 8 --height 8 -q -o probe.png 2>probe.txt ||
   skip "no GL engine here: $(cat probe.txt)"

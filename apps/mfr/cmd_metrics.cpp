@@ -73,6 +73,11 @@ int run(const MetricsArgs& a) {
                                            {{"reference", a.reference}, {"test image", a.test}});
       !distinct)
     return fail(distinct.error().message);
+  for (const auto& [option, path] :
+       {std::pair{"--flip-map", &a.flipMap}, std::pair{"--error-map", &a.errorMap}})
+    if (!path->empty())
+      if (auto format = imageOutputFormat(option, *path, {OutputImageFormat::Png}); !format)
+        return fail(format.error().message);
   // from each header, before its pixels are decoded (images of one size: the first check counts
   // both)
   const auto preflight = [limit](const std::string& path) {

@@ -77,13 +77,30 @@ void writeMap(const std::string& path, const std::vector<T>& values, int w, int 
   if (!written) throw std::runtime_error(written.error().message);
 }
 
+/// The format of --out (.png or .pfm), the maps' extensions checked (.png): the name of every
+/// image output says its format, checked before any work.
+Result<OutputImageFormat> checkImageOutputs(const RenderArgs& a) {
+  const std::pair<const char*, const std::string*> maps[] = {
+      {"--depth-complexity", &a.depthComplexity},
+      {"--k-map", &a.kMap},
+      {"--overflow-map", &a.overflowMap},
+      {"--importance-map", &a.importanceMap}};
+  for (const auto& [option, path] : maps)
+    if (!path->empty()) MFR_TRY(imageOutputFormat(option, *path, {OutputImageFormat::Png}));
+  if (a.out.empty()) return OutputImageFormat::Png;  // refused later as an empty path
+  return imageOutputFormat("--out", a.out, {OutputImageFormat::Png, OutputImageFormat::Pfm});
+}
+
 /// The images and maps --out, --depth-complexity, --k-map, --importance-map and
 /// --importance-factors ask for, of view `v` of `views`.
-Result<void> writeViewImages(const RenderArgs& a, Engine& engine, const RenderedView& r,
-                             int views) {
+Result<void> writeViewImages(const RenderArgs& a, OutputImageFormat format, Engine& engine,
+                             const RenderedView& r, int views) {
   const int v = r.index, width = a.scene.width, height = a.scene.height;
   const RenderOutput& result = r.output;
-  MFR_TRY(writePng(viewPath(a.out, v, views), encodeSrgb(result.image)));
+  if (format == OutputImageFormat::Pfm)
+    MFR_TRY(writePfm(viewPath(a.out, v, views), result.image));
+  else
+    MFR_TRY(writePng(viewPath(a.out, v, views), encodeSrgb(result.image)));
   try {
     if (!a.depthComplexity.empty()) {
       std::vector<uint32_t> n = result.depthComplexity;
@@ -151,6 +168,8 @@ int run(const RenderArgs& a) {
           outputFiles(a), {{"scene", a.scene.source}, {"--model", a.overrides.modelPath}});
       !distinct)
     return fail(distinct.error().message);
+  const auto outFormat = checkImageOutputs(a);
+  if (!outFormat) return fail(outFormat.error().message);
   auto method = buildMethod(a);
   if (!method) return fail(method.error().message);
   RenderOptions options;
@@ -190,7 +209,7 @@ int run(const RenderArgs& a) {
   auto rendered = renderViews(
       **engine, prepared->scene, a.scene.source, sceneViews, a.scene.width, a.scene.height,
       a.scene.sampleCount(), *method, options, budget, [&](const RenderedView& r) -> Result<void> {
-        MFR_TRY(writeViewImages(a, **engine, r, views));
+        MFR_TRY(writeViewImages(a, *outFormat, **engine, r, views));
         nlohmann::json stats = statsToJson(r.output.stats);
         stats["scene"] = a.scene.source;
         stats["width"] = a.scene.width;
@@ -235,7 +254,9 @@ Runner addRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "Render a scene with one method");
   args->scene.add(*cmd, true, true);
-  cmd->add_option("--out,-o", args->out, "Output PNG (sRGB)");
+  cmd->add_option("--out,-o", args->out,
+                  "Output image: NAME.png (sRGB, 8 bits) or NAME.pfm (Portable Float Map: linear "
+                  "RGB floats) (default mfr.png)");
   cmd->add_option("--depth-complexity", args->depthComplexity,
                   "Write the fragments-per-pixel map (colour-mapped PNG with legend)");
   cmd->add_option("--k-map", args->kMap, "Write the per-pixel k as a colour-mapped PNG");

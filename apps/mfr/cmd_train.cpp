@@ -167,6 +167,9 @@ int runTrain(TrainArgs& a) {
           {{"--out", a.out}, {"--log", a.log}, {"--loss-curve", a.lossCurve}}, inputs);
       !distinct)
     return fail(distinct.error().message);
+  if (auto format = imageOutputFormat("--loss-curve", a.lossCurve, {OutputImageFormat::Png});
+      !format)
+    return fail(format.error().message);
 
   auto split = loadSplit(a);
   if (!split) return fail(split.error().message);

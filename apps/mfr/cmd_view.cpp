@@ -5,6 +5,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "mfr/core/image.hpp"
 #include "view/viewer.hpp"
 
 namespace mfr::cli {
@@ -50,6 +51,11 @@ Runner addViewCommand(CLI::App& app) {
             {{"--screenshot", args->screenshot}, {"--stats-json", args->statsJson}});
         !distinct)
       return fail(distinct.error().message);
+    if (!args->screenshot.empty())
+      if (auto format =
+              imageOutputFormat("--screenshot", args->screenshot, {OutputImageFormat::Png});
+          !format)
+        return fail(format.error().message);
     return view::runViewer(*args);
   };
 }

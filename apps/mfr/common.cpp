@@ -102,7 +102,8 @@ void SceneOptions::add(CLI::App& app, bool sceneArgument, bool engineOption) {
   if (engineOption) {
     std::string names;
     for (const std::string& n : engineNames()) names += (names.empty() ? "" : "|") + n;
-    app.add_option("--engine", engine, "Engine that renders: " + names + " (default cpu)");
+    app.add_option("--engine", engine,
+                   "Engine that renders: " + names + " (default " + engine + ")");
     app.add_option("--gl-sync", glSync,
                    "GL engine's k-buffer capture: auto (the fragment shader interlock when the "
                    "driver offers it, else the spin-lock), lock or interlock (default auto)");

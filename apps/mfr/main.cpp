@@ -6,12 +6,15 @@
 #include <cstring>
 #include <exception>
 #include <new>
+#include <string>
+#include <vector>
 
 #include <unistd.h>
 
 #include "commands.hpp"
 #include "common.hpp"
 #include "mfr/core/quote.hpp"
+#include "mfr/core/suggest.hpp"
 #ifdef MFR_HAS_GL
 #include "mfr/gl/gl_render_engine.hpp"
 #endif
@@ -30,9 +33,14 @@ int reportParseError(const CLI::App& app, const CLI::ParseError& e, int argc, ch
   std::string message = mfr::oneLine(e.what(), 200);
   if (commands.empty() && argc > 1 && argv[1][0] != '-') {  // "mfr rendr ...": name the word
     std::string names;
-    for (const CLI::App* c : app.get_subcommands({}))
+    std::vector<std::string> known;
+    for (const CLI::App* c : app.get_subcommands({})) {
       names += (names.empty() ? "" : ", ") + c->get_name();
-    message = "unknown command " + mfr::quoteInput(argv[1]) + " (commands: " + names + ")";
+      known.push_back(c->get_name());
+    }
+    const std::string suggestion = mfr::didYouMean(argv[1], known);
+    message = "unknown command " + mfr::quoteInput(argv[1]) +
+              (suggestion.empty() ? "" : "; " + suggestion) + " (commands: " + names + ")";
   }
   const std::string help =
       commands.empty() ? "mfr --help" : "mfr " + commands.front()->get_name() + " --help";

@@ -54,7 +54,7 @@ __all__ = [
     "compare", "decode_srgb", "encode_srgb", "engine_names", "load_dataset", "load_model",
     "load_scene",
     "make_model", "metrics", "parse_bytes", "preset_names", "read_png", "render",
-    "save_dataset", "save_model", "write_png",
+    "save_dataset", "save_model", "write_pfm", "write_png",
 ]
 
 # --- arguments ---------------------------------------------------------------------------------
@@ -146,8 +146,15 @@ def read_png(path) -> np.ndarray:
 
 def write_png(path, image) -> None:
     """Writes uint8 (h, w, 3|4) sRGB, or float (h, w, 3) linear RGB (sRGB-encoded as mfr render
-    does), as a PNG."""
+    does), as a PNG. The path must end in .png (ValueError otherwise)."""
     _mfr.write_png(path, image)
+
+
+def write_pfm(path, image) -> None:
+    """Writes float (h, w, 3) linear RGB (r.image) as a Portable Float Map, as
+    `mfr render -o NAME.pfm` does: float32, rows bottom to top, little-endian. The path must end
+    in .pfm (ValueError otherwise)."""
+    _mfr.write_pfm(path, image)
 
 
 def encode_srgb(image) -> np.ndarray:

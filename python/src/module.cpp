@@ -3,6 +3,7 @@
 // datasets (learn.cpp). Library errors raise mfr.Error with the library's one-line message; the
 // GIL is released while the library works; arrays are returned over moved buffers, not copies.
 #include <cmath>
+#include <cstring>
 #include <optional>
 #include <type_traits>
 
@@ -244,11 +245,40 @@ py::array readPngArray(const py::object& pathArg) {
   return ownedArray<uint8_t>(std::move(image.rgba), {h, w, 4});
 }
 
+/// ValueError unless `path` ends in `format`'s extension (as the command line's --out): a PNG
+/// is never written under another name.
+void checkImagePath(const std::string& path, OutputImageFormat format) {
+  if (auto checked = imageOutputFormat("path", path, {format}); !checked)
+    throw py::value_error(checked.error().message);
+}
+
 void writePngArray(const py::object& pathArg, const py::object& image) {
   const std::string path = pathText(pathArg);
+  checkImagePath(path, OutputImageFormat::Png);
   const Image8 encoded = image8Argument(image, "image");
   py::gil_scoped_release release;
   unwrap(writePng(path, encoded));
+}
+
+void writePfmArray(const py::object& pathArg, const py::object& imageArg) {
+  const std::string path = pathText(pathArg);
+  checkImagePath(path, OutputImageFormat::Pfm);
+  const py::array image =
+      arrayArgument(imageArg, "image", "a linear float image array (height, width, 3)");
+  if (image.dtype().kind() != 'f')
+    throw py::value_error("image: expected floating-point linear values, got dtype " +
+                          std::string(py::str(static_cast<py::handle>(image.dtype()))) +
+                          " (an sRGB uint8 image: decode_srgb first)");
+  if (image.ndim() != 3 || image.shape(0) < 1 || image.shape(1) < 1 || image.shape(2) != 3)
+    throw py::value_error("image: expected an array (height, width, 3)");
+  if (image.shape(0) > kMaxImageSize || image.shape(1) > kMaxImageSize)
+    throw py::value_error("image: larger than " + std::to_string(kMaxImageSize) + " pixels");
+  const auto pixels = py::array_t<float, py::array::c_style | py::array::forcecast>(image);
+  ImageRGB linear(static_cast<int>(image.shape(1)), static_cast<int>(image.shape(0)));
+  std::memcpy(linear.pixels.data(), pixels.data(), sizeof(float) * 3 * linear.pixels.size());
+  unwrap(checkFinite(linear, "image"));
+  py::gil_scoped_release release;
+  unwrap(writePfm(path, linear));
 }
 
 py::array encodeSrgbArray(const py::object& linear) {
@@ -438,7 +468,11 @@ arguments.)");
   m.def("write_png", namedArguments("write_png(): ", &writePngArray), py::arg("path"),
         py::arg("image"),
         "Writes uint8 (h, w, 3|4) sRGB, or float (h, w, 3) linear RGB (sRGB-encoded as mfr "
-        "render does), as a PNG.");
+        "render does), as a PNG; the path must end in .png.");
+  m.def("write_pfm", namedArguments("write_pfm(): ", &writePfmArray), py::arg("path"),
+        py::arg("image"),
+        "Writes float (h, w, 3) linear RGB as a Portable Float Map (as mfr render -o NAME.pfm: "
+        "float32, rows bottom to top, little-endian); the path must end in .pfm.");
   m.def("encode_srgb", namedArguments("encode_srgb(): ", &encodeSrgbArray), py::arg("image"),
         "Linear float (h, w, 3) -> sRGB uint8 (h, w, 4), exactly as images are written.");
   m.def("decode_srgb", namedArguments("decode_srgb(): ", &decodeSrgbArray), py::arg("image"),

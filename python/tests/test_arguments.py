@@ -66,6 +66,8 @@ def valid_calls(work):
         "parse_bytes": (mfr.parse_bytes, lambda: dict(text="20MB")),
         "read_png": (mfr.read_png, lambda: dict(path=png)),
         "write_png": (mfr.write_png, lambda: dict(path=fresh("w") + ".png", image=rgb)),
+        "write_pfm": (mfr.write_pfm, lambda: dict(path=fresh("p") + ".pfm",
+                                                  image=np.zeros((4, 4, 3), np.float32))),
         "encode_srgb": (mfr.encode_srgb, lambda: dict(image=np.zeros((4, 4, 3), np.float32))),
         "decode_srgb": (mfr.decode_srgb, lambda: dict(image=rgb)),
         "engine_names": (mfr.engine_names, dict),

@@ -3,6 +3,7 @@ map, and errors; PNG and sRGB helpers."""
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -118,3 +119,34 @@ def test_png_and_srgb_helpers(tmp_path):
     (tmp_path / "file").write_text("a file, not a folder")
     with pytest.raises(mfr.Error, match="cannot write PNG"):
         mfr.write_png(tmp_path / "file" / "x.png", rgba)
+
+
+def test_image_files_are_named_by_their_format(tmp_path):
+    rgb = np.zeros((H, W, 3), np.uint8)
+    # a PNG is never written under another name (as `mfr render -o x.jpg` is refused)
+    for name in ("x.jpg", "x.exr", "x.pfm", "x"):
+        with pytest.raises(ValueError, match=r"^write_png\(\): path '.*" + re.escape(name) +
+                           r"': .*\(accepted: \.png\)$"):
+            mfr.write_png(tmp_path / name, rgb)
+        assert not (tmp_path / name).exists()
+    mfr.write_png(tmp_path / "upper.PNG", rgb)
+    assert (tmp_path / "upper.PNG").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    # write_pfm: linear floats as they are, rows bottom to top, little-endian (scale -1.0)
+    rng = np.random.default_rng(3)
+    linear = (rng.random((H, W, 3)) * 4.0).astype(np.float32)  # above 1: not clamped
+    mfr.write_pfm(tmp_path / "a.pfm", linear)
+    data = (tmp_path / "a.pfm").read_bytes()
+    header = f"PF\n{W} {H}\n-1.0\n".encode()
+    assert data[:len(header)] == header and len(data) == len(header) + H * W * 12
+    back = np.frombuffer(data[len(header):], dtype="<f4").reshape(H, W, 3)[::-1]
+    assert np.array_equal(back, linear)
+    for name in ("a.png", "a.PFM.txt"):
+        with pytest.raises(ValueError, match=r"^write_pfm\(\): path .*\(accepted: \.pfm\)$"):
+            mfr.write_pfm(tmp_path / name, linear)
+    with pytest.raises(ValueError, match=r"^write_pfm\(\): image: expected floating-point"):
+        mfr.write_pfm(tmp_path / "b.pfm", rgb)
+    bad = linear.copy()
+    bad[1, 2, 0] = np.nan
+    with pytest.raises(mfr.Error, match=r"^image: pixel \(2, 1\) is not finite"):
+        mfr.write_pfm(tmp_path / "b.pfm", bad)
+    assert not (tmp_path / "b.pfm").exists()

@@ -6,6 +6,7 @@
 #include "mfr/method/peel.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -426,6 +427,25 @@ nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersi
   return j;
 }
 
+namespace {
+
+/// A pass name as part of a CSV column name: lower case letters and digits, every run of other
+/// characters one '_' ("peel 1" -> "peel_1").
+std::string columnIdentifier(const std::string& name) {
+  std::string id;
+  for (char c : name) {
+    const auto u = static_cast<unsigned char>(c);
+    if (std::isalnum(u) && u < 0x80)
+      id += static_cast<char>(std::tolower(u));
+    else if (!id.empty() && id.back() != '_')
+      id += '_';
+  }
+  while (!id.empty() && id.back() == '_') id.pop_back();
+  return id.empty() ? "pass" : id;
+}
+
+}  // namespace
+
 std::string compareToCsv(const CompareResult& r) {
   // pass columns: the union of the runs' pass names, in order of first appearance
   std::vector<std::string> passes;
@@ -437,16 +457,28 @@ std::string compareToCsv(const CompareResult& r) {
   for (const CompareBudget& cb : r.budgets)
     for (const CompareRun& run : cb.runs) addPasses(run);
 
+  // every column name a snake_case identifier: "time_peel_1_ms" for pass "peel 1" (two names
+  // that would give one column get _2, _3, ...)
   std::ostringstream csv;
-  csv << "budget_bytes,method,compositing,status,image,bytes_used,fm_slots,fragment_slots,"
-         "memory_utilisation,k_min,k_max,fragments_generated,fragments_captured,fragments_lost,"
-         "fragments_lost_percent,mse,psnr,mse_linear,psnr_linear,mse_srgb,psnr_srgb,flip_mean,"
-         "total_ms";
-  for (const std::string& p : passes) csv << ",time_" << p << "_ms";
+  csv << "budget_bytes,budget_label,method,compositing,status,image,bytes_used,fm_slots,"
+         "fragment_slots,memory_utilisation,k_min,k_max,fragments_generated,fragments_captured,"
+         "fragments_lost,fragments_lost_percent,mse,psnr,mse_linear,psnr_linear,mse_srgb,"
+         "psnr_srgb,flip_mean,total_ms";
+  std::vector<std::string> columns;
+  for (const std::string& p : passes) {
+    const std::string base = "time_" + columnIdentifier(p) + "_ms";
+    std::string column = base;
+    for (int n = 2; std::find(columns.begin(), columns.end(), column) != columns.end(); ++n)
+      column = base + "_" + std::to_string(n);
+    columns.push_back(column);
+    csv << ',' << column;
+  }
   csv << ",error\n";
-  const auto row = [&](const CompareRun& run) {
+  // budget_label: the budget as given ("20MB", "25%"), empty for the ground truth
+  const auto row = [&](const CompareRun& run, const std::string& budgetLabel) {
     csv << (run.budgetBytes ? std::to_string(*run.budgetBytes) : std::string()) << ','
-        << csvField(run.method) << ',' << toString(run.compositing) << ',';
+        << csvField(budgetLabel) << ',' << csvField(run.method) << ',' << toString(run.compositing)
+        << ',';
     if (run.error) {
       csv << "error";
       for (size_t i = 0; i < 20 + passes.size(); ++i) csv << ',';
@@ -470,9 +502,9 @@ std::string compareToCsv(const CompareResult& r) {
     }
     csv << ",\n";
   };
-  row(r.groundTruth);
+  row(r.groundTruth, "");
   for (const CompareBudget& cb : r.budgets)
-    for (const CompareRun& run : cb.runs) row(run);
+    for (const CompareRun& run : cb.runs) row(run, cb.label);
   return csv.str();
 }
 

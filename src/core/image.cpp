@@ -1,8 +1,11 @@
 #include "mfr/core/image.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <string>
@@ -77,6 +80,59 @@ Result<void> writePng(const std::string& path, const Image8& image) {
     return makeError(what + ": cannot write PNG: " + reason);
   }
   return {};
+}
+
+Result<void> writePfm(const std::string& path, const ImageRGB& image) {
+  const std::string what = echoPath(path);
+  if (image.width <= 0 || image.height <= 0) return makeError(what + ": empty image");
+  std::string bytes =
+      "PF\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n-1.0\n";
+  const size_t header = bytes.size(), row = static_cast<size_t>(image.width) * 12;
+  bytes.resize(header + row * static_cast<size_t>(image.height));
+  for (int y = 0; y < image.height; ++y) {  // the bottom row first
+    char* out = bytes.data() + header + row * static_cast<size_t>(image.height - 1 - y);
+    for (int x = 0; x < image.width; ++x)
+      for (int c = 0; c < 3; ++c, out += 4) {
+        uint32_t word = std::bit_cast<uint32_t>(image.at(x, y)[c]);
+        if constexpr (std::endian::native == std::endian::big) word = __builtin_bswap32(word);
+        std::memcpy(out, &word, 4);
+      }
+  }
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  auto written = writeFileAtomically(path, bytes);
+  if (!written) {
+    std::string reason = written.error().message;
+    if (reason.rfind(what + ": ", 0) == 0) reason.erase(0, what.size() + 2);
+    return makeError(what + ": cannot write PFM: " + reason);
+  }
+  return {};
+}
+
+const char* imageExtension(OutputImageFormat format) {
+  return format == OutputImageFormat::Pfm ? ".pfm" : ".png";
+}
+
+Result<OutputImageFormat> imageOutputFormat(const std::string& option, const std::string& path,
+                                            std::initializer_list<OutputImageFormat> accepted) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status) &&
+      !std::filesystem::is_directory(status) && accepted.size() > 0)
+    return *accepted.begin();  // /dev/stdout, a pipe: nothing to name the format by
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  std::string list;
+  for (OutputImageFormat f : accepted) {
+    if (ext == imageExtension(f)) return f;
+    list += (list.empty() ? "" : ", ") + std::string(imageExtension(f));
+  }
+  const std::string given = std::filesystem::path(path).extension().string();
+  return makeError(option + " " + quoteInput(path, 256) + ": " +
+                   (given.empty() ? "no image extension"
+                                  : "unsupported image extension " + quoteInput(given, 40)) +
+                   " (accepted: " + list + ")");
 }
 
 Result<void> checkPngChunks(const uint8_t* bytes, size_t size, const std::string& what) {

@@ -2,6 +2,7 @@
 #include "mfr/engine/engine.hpp"
 
 #include "mfr/core/quote.hpp"
+#include "mfr/core/suggest.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
 
 namespace mfr {
@@ -52,7 +53,9 @@ Result<std::unique_ptr<Engine>> makeEngine(std::string_view name, const EngineOp
     if (known == name) return factory(options);
   std::string known;
   for (const std::string& n : engineNames()) known += (known.empty() ? "" : ", ") + n;
-  return makeError("--engine " + quoteInput(name) + ": unknown engine (known: " + known + ")");
+  const std::string suggestion = didYouMean(name, engineNames());
+  return makeError("--engine " + quoteInput(name) + ": unknown engine" +
+                   (suggestion.empty() ? "" : "; " + suggestion) + " (known: " + known + ")");
 }
 
 }  // namespace mfr

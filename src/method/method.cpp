@@ -1,6 +1,7 @@
 #include "mfr/method/method.hpp"
 
 #include "mfr/core/quote.hpp"
+#include "mfr/core/suggest.hpp"
 #include "mfr/method/peer_method.hpp"
 
 namespace mfr {
@@ -186,8 +187,16 @@ Result<MethodDesc> methodPreset(const std::string& fullName) {
     if (r.info.name == name) row = &r;
   if (row == nullptr) {
     std::string known;
-    for (const std::string& n : presetNames()) known += (known.empty() ? "" : ", ") + n;
-    return makeError("method " + quoteInput(fullName) + ": unknown (known: " + known +
+    std::vector<std::string> candidates;  // for "did you mean": every name that runs
+    for (const std::string& n : presetNames()) {
+      known += (known.empty() ? "" : ", ") + n;
+      candidates.push_back(n);
+    }
+    for (const std::string& n : presetNames())
+      if (methodPreset(n + suffix)) candidates.push_back(n + suffix);
+    const std::string suggestion = didYouMean(fullName, candidates);
+    return makeError("method " + quoteInput(fullName) + ": unknown" +
+                     (suggestion.empty() ? "" : "; " + suggestion) + " (known: " + known +
                      ", each optionally with +occupancy)");
   }
   row->configure(m);

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "mfr/core/image.hpp"
 #include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
@@ -152,12 +153,14 @@ Result<void> applyStep(const nlohmann::json& step, ViewSettings& s, FrameActions
       s.compare = value.get<bool>();
     } else if (key == "screenshot") {
       MFR_VIEW_GET(path, text(value, key));
+      MFR_TRY(imageOutputFormat("\"screenshot\"", path, {OutputImageFormat::Png}));
       actions.screenshots.push_back(path);
     } else if (key == "screenshot_maps") {
       MFR_VIEW_GET(prefix, text(value, key));
       actions.screenshotMaps.push_back(prefix);
     } else if (key == "screenshot_ui") {
       MFR_VIEW_GET(path, text(value, key));
+      MFR_TRY(imageOutputFormat("\"screenshot_ui\"", path, {OutputImageFormat::Png}));
       actions.screenshotsUi.push_back(path);
     } else if (key == "copy_command") {
       actions.copyCommand = true;

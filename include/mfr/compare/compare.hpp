@@ -151,7 +151,10 @@ Result<void> checkComparisonFits(const Engine& engine, int width, int height,
 /// run's keys (see docs/COMPARE.md). `mfrVersion` is recorded as mfr_version when not empty.
 nlohmann::json compareToJson(const CompareResult& result, const std::string& mfrVersion = "");
 
-/// results.csv: a header and one row per run (ground truth first), budgets in order.
+/// results.csv: a header and one row per run (ground truth first), budgets in order. Every column
+/// name is a snake_case identifier ([a-z0-9_]): budget_bytes, budget_label (the budget as given:
+/// "20MB", "25%"; empty for the ground truth), ..., total_ms, time_PASS_ms per pass (the pass name
+/// in lower case, other characters as '_': "peel 1" -> time_peel_1_ms), error.
 std::string compareToCsv(const CompareResult& result);
 
 struct ReportInfo {

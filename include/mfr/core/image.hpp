@@ -3,6 +3,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,26 @@ ImageRGB decodeSrgb(const Image8& image);
 Result<void> checkPngChunks(const uint8_t* bytes, size_t size, const std::string& what);
 
 Result<void> writePng(const std::string& path, const Image8& image);
+
+/// Writes a linear image as a Portable Float Map: "PF\n<width> <height>\n-1.0\n" (the negative
+/// scale marks little-endian), then the RGB float32 triples row by row from the bottom row up.
+/// The values are written as they are (no sRGB encoding, no clamping). Atomic, as writePng.
+Result<void> writePfm(const std::string& path, const ImageRGB& image);
+
+/// The image file formats mfr writes, chosen by a file name's extension.
+enum class OutputImageFormat { Png, Pfm };
+
+/// ".png", ".pfm".
+const char* imageExtension(OutputImageFormat format);
+
+/// The format of image output `path`, given by option `option` ("--out"), from its extension
+/// (case-insensitive) among `accepted`; an existing special file (/dev/stdout, a pipe) takes the
+/// first accepted format. Checked before any work, so that no output is written in a format its
+/// name does not say. Error (one line, naming the option, the path and the accepted extensions):
+/// "--out 'x.exr': unsupported image extension '.exr' (accepted: .png, .pfm)".
+Result<OutputImageFormat> imageOutputFormat(const std::string& option, const std::string& path,
+                                            std::initializer_list<OutputImageFormat> accepted);
+
 /// `beforeDecode`, when given, is called with the header's width and height before the pixels are
 /// decoded (a caller's memory pre-flight): its error is readPng's.
 Result<Image8> readPng(const std::string& path,
