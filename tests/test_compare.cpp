@@ -30,6 +30,17 @@
 namespace mfr {
 namespace {
 
+/// The fields of one CSV row: commas outside double quotes, plus one.
+size_t csvFieldCount(const std::string& row) {
+  size_t commas = 0;
+  bool quoted = false;
+  for (char c : row) {
+    if (c == '"') quoted = !quoted;
+    if (c == ',' && !quoted) ++commas;
+  }
+  return commas + 1;
+}
+
 namespace fs = std::filesystem;
 
 // 200 strands at 96x96: ~32k fragments, depth complexity ~25; the exact A-buffer needs ~320 KiB,
@@ -264,14 +275,8 @@ TEST_F(CompareLibrary, CsvHasOneRowPerRunAndTheGroundTruthFirst) {
   EXPECT_EQ(rows[0].rfind(",,abuffer,kbuffer,ok,ground_truth.png,", 0), 0u) << rows[0];
   EXPECT_EQ(rows[1].rfind(std::to_string(kSmall) + ",200KB,fkb,", 0), 0u) << rows[1];
   for (const std::string& row : rows) {
-    // no field of these rows is quoted except an error message; count the columns outside quotes
-    size_t commas = 0;
-    bool quoted = false;
-    for (char c : row) {
-      if (c == '"') quoted = !quoted;
-      if (c == ',' && !quoted) ++commas;
-    }
-    EXPECT_EQ(commas + 1, columns) << row;
+    // no field of these rows is quoted except an error message
+    EXPECT_EQ(csvFieldCount(row), columns) << row;
   }
   EXPECT_NE(rows[5].find(",abuffer,kbuffer,error,"), std::string::npos) << rows[5];
 }
@@ -614,13 +619,7 @@ TEST(CompareCsv, ColumnsAreSnakeCaseIdentifiersWithTheBudgetLabel) {
   EXPECT_EQ(rows[4].rfind("8388608,8MB,fkb,kbuffer,error,", 0), 0u) << rows[4];
   // every row has the header's columns (the error message quoted: its comma is not a column)
   for (const std::string& row : rows) {
-    size_t commas = 0;
-    bool quoted = false;
-    for (char c : row) {
-      if (c == '"') quoted = !quoted;
-      if (c == ',' && !quoted) ++commas;
-    }
-    EXPECT_EQ(commas + 1, columns.size()) << row;
+    EXPECT_EQ(csvFieldCount(row), columns.size()) << row;
   }
   EXPECT_NE(rows[2].find(",\"too small, by far\""), std::string::npos) << rows[2];
   // the pass times land in their own columns: peel 1 = 3, Peel-1 = 4, dual peel 2 (far) = 5
