@@ -484,6 +484,19 @@ struct UvTransform {
   }
 };
 
+/// A primitive's accessors, read and checked once: addMeshInstances places it once per instance.
+struct PrimitiveData {
+  bool skipped = false;           // points or lines: not a surface, counted per placement
+  std::string what;               // "mesh 0 ('name') primitive 1", for errors
+  std::vector<double> positions;  // xyz per vertex
+  std::vector<double> normals;    // xyz per vertex, or empty (area-weighted from the faces)
+  std::vector<double> uvs;        // the base colour's texture coordinate set, or empty
+  std::vector<double> colors;     // COLOR_0 as linear RGBA, or empty
+  UvTransform transform;
+  std::vector<uint32_t> triangles;  // vertex indices, three a triangle (empty: nothing to draw)
+  uint32_t material = 0;            // scene material
+};
+
 // ---------------------------------------------------------------------------------------------
 
 class GltfSceneBuilder {
@@ -514,9 +527,10 @@ class GltfSceneBuilder {
   Result<void> checkExpansion();
   Result<void> visitNodes();
   Result<void> addMeshInstances(const tinygltf::Node& node, int nodeIndex, const glm::dmat4& world);
-  Result<void> addMesh(int meshIndex, const glm::dmat4& world);
-  Result<void> addPrimitive(const tinygltf::Primitive& primitive, const glm::dmat4& world,
-                            const std::string& what);
+  Result<std::vector<PrimitiveData>> readMesh(int meshIndex);
+  Result<PrimitiveData> readPrimitive(const tinygltf::Primitive& primitive,
+                                      const std::string& what);
+  Result<void> placeMesh(const std::vector<PrimitiveData>& mesh, const glm::dmat4& world);
   uint32_t materialIndex(int gltfMaterial);
   int textureIndex(int gltfTexture);
   Result<void> readSamplers();
@@ -901,10 +915,22 @@ Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int 
   // before any instance is read: checkExpansion counted no instances for a mesh that is not there
   if (static_cast<size_t>(node.mesh) >= model_.meshes.size())
     return fail("mesh " + std::to_string(node.mesh) + " does not exist");
+  // the mesh is read once, when the first instance is placed (after that instance's checks), and
+  // placed per instance: their vertices and triangles were checked against the memory limit
+  // (checkExpansion)
+  std::optional<std::vector<PrimitiveData>> mesh;
+  const auto place = [&](const glm::dmat4& transform) -> Result<void> {
+    if (!mesh) {
+      auto read = readMesh(node.mesh);
+      if (!read) return read.error();
+      mesh = std::move(*read);
+    }
+    return placeMesh(*mesh, transform);
+  };
   const auto ext = node.extensions.find("EXT_mesh_gpu_instancing");
   if (ext == node.extensions.end() || !ext->second.Has("attributes") ||
       !ext->second.Get("attributes").IsObject())
-    return addMesh(node.mesh, world);
+    return place(world);
   const tinygltf::Value& attributes = ext->second.Get("attributes");
   const std::string what = "node " + std::to_string(nodeIndex) + " EXT_mesh_gpu_instancing";
   std::vector<double> values[3];  // translation, rotation, scale
@@ -924,8 +950,7 @@ Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int 
     count = n;
     values[a] = std::move(*read);
   }
-  if (!count) return addMesh(node.mesh, world);
-  // their vertices and triangles were checked against the memory limit (checkExpansion)
+  if (!count) return place(world);
   for (size_t i = 0; i < *count; ++i) {
     glm::dmat4 instance(1.0);
     if (!values[0].empty())
@@ -941,20 +966,24 @@ Result<void> GltfSceneBuilder::addMeshInstances(const tinygltf::Node& node, int 
     if (!values[2].empty())
       instance = glm::scale(
           instance, glm::dvec3(values[2][3 * i], values[2][3 * i + 1], values[2][3 * i + 2]));
-    MFR_TRY(addMesh(node.mesh, world * instance));
+    MFR_TRY(place(world * instance));
   }
   return {};
 }
 
 // `meshIndex` exists: addMeshInstances checked it
-Result<void> GltfSceneBuilder::addMesh(int meshIndex, const glm::dmat4& world) {
+Result<std::vector<PrimitiveData>> GltfSceneBuilder::readMesh(int meshIndex) {
   const tinygltf::Mesh& mesh = model_.meshes[static_cast<size_t>(meshIndex)];
+  std::vector<PrimitiveData> primitives;
+  primitives.reserve(mesh.primitives.size());
   for (size_t p = 0; p < mesh.primitives.size(); ++p) {
     const std::string what = "mesh " + std::to_string(meshIndex) + " (" +
                              quoteInput(mesh.name, 60) + ") primitive " + std::to_string(p);
-    MFR_TRY(addPrimitive(mesh.primitives[p], world, what));
+    auto read = readPrimitive(mesh.primitives[p], what);
+    if (!read) return read.error();
+    primitives.push_back(std::move(*read));
   }
-  return {};
+  return primitives;
 }
 
 /// Triangle list for a triangle, strip or fan primitive (glTF section 3.7.2.1); empty otherwise.
@@ -974,23 +1003,22 @@ std::vector<uint32_t> triangulate(int mode, const std::vector<uint32_t>& v) {
   return out;
 }
 
-Result<void> GltfSceneBuilder::addPrimitive(const tinygltf::Primitive& primitive,
-                                            const glm::dmat4& world, const std::string& what) {
+Result<PrimitiveData> GltfSceneBuilder::readPrimitive(const tinygltf::Primitive& primitive,
+                                                      const std::string& what) {
+  PrimitiveData out;
+  out.what = what;
   const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
   if (mode != TINYGLTF_MODE_TRIANGLES && mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
       mode != TINYGLTF_MODE_TRIANGLE_FAN) {
-    ++scene_.primitivesSkipped;  // points and lines are not surfaces: counted, not rendered
-    return {};
+    out.skipped = true;  // points and lines are not surfaces: counted, not rendered
+    return out;
   }
   const auto position = primitive.attributes.find("POSITION");
-  if (position == primitive.attributes.end()) return {};  // nothing to draw
+  if (position == primitive.attributes.end()) return out;  // nothing to draw
 
   auto positions = readAccessor(position->second, TINYGLTF_TYPE_VEC3, what + " POSITION");
   if (!positions) return positions.error();
   const size_t vertexCount = positions->size() / 3;
-  const size_t base = scene_.positions.size();
-  if (vertexCount > std::numeric_limits<uint32_t>::max() - base)
-    return fail(what + ": more than 2^32 vertices in the scene");
 
   std::vector<double> normals;
   if (auto it = primitive.attributes.find("NORMAL"); it != primitive.attributes.end()) {
@@ -1046,58 +1074,78 @@ Result<void> GltfSceneBuilder::addPrimitive(const tinygltf::Primitive& primitive
     corners.resize(vertexCount);
     for (size_t i = 0; i < vertexCount; ++i) corners[i] = static_cast<uint32_t>(i);
   }
-  std::vector<uint32_t> triangles = triangulate(mode, corners);
-  if (triangles.empty()) return {};
+  out.triangles = triangulate(mode, corners);
+  out.positions = std::move(*positions);
+  out.normals = std::move(normals);
+  out.uvs = std::move(uvs);
+  out.colors = std::move(colors);
+  out.transform = transform;
+  if (!out.triangles.empty()) out.material = materialIndex(primitive.material);  // as used
+  return out;
+}
 
+Result<void> GltfSceneBuilder::placeMesh(const std::vector<PrimitiveData>& mesh,
+                                         const glm::dmat4& world) {
   // Geometry to world space; normals by the inverse transpose; mirrored transforms flip winding
   // so that counter-clockwise stays front-facing.
   const double det = glm::determinant(glm::dmat3(world));
   const bool singular = !(std::abs(det) > 1e-300) || !std::isfinite(det);  // e.g. scale 0
   const glm::dmat3 normalMatrix =
       singular ? glm::dmat3(1.0) : glm::transpose(glm::inverse(glm::dmat3(world)));
-  for (size_t i = 0; i < vertexCount; ++i) {
-    const glm::dvec3 p = glm::make_vec3(positions->data() + 3 * i);
-    scene_.positions.emplace_back(glm::vec3(world * glm::dvec4(p, 1.0)));
-    if (!normals.empty()) {
-      const glm::dvec3 n = normalMatrix * glm::make_vec3(normals.data() + 3 * i);
-      const double length = glm::length(n);
-      scene_.normals.emplace_back(length > 0.0 ? glm::vec3(n / length) : glm::vec3(n));
-    } else {
-      scene_.normals.emplace_back(0.0f);  // filled from the faces below
-    }
-    scene_.uvs.emplace_back(uvs.empty() ? glm::vec2(0.0f)
-                                        : transform.apply(uvs[2 * i], uvs[2 * i + 1]));
-    scene_.colors.emplace_back(colors.empty() ? glm::vec4(1.0f)
-                                              : glm::vec4(static_cast<float>(colors[4 * i]),
-                                                          static_cast<float>(colors[4 * i + 1]),
-                                                          static_cast<float>(colors[4 * i + 2]),
-                                                          static_cast<float>(colors[4 * i + 3])));
-  }
-  anyUvs_ = anyUvs_ || !uvs.empty();
-  anyColors_ = anyColors_ || !colors.empty();
-
   const bool mirrored = det < 0.0;
-  const uint32_t material = materialIndex(primitive.material);
-  for (size_t t = 0; t < triangles.size(); t += 3) {
-    const uint32_t a = static_cast<uint32_t>(base) + triangles[t];
-    uint32_t b = static_cast<uint32_t>(base) + triangles[t + 1];
-    uint32_t c = static_cast<uint32_t>(base) + triangles[t + 2];
-    if (mirrored) std::swap(b, c);
-    scene_.indices.insert(scene_.indices.end(), {a, b, c});
-    scene_.triangleMaterial.push_back(material);
-    if (normals.empty()) {  // area-weighted vertex normals of this primitive
-      const glm::vec3 n = glm::cross(scene_.positions[b] - scene_.positions[a],
-                                     scene_.positions[c] - scene_.positions[a]);
-      scene_.normals[a] += n;
-      scene_.normals[b] += n;
-      scene_.normals[c] += n;
+  for (const PrimitiveData& primitive : mesh) {
+    if (primitive.skipped) ++scene_.primitivesSkipped;
+    if (primitive.triangles.empty()) continue;
+    const std::vector<double>& normals = primitive.normals;
+    const std::vector<double>& uvs = primitive.uvs;
+    const std::vector<double>& colors = primitive.colors;
+    const size_t vertexCount = primitive.positions.size() / 3;
+    const size_t base = scene_.positions.size();
+    if (vertexCount > std::numeric_limits<uint32_t>::max() - base)
+      return fail(primitive.what + ": more than 2^32 vertices in the scene");
+    for (size_t i = 0; i < vertexCount; ++i) {
+      const glm::dvec3 p = glm::make_vec3(primitive.positions.data() + 3 * i);
+      scene_.positions.emplace_back(glm::vec3(world * glm::dvec4(p, 1.0)));
+      if (!normals.empty()) {
+        const glm::dvec3 n = normalMatrix * glm::make_vec3(normals.data() + 3 * i);
+        const double length = glm::length(n);
+        scene_.normals.emplace_back(length > 0.0 ? glm::vec3(n / length) : glm::vec3(n));
+      } else {
+        scene_.normals.emplace_back(0.0f);  // filled from the faces below
+      }
+      scene_.uvs.emplace_back(uvs.empty() ? glm::vec2(0.0f)
+                                          : primitive.transform.apply(uvs[2 * i], uvs[2 * i + 1]));
+      scene_.colors.emplace_back(colors.empty() ? glm::vec4(1.0f)
+                                                : glm::vec4(static_cast<float>(colors[4 * i]),
+                                                            static_cast<float>(colors[4 * i + 1]),
+                                                            static_cast<float>(colors[4 * i + 2]),
+                                                            static_cast<float>(colors[4 * i + 3])));
     }
-  }
-  if (normals.empty()) {
-    for (size_t i = base; i < scene_.normals.size(); ++i) {
-      const float length = glm::length(scene_.normals[i]);
-      scene_.normals[i] = (length > 0.0f && std::isfinite(length)) ? scene_.normals[i] / length
-                                                                   : glm::vec3(0.0f, 0.0f, 1.0f);
+    anyUvs_ = anyUvs_ || !uvs.empty();
+    anyColors_ = anyColors_ || !colors.empty();
+
+    const std::vector<uint32_t>& triangles = primitive.triangles;
+    for (size_t t = 0; t < triangles.size(); t += 3) {
+      const uint32_t a = static_cast<uint32_t>(base) + triangles[t];
+      uint32_t b = static_cast<uint32_t>(base) + triangles[t + 1];
+      uint32_t c = static_cast<uint32_t>(base) + triangles[t + 2];
+      if (mirrored) std::swap(b, c);
+      scene_.indices.insert(scene_.indices.end(), {a, b, c});
+      scene_.triangleMaterial.push_back(primitive.material);
+      if (normals.empty()) {  // area-weighted vertex normals of this primitive
+        const glm::vec3 n = glm::cross(scene_.positions[b] - scene_.positions[a],
+                                       scene_.positions[c] - scene_.positions[a]);
+        scene_.normals[a] += n;
+        scene_.normals[b] += n;
+        scene_.normals[c] += n;
+      }
+    }
+    if (normals.empty()) {
+      for (size_t i = base; i < scene_.normals.size(); ++i) {
+        const float length = glm::length(scene_.normals[i]);
+        scene_.normals[i] = (length > 0.0f && std::isfinite(length)) ? scene_.normals[i] / length
+                                                                     : glm::vec3(0.0f, 0.0f, 1.0f);
+      }
     }
   }
   return {};
