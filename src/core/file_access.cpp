@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <system_error>
@@ -189,6 +190,12 @@ Result<OpenFile> openReference(const fs::path& referencingFile, const std::strin
     }
   }
   return checkedOpenFile(fd, target.empty() ? folder / ref : target, what);
+}
+
+std::string lowercaseExtension(const std::filesystem::path& path) {
+  std::string extension = path.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return extension;
 }
 
 bool isNoSuchFileError(const Error& error) {

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <bit>
-#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -121,8 +120,7 @@ Result<OutputImageFormat> imageOutputFormat(const std::string& option, const std
   if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status) &&
       !std::filesystem::is_directory(status) && accepted.size() > 0)
     return *accepted.begin();  // /dev/stdout, a pipe: nothing to name the format by
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  const std::string ext = lowercaseExtension(path);
   std::string list;
   for (OutputImageFormat f : accepted) {
     if (ext == imageExtension(f)) return f;

@@ -179,9 +179,8 @@ Result<Scene> loadJsonScene(const std::string& path, const OpenFile& file,
     loaded = loadScene(mesh, meshOptions);
   } else {
     const std::filesystem::path meshPath(mesh);
-    std::string extension = meshPath.extension().string();
-    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (extension == ".json") return check.fail("mesh", "must not be another JSON scene file");
+    if (lowercaseExtension(meshPath) == ".json")
+      return check.fail("mesh", "must not be another JSON scene file");
     // opened once, relative to this file's folder; the mesh loader reads that descriptor
     auto meshFile =
         openReference(path, mesh, "'mesh' " + oneLine(mesh, 200), options.allowOutsideReferences);

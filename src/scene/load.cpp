@@ -3,8 +3,6 @@
 // has vertex normals, passes validateScene and is named after the source string.
 #include "mfr/scene/load.hpp"
 
-#include <algorithm>
-#include <cctype>
 #include <filesystem>
 
 #include "file_loaders.hpp"
@@ -19,13 +17,6 @@ namespace {
 constexpr const char* kProceduralPrefix = "procedural:";
 /// However much of its input a loader or library quotes, an error stays a readable line.
 constexpr size_t kMaxMessage = 1000;
-
-std::string lowercaseExtension(const std::string& path) {
-  std::string extension = std::filesystem::path(path).extension().string();
-  std::transform(extension.begin(), extension.end(), extension.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return extension;
-}
 
 Result<Scene> loadFile(const std::string& path, const LoadOptions& options) {
   // opened once, non-blocking: a FIFO or device named as the scene is refused on the descriptor

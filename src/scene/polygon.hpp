@@ -2,11 +2,11 @@
 //
 // Triangles and convex quads are split as tinyobjloader splits them (a quad along its shorter
 // diagonal), so that scenes made of them load as before; a concave quad is split from its reflex
-// corner, and one that crosses itself (a bow-tie) is refused. Larger polygons are projected onto the plane of
-// their Newell normal (Newell 1972; Sutherland, Sproull, Schumacker 1974); a convex one (every turn
-// the same way, and each axis direction changing sign at most twice, so a star polygon whose
-// turns all agree is not mistaken for one) becomes a fan, a non-convex one is ear-clipped (Meisters
-// 1975) up to kMaxNonConvexCorners corners, quadratic in the corners.
+// corner, and one that crosses itself (a bow-tie) is refused. Larger polygons are projected onto
+// the plane of their Newell normal (Newell 1972; Sutherland, Sproull, Schumacker 1974); a convex
+// one (every turn the same way, and each axis direction changing sign at most twice, so a star
+// polygon whose turns all agree is not mistaken for one) becomes a fan, a non-convex one is
+// ear-clipped (Meisters 1975) up to kMaxNonConvexCorners corners, quadratic in the corners.
 #pragma once
 
 #include <cstddef>

@@ -87,6 +87,10 @@ Result<OpenFile> openReference(const std::filesystem::path& referencingFile,
 /// not exist (as opposed to a refusal or a read error).
 bool isNoSuchFileError(const Error& error);
 
+/// The extension of `path`'s file name in lower case, dot included (".gltf" for "Scene.GLTF"),
+/// or "" when it has none: what the loaders and the image writers choose a format by.
+std::string lowercaseExtension(const std::filesystem::path& path);
+
 /// Checks an image header's dimensions against kMaxImageDimension and kMaxImagePixels.
 Result<void> checkImageDimensions(int width, int height, const std::string& what);
 
