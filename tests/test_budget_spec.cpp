@@ -185,7 +185,7 @@ TEST(RelativeBudget, CompareTakesMixedLists) {
   o.methods = {"fkb", "kplus-dynamic", "vkb-fill"};
   o.budgets = {BudgetSpec(400u << 10), BudgetSpec::relative(50.0), BudgetSpec::relative(20.0)};
   o.scene = kScene;
-  o.compositing = Compositing::KBuffer;
+  o.rules = {Compositing::KBuffer};
   auto r = runComparison(engine(), *view, o);
   ASSERT_TRUE(r.ok()) << r.error().message;
   ASSERT_EQ(r->budgets.size(), 3u);
@@ -291,7 +291,7 @@ TEST(RelativeBudgetCli, CompareWritesMixedBudgets) {
   const fs::path dir = test::processTempDir("mfr_relative_compare") / "out";
   auto r = test::runCli(std::string("compare '") + kScene +
                             "' --width 96 --height 96 --quiet --methods fkb,kplus-dynamic "
-                            "--budget 400KB,25%,50% --out " +
+                            "--composite kbuffer --budget 400KB,25%,50% --out " +
                             dir.string(),
                         dir.parent_path());
   ASSERT_EQ(r.exitCode, 0) << r.err;

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -76,24 +77,56 @@ TEST(CliDefaults, OtherPresetsCompositeKBufferUnlessTold) {
   }
 }
 
-TEST(CliDefaults, CompareUsesEachPresetsRuleUnlessTold) {
+// The fair default (issue 48): every method that takes a rule runs under kbuffer and hybrid, the
+// oracle too, each row labelled with its rule; --composite narrows it to the rules named.
+TEST(CliDefaults, CompareRunsBothRulesUnlessTold) {
   const fs::path out = tempDir() / "compare";
-  const std::string base = "compare " + kScene + " --budget 400KB --methods fkb,dkb,optimal --out ";
+  const std::string base =
+      "compare " + kScene + " --budget 400KB --methods fkb,dkb,optimal,wboit --out ";
   test::CliRun r = test::runCli(base + out.string(), tempDir());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   nlohmann::json j = readJson(out / "results.json");
   EXPECT_EQ(j["compositing"], "per-method");
-  ASSERT_EQ(j["methods"].size(), 3u);
-  const char* expected[] = {"kbuffer", "hybrid", "hybrid"};
-  for (size_t i = 0; i < 3; ++i) {
-    EXPECT_EQ(j["methods"][i]["compositing"], expected[i]) << j["methods"][i]["name"];
-    EXPECT_EQ(j["methods"][i]["bytes_by_category"].contains("tail"), i > 0);
+  EXPECT_EQ(j["compositing_rules"], nlohmann::json({"kbuffer", "hybrid"}));
+  ASSERT_EQ(j["methods"].size(), 7u);
+  const char* labels[] = {"fkb-kbuffer",     "fkb-hybrid",     "dkb-kbuffer", "dkb-hybrid",
+                          "optimal-kbuffer", "optimal-hybrid", "wboit"};
+  const char* names[] = {"fkb", "fkb", "dkb", "dkb", "optimal", "optimal", "wboit"};
+  for (size_t i = 0; i < 7; ++i) {
+    const nlohmann::json& run = j["methods"][i];
+    EXPECT_EQ(run["label"], labels[i]);
+    EXPECT_EQ(run["name"], names[i]);
+    const bool hybrid = std::string(labels[i]).ends_with("-hybrid");
+    if (i < 6) {
+      EXPECT_EQ(run["compositing"], hybrid ? "hybrid" : "kbuffer") << labels[i];
+    }
+    EXPECT_EQ(run["bytes_by_category"].contains("tail"), hybrid) << labels[i];
+    EXPECT_EQ(run["image"], std::string(labels[i]) + "_400KB.png");
+    EXPECT_TRUE(fs::exists(out / run["image"].get<std::string>())) << labels[i];
+  }
+  EXPECT_EQ(j["methods"][6]["compositing"],
+            "weighted-blended");  // a peer method keeps its own rule
+  // the console table says which rule each row ran
+  std::string loud = base;  // without --quiet
+  loud.erase(loud.find(" --quiet"), 8);
+  r = test::runCli(loud + out.string(), tempDir());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  for (const char* label : {"optimal-kbuffer", "optimal-hybrid"}) {
+    const size_t at = r.err.find(std::string("  ") + label + " ");
+    ASSERT_NE(at, std::string::npos) << r.err;
+    std::istringstream row(r.err.substr(at));
+    std::string name, rule;
+    row >> name >> rule;
+    EXPECT_EQ(rule, std::string(label).substr(8)) << r.err;
   }
   r = test::runCli(base + out.string() + " --composite kbuffer", tempDir());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   j = readJson(out / "results.json");
   EXPECT_EQ(j["compositing"], "kbuffer");
+  ASSERT_EQ(j["methods"].size(), 4u);
   for (const nlohmann::json& run : j["methods"]) {
+    EXPECT_EQ(run["label"], run["name"]);  // one rule: the preset's name
+    if (run["name"] == "wboit") continue;
     EXPECT_EQ(run["compositing"], "kbuffer") << run["name"];
     EXPECT_FALSE(run["bytes_by_category"].contains("tail")) << run["name"];
   }

@@ -272,8 +272,8 @@ TEST_F(CompareLibrary, CsvHasOneRowPerRunAndTheGroundTruthFirst) {
   std::vector<std::string> rows;
   while (std::getline(in, line)) rows.push_back(line);
   ASSERT_EQ(rows.size(), 1 + kMethods.size() * 2);
-  EXPECT_EQ(rows[0].rfind(",,abuffer,kbuffer,ok,ground_truth.png,", 0), 0u) << rows[0];
-  EXPECT_EQ(rows[1].rfind(std::to_string(kSmall) + ",200KB,fkb,", 0), 0u) << rows[1];
+  EXPECT_EQ(rows[0].rfind(",,abuffer,abuffer,kbuffer,ok,ground_truth.png,", 0), 0u) << rows[0];
+  EXPECT_EQ(rows[1].rfind(std::to_string(kSmall) + ",200KB,fkb,fkb,", 0), 0u) << rows[1];
   for (const std::string& row : rows) {
     // no field of these rows is quoted except an error message
     EXPECT_EQ(csvFieldCount(row), columns) << row;
@@ -348,7 +348,7 @@ TEST(CompareOptionsCheck, SingleBudgetHasNoPlotsAndHybridIsRecorded) {
   CompareOptions o;
   o.methods = {"kplus-sb"};
   o.budgets = {1u << 20};
-  o.compositing = Compositing::Hybrid;
+  o.rules = {Compositing::Hybrid};
   o.scene = kScene;
   auto r = runComparison(engine(), *view, o);
   ASSERT_TRUE(r.ok()) << r.error().message;
@@ -414,7 +414,7 @@ class CompareCli : public ::testing::Test {
     run_ =
         new CompareCliRun(runCli("compare " + sceneArgs() +
                                  " --budget 200KB,400KB --methods fkb,kplus-dynamic,vkb,vkb-fill,"
-                                 "abuffer --json --out '" +
+                                 "abuffer --composite kbuffer --json --out '" +
                                  dir_->string() + "'"));
   }
   static void TearDownTestSuite() {
@@ -563,7 +563,7 @@ TEST_F(CompareCli, SummaryAndReportPathOnStderrAndACsvRowPerRun) {
 // column "time_peel 1_ms"), and budget_label beside budget_bytes with the budget as given.
 TEST(CompareCsv, ColumnsAreSnakeCaseIdentifiersWithTheBudgetLabel) {
   CompareResult r;
-  r.groundTruth.method = "abuffer";
+  r.groundTruth.method = r.groundTruth.label = "abuffer";
   r.groundTruth.imageFile = "ground_truth.png";
   r.groundTruth.stats.passes = {{"capture", 1.0}, {"peel 1", 2.0}};
   const auto budget = [](uint64_t bytes, const std::string& label) {
@@ -572,11 +572,14 @@ TEST(CompareCsv, ColumnsAreSnakeCaseIdentifiersWithTheBudgetLabel) {
     b.label = label;
     CompareRun ok;
     ok.method = "peel";
+    ok.label = "peel-hybrid";
+    ok.compositing = Compositing::Hybrid;
+    ok.timing = {3, 12.0, 11.5, 14.25};
     ok.budgetBytes = bytes;
     ok.imageFile = "peel_" + label + ".png";
     ok.stats.passes = {{"peel 1", 3.0}, {"Peel-1", 4.0}, {"dual peel 2 (far)", 5.0}};
     CompareRun failed;
-    failed.method = "fkb";
+    failed.method = failed.label = "fkb";
     failed.budgetBytes = bytes;
     failed.error = "too small, by far";
     b.runs = {ok, failed};
@@ -601,22 +604,26 @@ TEST(CompareCsv, ColumnsAreSnakeCaseIdentifiersWithTheBudgetLabel) {
   EXPECT_EQ(columns[0], "budget_bytes");
   EXPECT_EQ(columns[1], "budget_label");
   EXPECT_EQ(columns[2], "method");
+  EXPECT_EQ(columns[3], "label");
+  EXPECT_EQ(columns[4], "compositing");
   EXPECT_EQ(columns.back(), "error");
   // the passes in order of first appearance; two names of one identifier get a suffix
   const std::vector<std::string> times = {"time_capture_ms", "time_peel_1_ms", "time_peel_1_ms_2",
                                           "time_dual_peel_2_far_ms"};
-  EXPECT_NE(header.find(",total_ms," + times[0] + "," + times[1] + "," + times[2] + "," + times[3] +
-                        ",error"),
+  EXPECT_NE(header.find(",total_ms,repeats,total_ms_min,total_ms_max," + times[0] + "," + times[1] +
+                        "," + times[2] + "," + times[3] + ",error"),
             std::string::npos)
       << header;
   std::vector<std::string> rows;
   for (std::string line; std::getline(in, line);) rows.push_back(line);
   ASSERT_EQ(rows.size(), 5u);
-  EXPECT_EQ(rows[0].rfind(",,abuffer,kbuffer,ok,ground_truth.png,", 0), 0u) << rows[0];
-  EXPECT_EQ(rows[1].rfind("123456,25%,peel,kbuffer,ok,peel_25%.png,", 0), 0u) << rows[1];
-  EXPECT_EQ(rows[2].rfind("123456,25%,fkb,kbuffer,error,", 0), 0u) << rows[2];
-  EXPECT_EQ(rows[3].rfind("8388608,8MB,peel,", 0), 0u) << rows[3];
-  EXPECT_EQ(rows[4].rfind("8388608,8MB,fkb,kbuffer,error,", 0), 0u) << rows[4];
+  EXPECT_EQ(rows[0].rfind(",,abuffer,abuffer,kbuffer,ok,ground_truth.png,", 0), 0u) << rows[0];
+  EXPECT_EQ(rows[1].rfind("123456,25%,peel,peel-hybrid,hybrid,ok,peel_25%.png,", 0), 0u) << rows[1];
+  EXPECT_EQ(rows[2].rfind("123456,25%,fkb,fkb,kbuffer,error,", 0), 0u) << rows[2];
+  EXPECT_EQ(rows[3].rfind("8388608,8MB,peel,peel-hybrid,", 0), 0u) << rows[3];
+  EXPECT_EQ(rows[4].rfind("8388608,8MB,fkb,fkb,kbuffer,error,", 0), 0u) << rows[4];
+  // the median total (the passes' sum), then the number of timed renders and their spread
+  EXPECT_NE(rows[1].find(",12.000,3,11.500,14.250,"), std::string::npos) << rows[1];
   // every row has the header's columns (the error message quoted: its comma is not a column)
   for (const std::string& row : rows) {
     EXPECT_EQ(csvFieldCount(row), columns.size()) << row;
@@ -681,7 +688,7 @@ std::string compareArgs(int size, const std::string& methods, const fs::path& ou
   // double quotes: the tests wrap some commands in sh -c '...'
   return "compare \"" + std::string(kScene) + "\" --width " + std::to_string(size) + " --height " +
          std::to_string(size) + " --threads 2 --budget 200KB --methods " + methods +
-         " -q --out \"" + out.string() + "\"";
+         " --composite kbuffer -q --out \"" + out.string() + "\"";
 }
 
 /// Every file of `dir` and its bytes.

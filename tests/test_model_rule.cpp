@@ -198,8 +198,19 @@ TEST(ModelRuleCli, RenderAndCompareRefuseAModelOfTheOtherRule) {
                      {"kbuffer.mfrnn", "--composite kbuffer"});
   EXPECT_FALSE(fs::exists(path("x.png")));
   expectOneLineError(runCli("compare " + scene + "--methods fkb,dkb --budget 60KB --model " +
-                            modelFor("kbuffer") + " -o " + path("cmp")),
+                            modelFor("kbuffer") + " --composite hybrid -o " + path("cmp")),
                      {"kbuffer.mfrnn"});
+  {  // under the default rules (both), dkb runs under the one its model was trained for
+    auto r = runCli("compare " + scene + "--methods fkb,dkb --budget 60KB --model " +
+                    modelFor("kbuffer") + " --repeat 1 --warmup 0 -o " + path("cmp"));
+    ASSERT_EQ(r.exitCode, 0) << r.err;
+    std::ifstream in(path("cmp") + "/results.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    std::vector<std::string> labels;
+    for (const nlohmann::json& run : j["methods"]) labels.push_back(run["label"]);
+    EXPECT_EQ(labels, (std::vector<std::string>{"fkb-kbuffer", "fkb-hybrid", "dkb"}));
+    EXPECT_EQ(j["methods"][2]["compositing"], "kbuffer");
+  }
   // matching rules render, the built-in models included
   for (const std::string rule : {"hybrid", "kbuffer"}) {
     auto r = runCli("render " + scene + "-m dkb -M 60KB --composite " + rule + " --model " +

@@ -321,7 +321,7 @@ TEST_P(ReportPlots, EveryPlottedPointIsTheJsonValue) {
   o.methods = sc.methods;
   o.budgets.assign(sc.budgets.begin(), sc.budgets.end());
   o.scene = kScene;
-  o.compositing = Compositing::KBuffer;  // explicit: independent of the presets' defaults
+  o.rules = {Compositing::KBuffer};  // explicit: independent of the presets' defaults
   auto r = runComparison(engine, *view, o);
   ASSERT_TRUE(r.ok()) << r.error().message;
   const nlohmann::json j = compareToJson(r.value());

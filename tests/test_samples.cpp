@@ -467,7 +467,7 @@ TEST(Samples, CompareRunsEverySampleCountAndPlotsThem) {
   const std::filesystem::path dir = mfr::test::processTempDir("mfr_sample_counts");
   const std::string common =
       "compare procedural:bottles?count=3 --width 32 --height 24 -q "
-      "-m kplus-heap,abuffer -M 40KB,80KB -o " +
+      "-m kplus-heap,abuffer -M 40KB,80KB --composite kbuffer -o " +
       (dir / "out").string();
   const mfr::test::CliRun ok = mfr::test::runCli(common + " --sample-counts 1,4", dir);
   ASSERT_EQ(ok.exitCode, 0) << ok.err;

@@ -52,7 +52,7 @@ double expectedErrorChange(const Image8& m0, const Image8& g0, const Image8& m1,
 
 CompareRun run(const std::string& method, const Image8& image, double flip) {
   CompareRun r;
-  r.method = method;
+  r.method = r.label = method;
   r.image = image;
   r.metrics.flipMean = flip;
   return r;
@@ -145,7 +145,7 @@ TEST(TemporalStability, ExactMethodsHaveNoExcessFlickerAlongAnOrbit) {
   CompareOptions o;
   o.methods = {"abuffer", "kplus-dynamic", "vkb"};
   o.budgets = {BudgetSpec::relative(100.0)};
-  o.compositing = Compositing::KBuffer;
+  o.rules = {Compositing::KBuffer};
   TemporalStability t;
   const std::vector<Camera> path = orbitPath(camera, 4, 6.0f);
   ASSERT_EQ(path.size(), 4u);
@@ -178,7 +178,8 @@ TEST(TemporalStabilityCli, CompareOrbitWritesFramesMeasureAndPlots) {
   const fs::path dir = test::processTempDir("mfr_temporal") / "out";
   auto r = test::runCli(
       "compare 'procedural:hairball?strands=120' --width 64 --height 64 --quiet --orbit 3 "
-      "--orbit-step 5 --methods abuffer,fkb,vkb-fill --budget 100%,60% --out " +
+      "--orbit-step 5 --methods abuffer,fkb,vkb-fill --composite kbuffer --budget 100%,60% "
+      "--out " +
           dir.string(),
       dir.parent_path());
   ASSERT_EQ(r.exitCode, 0) << r.err;

@@ -14,6 +14,7 @@
 #include "common.hpp"
 #include "mfr/compare/compare.hpp"
 #include "mfr/compare/compare_output.hpp"
+#include "mfr/compare/compare_request.hpp"
 #include "mfr/compare/temporal.hpp"
 #include "mfr/compare/temporal_run.hpp"
 #include "mfr/core/atomic_file.hpp"
@@ -34,30 +35,19 @@ namespace fs = std::filesystem;
 struct CompareArgs {
   SceneOptions scene;
   std::string budgets;
-  std::string methods =
-      "fkb,kplus-dynamic,vkb,vkb-fill,dkb,dkb-fill,optimal,wboit,mboit,mboit6,mboit8,mboit-trig3,"
-      "mboit-trig4,mboit-q16,mboit6-q16,mboit8-q16,mboit-trig3-q16,mboit-trig4-q16,mlab,aoit4,"
-      "aoit8,aoit16,linked-list,peel,dual-peel,dfaoit,stochastic,stochastic-strat,hashed-alpha";
+  std::string methods = kDefaultCompareMethods;
   std::string model;
   std::string out;
-  std::string composite;            // empty: each preset's own rule
+  std::string composite;            // empty: both rules for the methods that take both
   std::optional<int64_t> maxPeels;  // --max-peels (peel, dual-peel)
   std::string capture = "tile";
   double pixelsPerDegree = kFlipDefaultPixelsPerDegree;
   double orbitStep = 0.0;    // --orbit N without --orbit-view: degrees between frames (0: 360 / N)
   std::string sampleCounts;  // --sample-counts 1,4,8: the comparison at each count too
+  int64_t repeat = 3;        // timed renders per run
+  int64_t warmup = 1;        // untimed renders before them
+  std::string truthEngine;   // empty: the engine's own, the CPU engine where a GPU refuses it
 };
-
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> items;
-  std::string item;
-  std::istringstream in(text);
-  while (std::getline(in, item, ',')) {
-    const size_t b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
-    items.push_back(b == std::string::npos ? std::string() : item.substr(b, e - b + 1));
-  }
-  return items;
-}
 
 // The command line as typed (from /proc/self/cmdline), shell-quoted where needed.
 std::string commandLine() {
@@ -110,26 +100,30 @@ std::string psnrCell(double psnr) {
 }
 
 void printSummary(const CompareResult& r) {
-  std::fprintf(stderr, "%s %dx%d, ground truth: %llu fragments, %s, %.1f ms\n",
-               echoPath(r.scene).c_str(), r.width, r.height,
+  std::fprintf(stderr, "%s %dx%d, ground truth (%s engine): %llu fragments, %s, %.1f ms\n",
+               echoPath(r.scene).c_str(), r.width, r.height, r.truthEngine.c_str(),
                static_cast<unsigned long long>(r.groundTruth.stats.fragmentsGenerated),
                formatBytes(r.groundTruth.stats.bytesUsed).c_str(), r.groundTruth.stats.totalMs());
-  std::fprintf(stderr, "  %-20s %8s %11s %9s %7s %10s %9s %10s %8s %9s\n", "method", "budget",
-               "used", "k", "lost%", "mse_lin", "psnr_lin", "psnr_srgb", "flip", "ms");
+  // ms: the median of the timed renders (--repeat), min-max beside it
+  std::fprintf(stderr, "  %-22s %-7s %8s %11s %9s %7s %10s %9s %10s %8s %9s %s\n", "method", "rule",
+               "budget", "used", "k", "lost%", "mse_lin", "psnr_lin", "psnr_srgb", "flip", "ms",
+               "ms_range");
   for (const CompareBudget& cb : r.budgets)
     for (const CompareRun& run : cb.runs) {
       if (!run.ok()) {
-        std::fprintf(stderr, "  %-20s %8s  failed: %s\n", run.method.c_str(), cb.label.c_str(),
-                     run.error->c_str());
+        std::fprintf(stderr, "  %-22s %-7s %8s  failed: %s\n", run.label.c_str(),
+                     toString(run.compositing), cb.label.c_str(), run.error->c_str());
         continue;
       }
       const RenderStats& s = run.stats;
-      char k[32];
+      char k[32], range[48];
       std::snprintf(k, sizeof k, "%u-%u", s.kMin, s.kMax);
-      std::fprintf(stderr, "  %-20s %8s %11s %9s %7.2f %10.3e %9s %10s %8.4f %9.1f\n",
-                   run.method.c_str(), cb.label.c_str(), formatBytes(s.bytesUsed).c_str(), k,
-                   s.lostPercent(), run.metrics.mseLinear, psnrCell(run.metrics.psnrLinear).c_str(),
-                   psnrCell(run.metrics.psnrSrgb).c_str(), run.metrics.flipMean, s.totalMs());
+      std::snprintf(range, sizeof range, "%.1f-%.1f", run.timing.minMs, run.timing.maxMs);
+      std::fprintf(stderr, "  %-22s %-7s %8s %11s %9s %7.2f %10.3e %9s %10s %8.4f %9.1f %s\n",
+                   run.label.c_str(), toString(run.compositing), cb.label.c_str(),
+                   formatBytes(s.bytesUsed).c_str(), k, s.lostPercent(), run.metrics.mseLinear,
+                   psnrCell(run.metrics.psnrLinear).c_str(), psnrCell(run.metrics.psnrSrgb).c_str(),
+                   run.metrics.flipMean, s.totalMs(), range);
     }
 }
 
@@ -165,11 +159,15 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
   if (!a.scene.quiet) {
     std::fprintf(stderr, "%s, %d frames %.3g degrees apart; ground truth flicker %.4f\n",
                  echoPath(a.scene.source).c_str(), frames, step, t.groundTruthFlicker);
-    std::fprintf(stderr, "  %-20s %8s %9s %9s %12s\n", "method", "budget", "flicker", "excess",
-                 "error change");
-    for (const TemporalSeries& s : t.series)
-      std::fprintf(stderr, "  %-20s %8s %9.4f %9.4f %12.4f\n", s.method.c_str(),
-                   s.budgetLabel.c_str(), s.flicker, s.excessFlicker, s.meanErrorChange);
+    // flip: the mean over the frames of each frame's mean FLIP against its ground truth
+    std::fprintf(stderr, "  %-22s %8s %8s %9s %9s %12s\n", "method", "budget", "flip", "flicker",
+                 "excess", "error change");
+    for (const TemporalSeries& s : t.series) {
+      double flip = 0.0;
+      for (const double f : s.errorFlip) flip += f / static_cast<double>(s.errorFlip.size());
+      std::fprintf(stderr, "  %-22s %8s %8.4f %9.4f %9.4f %12.4f\n", s.method.c_str(),
+                   s.budgetLabel.c_str(), flip, s.flicker, s.excessFlicker, s.meanErrorChange);
+    }
     std::fprintf(stderr, "report: %s\n",
                  echoPath((fs::path(a.out) / "report.html").string()).c_str());
   }
@@ -194,74 +192,22 @@ int run(const CompareArgs& a, const std::string& version) {
     if (!counts) return fail(counts.error().message);
     sampleCounts = std::move(counts.value());
   }
-  CompareOptions options;
+  CompareRequest request;
+  request.methods = splitCommaList(a.methods);
+  request.budgets = splitCommaList(a.budgets);
+  if (!a.composite.empty()) request.rules = splitCommaList(a.composite);
+  request.maxPeels = a.maxPeels;
+  request.modelPath = a.model;
+  request.capture = a.capture;
+  request.pixelsPerDegree = a.pixelsPerDegree;
+  request.seed = a.scene.seed;
+  request.sampleStorage = a.scene.storage() == SampleStorage::Sample ? "sample" : "pixel";
+  request.repeat = a.repeat;
+  request.warmup = a.warmup;
+  auto checked = checkCompareRequest(request);
+  if (!checked) return fail(checked.error().message);
+  CompareOptions options = std::move(checked.value());
   options.scene = a.scene.source;
-  options.seed = a.scene.seed;
-  options.flipPixelsPerDegree = a.pixelsPerDegree;
-  options.sampleStorage = a.scene.storage();
-  if (auto ppd = checkFlipPixelsPerDegree(a.pixelsPerDegree); !ppd)
-    return fail(ppd.error().message);
-
-  // methods
-  for (const std::string& name : splitList(a.methods)) {
-    if (name.empty())
-      return fail("--methods " + quoteInput(a.methods) + ": empty method name in the list");
-    auto preset = methodPreset(name);
-    if (!preset) return fail("--methods: " + preset.error().message);
-    for (const std::string& seen : options.methods)
-      if (seen == name) return fail("--methods: method " + quoteInput(name) + " listed twice");
-    options.methods.push_back(name);
-  }
-  if (options.methods.empty()) return fail("--methods: the method list is empty");
-  if (!a.model.empty()) {  // the model must be used by some method, not silently ignored
-    if (auto used = checkModelUsed(options.methods); !used) return fail(used.error().message);
-    auto model = loadMethodModel(a.model);
-    if (!model) return fail(model.error().message);
-    options.model = model.value();
-  }
-  // budgets
-  for (const std::string& text : splitList(a.budgets)) {
-    if (text.empty())
-      return fail("--budget " + quoteInput(a.budgets) + ": empty budget in the list");
-    auto spec = parseBudgetSpec(text);
-    if (!spec) return fail("--budget: " + spec.error().message);
-    for (const BudgetSpec& seen : options.budgets)
-      if (seen == spec.value()) return fail("--budget " + quoteInput(text) + ": listed twice");
-    options.budgets.push_back(spec.value());
-  }
-  if (options.budgets.empty())
-    return fail("--budget: no budget given (e.g. --budget 20MB,40MB or 25%,50%)");
-  if (!a.composite.empty()) {
-    auto compositing = parseCompositing(a.composite);
-    if (!compositing) return fail("--composite: " + compositing.error().message);
-    options.compositing = compositing.value();
-  }
-  if (a.maxPeels) {  // checked by the one option check, on the first peeling method listed
-    bool used = false;
-    for (const std::string& name : options.methods) {
-      auto preset = methodPreset(name);
-      if (!preset || !peelingRule(preset->compositing)) continue;
-      MethodOverrides o;
-      o.maxPeels = a.maxPeels;
-      auto m = makeMethod(name, o);
-      if (!m) return fail(m.error().message);
-      options.maxPeels = m->maxPeels;
-      used = true;
-      break;
-    }
-    if (!used)
-      return fail("--max-peels: none of the methods peels (only " +
-                  std::string(methodOptionRule(MethodOption::MaxPeels).appliesTo) + ": " +
-                  presetsAccepting(MethodOption::MaxPeels) + ")");
-  }
-  if (options.model)  // a model trained for the other compositing rule is refused up front
-    if (auto fits =
-            checkComparisonModel(*options.model, a.model, options.methods, options.compositing);
-        !fits)
-      return fail(fits.error().message);
-  auto capture = parseCaptureOption(a.capture);
-  if (!capture) return fail(capture.error().message);
-  options.capture = capture.value();
 
   // output folder: checked and its staging folder made before any work; put in place at the end
   auto outFolder = OutputFolder::begin(a.out);
@@ -273,6 +219,10 @@ int run(const CompareArgs& a, const std::string& version) {
   options.memoryLimitBytes = memoryLimit.value();
   auto engine = makeSceneEngine(a.scene);
   if (!engine) return fail(engine.error().message);
+  EngineOptions engineOptions;
+  engineOptions.threads = a.scene.threads;
+  auto truthEngine = makeTruthEngine(a.truthEngine, **engine, engineOptions, options);
+  if (!truthEngine) return fail(truthEngine.error().message);
   // the ground truth's (the A-buffer's) buffers at this size, before the scene is loaded
   if (auto fits = checkComparisonFits(**engine, a.scene.width, a.scene.height, options); !fits)
     return fail(echoPath(a.scene.source) + ": " + fits.error().message);
@@ -285,7 +235,8 @@ int run(const CompareArgs& a, const std::string& version) {
   if (temporal)
     return runTemporal(a, options, version, **engine, *prepared, progress, outFolder.value());
   progress.set("setting up " + a.scene.source);
-  auto view = (*engine)->prepare(sceneView(*prepared, a.scene, prepared->cameras.front()));
+  auto view = prepareComparedView(
+      **engine, sceneView(*prepared, a.scene, prepared->cameras.front()), options);
   if (!view) return fail(echoPath(a.scene.source) + ": " + view.error().message);
   // --orbit-view I: view I - 1 precedes it (vkb's Fresnel term)
   auto previous = previousViewCosine(**engine, prepared->scene, a.scene.source,
@@ -296,7 +247,7 @@ int run(const CompareArgs& a, const std::string& version) {
   options.progress = [&progress](const std::string& stage, int done, int total) {
     progress.set(stage, done, total);
   };
-  auto result = runComparison(**engine, **view, options);
+  auto result = runComparison(**engine, *view->view, options, view->truth.get());
   if (!result) return fail(echoPath(a.scene.source) + ": " + result.error().message);
   // --sample-counts: the same comparison at each count, against that count's own ground truth
   if (auto counted =
@@ -316,6 +267,7 @@ int run(const CompareArgs& a, const std::string& version) {
   progress.clear();
 
   if (!a.scene.quiet) {
+    if (!r.truthNote.empty()) std::fprintf(stderr, "note: %s\n", r.truthNote.c_str());
     printSummary(r);
     std::fprintf(stderr, "report: %s\n", echoPath((dir / "report.html").string()).c_str());
   }
@@ -335,14 +287,24 @@ Runner addCompareCommand(CLI::App& app) {
   cmd->add_option("--budget,--budgets,-M", args->budgets,
                   "Memory budgets, comma-separated, e.g. 20MB,40MB (MB = 2^20 bytes) or 25%,50% "
                   "(each method's per-pixel words + that share of the exact A-buffer's node "
-                  "bytes); lists may mix both")
+                  "bytes); lists may mix both; auto: log-spaced from the listed methods' "
+                  "smallest budget to the exact A-buffer's (mfr info --methods)")
       ->required();
   cmd->add_option("--methods,-m", args->methods,
                   "Methods, comma-separated (default " + args->methods + "). " + presetHelp());
   cmd->add_option("--out,-o", args->out, "Output folder (created if missing)")->required();
   cmd->add_option("--composite", args->composite,
-                  "kbuffer or hybrid for every method (default: each preset's own rule, hybrid "
-                  "for dkb* and optimal*, else kbuffer)");
+                  "Compositing rules, comma-separated (kbuffer, hybrid): every method that takes "
+                  "a rule runs under each, the oracle (optimal) too, each row labelled with its "
+                  "rule (default kbuffer,hybrid; the peer methods keep their own rule)");
+  cmd->add_option("--repeat", args->repeat,
+                  "Timed renders per run (default 3): the table shows the median time, results "
+                  "the min and max");
+  cmd->add_option("--warmup", args->warmup, "Untimed renders before the timed ones (default 1)");
+  cmd->add_option("--truth-engine", args->truthEngine,
+                  "Engine of the ground truth, cpu or gl (default: the comparison's own; on the "
+                  "gl engine the cpu engine takes over, with a note, when the GPU's limits refuse "
+                  "the A-buffer)");
   cmd->add_option("--capture", args->capture, "tile (default) or parallel");
   cmd->add_option("--max-peels", args->maxPeels,
                   "Depth peeling (peel, dual-peel): at most P geometry passes; the rest dropped, "

@@ -191,7 +191,7 @@ std::string viewPath(const std::string& path, int view, int views) {
   return (p.parent_path() / (p.stem().string() + suffix + p.extension().string())).string();
 }
 
-Progress::Progress(bool enabled) : enabled_(enabled && isatty(STDERR_FILENO)) {
+Progress::Progress(bool enabled) : enabled_(enabled), terminal_(isatty(STDERR_FILENO) != 0) {
   if (enabled_) thread_ = std::thread([this] { loop(); });
 }
 
@@ -218,12 +218,26 @@ void Progress::loop() {
   const auto start = std::chrono::steady_clock::now();
   static const char spinner[] = "|/-\\";
   int tick = 0;
+  double lastLine = 0.0;  // without a terminal: when the last line was printed
+  std::string lastStage;
   while (!stop_) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (elapsed < 1.0 || stop_) continue;
     std::lock_guard<std::mutex> lock(mutex_);
+    if (!terminal_) {  // a log: a plain line every kLogSeconds at most, while the stage changes
+      const bool due = elapsed - lastLine >= kLogSeconds &&
+                       (stage_ != lastStage || elapsed - lastLine >= kQuietLogSeconds);
+      if (!due) continue;
+      const std::string count =
+          total_ > 0 ? std::to_string(done_) + "/" + std::to_string(total_) + " " : std::string();
+      std::fprintf(stderr, "progress: %s%s (%.0f s)\n", count.c_str(), stage_.c_str(), elapsed);
+      std::fflush(stderr);
+      lastLine = elapsed;
+      lastStage = stage_;
+      continue;
+    }
     std::string bar;
     if (total_ > 0) {
       const int width = 24, filled = done_ * width / total_;

@@ -91,8 +91,14 @@ View sceneView(const PreparedScene& prepared, const SceneOptions& options, const
 std::string viewPath(const std::string& path, int view, int views);
 
 /// A progress line on a terminal (stderr), shown only for work that lasts more than a second.
+/// A command's progress on stderr while it works: on a terminal a line redrawn in place after
+/// the first second; otherwise (a log, a pipe) a plain "progress: 3/12 STAGE (12 s)" line at most
+/// every kLogSeconds when the stage has changed, every kQuietLogSeconds when it has not, and
+/// nothing for a command done within kLogSeconds.
 class Progress {
  public:
+  static constexpr double kLogSeconds = 5.0;
+  static constexpr double kQuietLogSeconds = 30.0;
   explicit Progress(bool enabled);
   ~Progress();
   void set(const std::string& stage, int done = -1, int total = -1);
@@ -102,6 +108,7 @@ class Progress {
  private:
   void loop();
   bool enabled_;
+  bool terminal_;
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::string stage_;

@@ -49,7 +49,7 @@ from ._mfr import (  # noqa: F401  (re-exported)
 )
 
 __all__ = [
-    "DEFAULT_COMPARE_METHODS", "DKB_LAYERS", "FEATURE_COUNT", "FEATURE_SET", "FLIP_DEFAULT_PPD",
+    "CompareResults", "DEFAULT_COMPARE_METHODS", "DKB_LAYERS", "FEATURE_COUNT", "FEATURE_SET", "FLIP_DEFAULT_PPD",
     "TARGET_SCALING", "Dataset", "Error", "Model", "RenderResult", "Scene", "builtin_model",
     "compare", "decode_srgb", "encode_srgb", "engine_names", "load_dataset", "load_model",
     "load_scene",
@@ -206,13 +206,34 @@ Model.__init__ = _method(lambda self, weights, biases, metadata:
                          _model_init.__doc__)
 
 
-#: The methods `mfr compare` runs when --methods is not given.
-DEFAULT_COMPARE_METHODS = ("fkb", "kplus-dynamic", "vkb", "vkb-fill", "dkb", "dkb-fill", "optimal",
-                           "wboit", "mboit", "mboit6", "mboit8", "mboit-trig3", "mboit-trig4",
-                           "mboit-q16", "mboit6-q16", "mboit8-q16", "mboit-trig3-q16",
-                           "mboit-trig4-q16", "mlab", "aoit4", "aoit8", "aoit16", "linked-list",
-                           "peel", "dual-peel", "dfaoit", "stochastic", "stochastic-strat",
-                           "hashed-alpha")
+#: The methods `mfr compare` runs when --methods is not given (the library's one list).
+DEFAULT_COMPARE_METHODS = tuple(_mfr.DEFAULT_COMPARE_METHODS.split(","))
+
+
+class CompareResults(dict):
+    """results.json of a comparison as a dict, with .table(): one row per run."""
+
+    def rows(self) -> list[dict]:
+        """One dict per run (the ground truth first, then each budget's runs in order): the
+        budget's budget_label and budget_bytes, then the run's keys of results.json (label,
+        compositing, flip_mean, total_ms, bytes_used, error, ...), lists and dicts left out."""
+        def flat(run, budget):
+            row = {"budget_label": budget.get("budget_label", ""),
+                   "budget_bytes": run.get("budget_bytes")}
+            row.update({k: v for k, v in run.items() if not isinstance(v, (list, dict))})
+            return row
+        out = [flat(self["ground_truth"], {})]
+        for budget in self.get("budgets", []):
+            out.extend(flat(run, budget) for run in budget["methods"])
+        return out
+
+    def table(self):
+        """The rows as a pandas DataFrame where pandas is installed, else the list of dicts."""
+        try:
+            import pandas
+        except ImportError:
+            return self.rows()
+        return pandas.DataFrame(self.rows())
 
 
 def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1024, camera=None,
@@ -292,7 +313,8 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
             alpha=None, background=None, transmission_floor=0.1, shuffle_draw_order=None,
             gltf_scene=None, cull=None, blend=None, engine="cpu", gl_sync="auto",
             gl_raster="native", memory_limit=None, allow_outside_references=False, samples=1,
-            sample_storage="pixel", sample_counts=None) -> dict:
+            sample_storage="pixel", sample_counts=None, max_peels=None, repeat=3, warmup=1,
+            truth_engine="") -> CompareResults:
     """Writes the folder `mfr compare --out OUT` writes for the same options and returns its
     results.json as a dict.
 
@@ -311,8 +333,15 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
     ground truth of a multisampled comparison is the per-sample A-buffer, box-filtered).
     sample_counts: sample counts (e.g. [1, 4, 8]) to run the comparison at too, each against its
     own ground truth, as `mfr compare --sample-counts` (results.json "sample_counts", the
-    report's error-vs-bytes-per-pixel figure per count). A method that fails at a budget is
-    recorded with its error; bad input raises mfr.Error.
+    report's error-vs-bytes-per-pixel figure per count). composite: a rule, "kbuffer,hybrid" or
+    a list; default both, every method that takes a rule running under each (labels
+    "fkb-kbuffer", "fkb-hybrid"). max_peels: --max-peels of peel and dual-peel. repeat, warmup:
+    timed and untimed renders per run (total_ms is the median, total_ms_min/max the spread).
+    truth_engine: the ground truth's engine ("" the comparison's, with the CPU engine taking
+    over when a GPU refuses the A-buffer). budgets="auto": log-spaced from the methods' smallest
+    budget to the A-buffer's. A method that fails at a budget is recorded with its error; bad
+    input raises mfr.Error. Returns results.json as a CompareResults dict; .table() gives one
+    row per run (a pandas DataFrame where pandas is installed).
     """
     budgets = _as_list(budgets, (str, int))
     if isinstance(methods, str):
@@ -338,13 +367,15 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                                  ("allow_outside_references", allow_outside_references, False),
                                  ("samples", samples, 1), ("sample_storage", sample_storage,
                                                            "pixel"),
-                                 ("sample_counts", sample_counts, None)):
+                                 ("sample_counts", sample_counts, None),
+                                 ("max_peels", max_peels, None), ("repeat", repeat, 3),
+                                 ("warmup", warmup, 1), ("truth_engine", truth_engine, "")):
         if _differs(value, default):
             call.append(f"{name}={value!r}")
     if model is not None:
         call.append("model=<mfr.Model>" if isinstance(model, Model) else
                     f"model={_path_text(model)!r}")
-    return _mfr._compare(scene, out, budgets=budgets, methods=methods, width=width,
+    return CompareResults(_mfr._compare(scene, out, budgets=budgets, methods=methods, width=width,
                          height=height, camera=camera, view=view, orbit=orbit,
                          orbit_view=orbit_view, orbit_step=orbit_step, zoom=zoom,
                          composite=composite, capture=capture, threads=threads, seed=seed,
@@ -355,7 +386,9 @@ def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_MET
                          memory_limit=memory_limit,
                          allow_outside_references=allow_outside_references, samples=samples,
                          sample_storage=sample_storage, sample_counts=sample_counts,
-                         command_line="mfr.compare(" + ", ".join(call) + ")")
+                         max_peels=max_peels, repeat=repeat, warmup=warmup,
+                         truth_engine=truth_engine,
+                         command_line="mfr.compare(" + ", ".join(call) + ")"))
 
 
 # --- the deep k-buffer's models ----------------------------------------------------------------

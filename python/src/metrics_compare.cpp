@@ -4,6 +4,7 @@
 #include "common.hpp"
 #include "mfr/compare/compare.hpp"
 #include "mfr/compare/compare_output.hpp"
+#include "mfr/compare/compare_request.hpp"
 #include "mfr/compare/temporal_run.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
@@ -92,6 +93,8 @@ py::object compare(const py::object& sceneArg, const py::object& outArg, const p
                    const py::object& glRasterArg, const py::object& memoryLimitArg,
                    const py::object& allowOutsideReferencesArg, const py::object& samplesArg,
                    const py::object& sampleStorageArg, const py::object& sampleCountsArg,
+                   const py::object& maxPeelsArg, const py::object& repeatArg,
+                   const py::object& warmupArg, const py::object& truthEngineArg,
                    const py::object& commandLineArg) {
   // every argument converted (and its type checked) before any work
   const std::string out = pathText(outArg, "out");
@@ -112,6 +115,20 @@ py::object compare(const py::object& sceneArg, const py::object& outArg, const p
       castArgument<bool>(allowOutsideReferencesArg, "allow_outside_references");
   const auto sampleStorage = castArgument<std::string>(sampleStorageArg, "sample_storage");
   const auto commandLine = castArgument<std::string>(commandLineArg, "command_line");
+  const auto repeat = castArgument<int64_t>(repeatArg, "repeat");
+  const auto warmup = castArgument<int64_t>(warmupArg, "warmup");
+  const auto truthEngine = castArgument<std::string>(truthEngineArg, "truth_engine");
+  std::optional<int64_t> maxPeels;
+  if (!maxPeelsArg.is_none()) maxPeels = castArgument<int64_t>(maxPeelsArg, "max_peels");
+  std::vector<std::string> rules;  // composite: a rule, "kbuffer,hybrid" or a list of rules
+  if (!composite.is_none()) {
+    if (PyUnicode_Check(composite.ptr()))
+      rules = splitCommaList(castArgument<std::string>(composite, "composite"));
+    else
+      for (const py::object& item : listArgument(composite, "composite", "a str or list of str"))
+        rules.push_back(
+            castArgument<std::string>(item, "composite[" + std::to_string(rules.size()) + "]"));
+  }
   if (!py::isinstance<Scene>(sceneArg) && !isPath(sceneArg))
     throw py::type_error(
         "scene: expected an mfr.Scene or a source (str, bytes or os.PathLike), "
@@ -144,48 +161,34 @@ py::object compare(const py::object& sceneArg, const py::object& outArg, const p
     throw LibraryError("orbit_step: needs orbit N (and no orbit_view)");
   if (!sampleCounts.empty() && temporal)
     throw LibraryError("sample_counts: not with a temporal comparison (orbit N)");
-  CompareOptions options;
-  options.seed = seed;
-  options.flipPixelsPerDegree = pixelsPerDegree(ppd);
-  for (const std::string& name : methodNames) {
-    if (name.empty()) throw LibraryError("methods: empty method name in the list");
-    unwrap(methodPreset(name));
-    for (const std::string& seen : options.methods)
-      if (seen == name) throw LibraryError("methods: method " + quoteInput(name) + " listed twice");
-    options.methods.push_back(name);
-  }
-  if (options.methods.empty()) throw LibraryError("methods: the method list is empty");
-  std::string modelName = "(mfr.Model)";
-  if (!model.is_none()) {  // the model must be used by some method, not silently ignored
-    unwrap(checkModelUsed(options.methods, Spelling::Python));
-    if (py::isinstance<learn::Model>(model)) {
-      options.model = model.cast<std::shared_ptr<learn::Model>>();
-    } else {
-      modelName = pathText(model, "model");
-      py::gil_scoped_release release;
-      options.model = unwrap(loadMethodModel(modelName));
-    }
-  }
+  CompareRequest compareRequest;
+  compareRequest.methods = methodNames;
   for (const py::object& budget : budgetList) {
-    // a size ("20MB", bytes) or a share of the A-buffer's node bytes ("25%")
-    const std::string name = "budgets[" + std::to_string(options.budgets.size()) + "]";
-    const BudgetSpec spec = PyUnicode_Check(budget.ptr())
-                                ? unwrap(parseBudgetSpec(castArgument<std::string>(budget, name)))
-                                : BudgetSpec(budgetArgument(budget, name));
-    for (const BudgetSpec& seen : options.budgets)
-      if (seen == spec) throw LibraryError("budgets: " + spec.label + " listed twice");
-    options.budgets.push_back(spec);
+    // a size ("20MB", bytes), a share of the A-buffer's node bytes ("25%") or "auto"
+    const std::string name = "budgets[" + std::to_string(compareRequest.budgets.size()) + "]";
+    compareRequest.budgets.push_back(PyUnicode_Check(budget.ptr())
+                                         ? castArgument<std::string>(budget, name)
+                                         : std::to_string(budgetArgument(budget, name)));
   }
-  if (options.budgets.empty())
-    throw LibraryError("budgets: no budget given (e.g. budgets=[\"20MB\", \"40MB\"])");
-  if (!composite.is_none())
-    options.compositing =
-        unwrap(parseCompositing(castArgument<std::string>(composite, "composite")));
-  if (options.model)  // a model trained for the other compositing rule is refused up front
-    unwrap(checkComparisonModel(*options.model, modelName, options.methods, options.compositing,
-                                Spelling::Python));
-  options.capture = captureArgument(capture);
-  options.sampleStorage = unwrap(parseSampleStorage(sampleStorage, "sample_storage"));
+  compareRequest.rules = rules;
+  compareRequest.maxPeels = maxPeels;
+  if (py::isinstance<learn::Model>(model)) {
+    compareRequest.model = model.cast<std::shared_ptr<learn::Model>>();
+    compareRequest.modelName = "(mfr.Model)";
+  } else if (!model.is_none()) {
+    compareRequest.modelPath = pathText(model, "model");
+  }
+  compareRequest.capture = capture;
+  compareRequest.pixelsPerDegree = ppd;
+  compareRequest.seed = seed;
+  compareRequest.sampleStorage = sampleStorage;
+  compareRequest.repeat = repeat;
+  compareRequest.warmup = warmup;
+  CompareOptions options;
+  {
+    py::gil_scoped_release release;  // a model file is read here
+    options = unwrap(checkCompareRequest(compareRequest, Spelling::Python));
+  }
   const SceneRequest request =
       sceneRequestArgument(width, height, camera, view, orbit, orbitView, zoom, alpha, background,
                            transmissionFloor, shuffleDrawOrder, gltfScene, cull, blend);
@@ -208,6 +211,10 @@ py::object compare(const py::object& sceneArg, const py::object& outArg, const p
     eo.glSync = glSync;
     eo.glRaster = glRaster;
     auto engine = unwrap(makeEngine(engineName, eo));
+    EngineOptions truthOptions;
+    truthOptions.threads = threads;
+    const std::unique_ptr<Engine> truth =
+        unwrap(makeTruthEngine(truthEngine, *engine, truthOptions, options, Spelling::Python));
     const auto named = [&](const Error& e) {
       return LibraryError(echoPath(scene.source) + ": " + e.message);
     };
@@ -232,13 +239,13 @@ py::object compare(const py::object& sceneArg, const py::object& outArg, const p
       jsonText =
           unwrap(runTemporalComparison(*engine, request, options, folder.staging())).jsonText;
     } else {
-      auto view =
-          engine->prepare(View{&*scene.scene, views.cameras.front(), width, height, samples});
+      auto view = prepareComparedView(
+          *engine, View{&*scene.scene, views.cameras.front(), width, height, samples}, options);
       if (!view) throw named(view.error());
       // orbit_view I: view I - 1 precedes it (vkb's Fresnel term)
       options.previousNearestCosine = unwrap(
           previousViewCosine(*engine, *scene.scene, scene.source, views, width, height, samples));
-      auto result = runComparison(*engine, **view, options);
+      auto result = runComparison(*engine, *view->view, options, view->truth.get());
       if (!result) throw named(result.error());
       if (auto counted = addSampleCounts(
               *engine, View{&*scene.scene, views.cameras.front(), width, height, samples}, options,
@@ -256,6 +263,7 @@ py::object compare(const py::object& sceneArg, const py::object& outArg, const p
 
 void addMetricsAndCompare(py::module_& m) {
   m.attr("FLIP_DEFAULT_PPD") = kFlipDefaultPixelsPerDegree;
+  m.attr("DEFAULT_COMPARE_METHODS") = kDefaultCompareMethods;
   m.def("metrics", namedArguments("metrics(): ", &metrics), py::arg("reference"), py::arg("test"),
         py::arg("ppd") = kFlipDefaultPixelsPerDegree,
         R"(Error of `test` against `reference`, as `mfr metrics --json` computes it: each a PNG path
@@ -272,7 +280,8 @@ flip_map (LDR-FLIP per pixel, float32 (h, w) in [0, 1]).)");
         py::arg("gltf_scene"), py::arg("cull"), py::arg("blend"), py::arg("engine"),
         py::arg("gl_sync"), py::arg("gl_raster"), py::arg("memory_limit"),
         py::arg("allow_outside_references"), py::arg("samples"), py::arg("sample_storage"),
-        py::arg("sample_counts"), py::arg("command_line"),
+        py::arg("sample_counts"), py::arg("max_peels"), py::arg("repeat"), py::arg("warmup"),
+        py::arg("truth_engine"), py::arg("command_line"),
         "mfr.compare's work (see python/mfr/__init__.py).");
 }
 

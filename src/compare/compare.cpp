@@ -13,7 +13,9 @@
 #include <sstream>
 
 #include "mfr/core/colormap.hpp"
+#include "mfr/method/dkb_model.hpp"
 #include "mfr/method/memory_model.hpp"
+#include "mfr/method/method_options.hpp"
 #include "mfr/method/stats_json.hpp"
 #include "mfr/metrics/image_metrics.hpp"
 
@@ -54,6 +56,7 @@ const char* captureName(CaptureMode c) {
 nlohmann::json runToJson(const CompareRun& run) {
   nlohmann::json j;
   j["name"] = run.method;
+  j["label"] = run.label;
   j["budget_bytes"] = run.budgetBytes ? nlohmann::json(*run.budgetBytes) : nlohmann::json(nullptr);
   j["compositing"] = toString(run.compositing);
   if (run.error) {
@@ -64,6 +67,10 @@ nlohmann::json runToJson(const CompareRun& run) {
   stats.erase("method");
   stats.erase("budget_bytes");
   j.update(stats);
+  j["repeats"] = run.timing.repeats;  // total_ms is the median render's; the spread beside it
+  j["total_ms_median"] = run.timing.medianMs;
+  j["total_ms_min"] = run.timing.minMs;
+  j["total_ms_max"] = run.timing.maxMs;
   j["image"] = run.imageFile;
   if (!run.flipFile.empty()) j["flip_image"] = run.flipFile;
   if (!run.kMapFile.empty()) j["k_map_image"] = run.kMapFile;
@@ -114,34 +121,79 @@ Result<void> checkComparisonFits(const Engine& engine, int width, int height,
   RenderOptions ro;
   ro.capture = options.capture;
   ro.memoryLimitBytes = options.memoryLimitBytes;
-  if (auto fits = engine.preflight(width, height, abuffer.value(), ro); !fits)
-    return makeError("ground truth (abuffer): " + fits.error().message);
+  const Engine& truth =
+      options.truthEngine && !options.truthFallback ? *options.truthEngine : engine;
+  auto fits = truth.preflight(width, height, abuffer.value(), ro);
+  if (!fits && options.truthEngine && options.truthFallback)
+    fits = options.truthEngine->preflight(width, height, abuffer.value(), ro);
+  if (!fits) return makeError("ground truth (abuffer): " + fits.error().message);
   return {};
+}
+
+Result<ComparedView> prepareComparedView(Engine& engine, const View& view,
+                                         const CompareOptions& options) {
+  ComparedView out;
+  auto prepared = engine.prepare(view);
+  if (!prepared) return prepared.error();
+  out.view = std::move(prepared.value());
+  if (options.truthEngine) {
+    auto truth = options.truthEngine->prepare(view);
+    if (!truth)
+      return makeError("ground truth (" + std::string(options.truthEngine->name()) +
+                       " engine): " + truth.error().message);
+    out.truth = std::move(truth.value());
+  }
+  return out;
 }
 
 namespace {
 
-// The presets named in --methods with the comparison's compositing rule, seed and model.
-Result<std::vector<MethodDesc>> comparedMethods(const CompareOptions& options) {
-  std::vector<MethodDesc> methods;
+// One run of a comparison's method list: the preset under one compositing rule.
+struct ComparedMethod {
+  MethodDesc desc;
+  std::string label;  // CompareRun::label
+};
+
+// The rules `m` runs under: every one of `options.rules` for the k-buffer family (those its user
+// model was trained for, with modelPicksRules) and for depth peeling bounded by --max-peels (its
+// hybrid form blends what remains into a tail); its own rule otherwise.
+std::vector<Compositing> methodRules(const MethodDesc& m, const CompareOptions& options) {
+  const bool choice =
+      kBufferFamilyRule(m.compositing) || (peelingRule(m.compositing) && m.maxPeels);
+  if (!choice || options.rules.empty()) return {m.compositing};
+  std::vector<Compositing> rules;
+  for (const Compositing rule : options.rules) {
+    MethodDesc variant = m;
+    if (kBufferFamilyRule(m.compositing)) variant.compositing = rule;
+    const bool userModel = options.model && checkMethodOption(MethodOption::Model, m);
+    if (userModel && options.modelPicksRules && !checkModelForMethod(*options.model, "", variant))
+      continue;
+    rules.push_back(rule);
+  }
+  return rules;
+}
+
+// The presets named in --methods, each under the comparison's rules, with its seed and model.
+Result<std::vector<ComparedMethod>> comparedMethods(const CompareOptions& options) {
+  std::vector<ComparedMethod> methods;
   std::set<std::string> seenMethods;
   for (const std::string& name : options.methods) {
     auto preset = methodPreset(name);
     if (!preset) return preset.error();
     if (!seenMethods.insert(name).second) return makeError("method '" + name + "': listed twice");
     MethodDesc m = preset.value();
-    // --composite chooses between the k-buffer family's rules; the peer methods (wboit, mboit,
-    // mlab) keep their own (each run records the rule it used)
-    if (options.compositing && kBufferFamilyRule(m.compositing))
-      m.compositing = *options.compositing;
-    // depth peeling: --max-peels bounds its passes, hybrid blends what remains into a tail
-    if (peelingRule(m.compositing)) {
-      m.maxPeels = options.maxPeels;
-      m.peelTail = options.compositing == Compositing::Hybrid;
-    }
+    if (peelingRule(m.compositing)) m.maxPeels = options.maxPeels;  // --max-peels
     m.importance.seed = options.seed;
     m.model = options.model;
-    methods.push_back(m);
+    const std::vector<Compositing> rules = methodRules(m, options);
+    for (const Compositing rule : rules) {
+      ComparedMethod& c = methods.emplace_back(ComparedMethod{m, name});
+      // the peer methods (wboit, mboit, mlab, ...) keep their own rule (each run records it);
+      // depth peeling's hybrid form blends what remains after its passes into a tail
+      if (kBufferFamilyRule(m.compositing)) c.desc.compositing = rule;
+      if (peelingRule(m.compositing)) c.desc.peelTail = rule == Compositing::Hybrid;
+      if (rules.size() > 1) c.label += std::string("-") + toString(rule);
+    }
   }
   return methods;
 }
@@ -170,17 +222,64 @@ struct CompareProgress {
   }
 };
 
+// Renders `method` options.warmup times untimed, then options.repeat times: the first timed
+// render's output, with the passes of the median-time render and the spread of the totals.
+Result<RenderOutput> timedRender(Engine& engine, const PreparedView& view, const MethodDesc& method,
+                                 const RenderOptions& ro, const CompareOptions& options,
+                                 RunTiming& timing) {
+  for (int i = 0; i < options.warmup; ++i)
+    if (auto warm = engine.render(view, method, ro); !warm) return warm.error();
+  auto first = engine.render(view, method, ro);
+  if (!first) return first.error();
+  std::vector<std::pair<double, std::vector<PassTime>>> renders{
+      {first->stats.totalMs(), first->stats.passes}};
+  for (int i = 1; i < options.repeat; ++i) {
+    auto again = engine.render(view, method, ro);
+    if (!again) return again.error();
+    renders.emplace_back(again->stats.totalMs(), std::move(again->stats.passes));
+  }
+  std::sort(renders.begin(), renders.end(),
+            [](const auto& a, const auto& b) { return a.first < b.first; });
+  const auto& median = renders[(renders.size() - 1) / 2];
+  timing.repeats = static_cast<int>(renders.size());
+  timing.medianMs = median.first;
+  timing.minMs = renders.front().first;
+  timing.maxMs = renders.back().first;
+  first->stats.passes = median.second;
+  return first;
+}
+
+// The ground truth on the truth engine (options.truthEngine with its view), or on the
+// comparison's engine, falling back to the truth engine when that is only a fallback.
+Result<RenderOutput> renderTruth(Engine& engine, const PreparedView& view,
+                                 const PreparedView* truthView, const MethodDesc& abuffer,
+                                 const RenderOptions& exact, const CompareOptions& options,
+                                 CompareResult& result) {
+  CompareRun& gt = result.groundTruth;
+  const bool elsewhere = options.truthEngine && !options.truthFallback;
+  Engine& first = elsewhere ? *options.truthEngine : engine;
+  result.truthEngine = std::string(first.name());
+  auto truth =
+      timedRender(first, elsewhere ? *truthView : view, abuffer, exact, options, gt.timing);
+  if (truth || !options.truthFallback || !options.truthEngine) return truth;
+  result.truthNote = "ground truth on the " + std::string(options.truthEngine->name()) +
+                     " engine: " + std::string(engine.name()) + ": " + truth.error().message;
+  result.truthEngine = std::string(options.truthEngine->name());
+  return timedRender(*options.truthEngine, *truthView, abuffer, exact, options, gt.timing);
+}
+
 // ground truth: the exact A-buffer, every fragment, sorted and composited
 Result<void> renderGroundTruth(Engine& engine, const PreparedView& view,
-                               const RenderOptions& renderOptions, CompareResult& result) {
+                               const PreparedView* truthView, const RenderOptions& renderOptions,
+                               const CompareOptions& options, CompareResult& result) {
   auto abuffer = methodPreset("abuffer");
   if (!abuffer) return abuffer.error();
   RenderOptions exact = renderOptions;  // multisampled: the per-sample A-buffer, box-filtered
   exact.sampleStorage = SampleStorage::Sample;
-  auto truth = engine.render(view, abuffer.value(), exact);
+  auto truth = renderTruth(engine, view, truthView, abuffer.value(), exact, options, result);
   if (!truth) return makeError("ground truth (abuffer): " + truth.error().message);
   CompareRun& gt = result.groundTruth;
-  gt.method = "abuffer";
+  gt.method = gt.label = "abuffer";
   gt.stats = std::move(truth->stats);
   gt.image = encodeSrgb(truth->image);
   gt.imageFile = "ground_truth.png";
@@ -208,9 +307,11 @@ struct RunSetting {
 // to measure is the comparison's.
 Result<std::vector<uint32_t>> compareOneRun(const RunSetting& s, const BudgetSpec& spec,
                                             const std::string& budgetLabel,
-                                            const MethodDesc& method,
+                                            const ComparedMethod& compared,
                                             const CompareProgress& progress, CompareRun& run) {
+  const MethodDesc& method = compared.desc;
   run.method = method.name;
+  run.label = compared.label;
   run.compositing = method.compositing;
   const MemoryModel memory = s.engine.memoryModel(method, s.renderOptions);
   const uint64_t storagePixels = s.view.storagePixels(sampleStorageOf(method, s.renderOptions));
@@ -223,17 +324,17 @@ Result<std::vector<uint32_t>> compareOneRun(const RunSetting& s, const BudgetSpe
   }
   run.budgetBytes = budget.value();
   run.budgetSlots = memory.fragmentSlots(budget.value(), storagePixels);
-  progress.report("rendering " + method.name + " at " + budgetLabel);
+  progress.report("rendering " + run.label + " at " + budgetLabel);
   RenderOptions ro = s.renderOptions;
   ro.budgetBytes = budget.value();
-  auto out = s.engine.render(s.view, method, ro);
+  auto out = timedRender(s.engine, s.view, method, ro, s.options, run.timing);
   if (!out) {
     run.error = out.error().message;
     return std::vector<uint32_t>{};
   }
   run.stats = std::move(out->stats);
   run.image = encodeSrgb(out->image);
-  progress.report("measuring " + method.name + " at " + budgetLabel);
+  progress.report("measuring " + run.label + " at " + budgetLabel);
   auto errors = compareImages(s.truth, run.image);
   if (!errors) return errors.error();
   auto flip = computeFlip(s.truth, run.image, s.options.flipPixelsPerDegree);
@@ -244,7 +345,7 @@ Result<std::vector<uint32_t>> compareOneRun(const RunSetting& s, const BudgetSpe
   run.metrics.psnrSrgb = errors->psnrSrgb;
   run.metrics.flipMean = flip->mean;
   run.flipMap = flipErrorImage(*flip);
-  const std::string stem = fileStem(method.name) + "_" + spec.fileLabel();
+  const std::string stem = fileStem(run.label) + "_" + spec.fileLabel();
   run.imageFile = stem + ".png";
   run.flipFile = stem + "_flip.png";
   run.kMapFile = stem + "_kmap.png";
@@ -271,8 +372,13 @@ void colourKMaps(const std::vector<std::vector<uint32_t>>& kMaps, int w, int h,
 }  // namespace
 
 Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
-                                    const CompareOptions& options) {
+                                    const CompareOptions& options, const PreparedView* truthView) {
+  if (options.truthEngine && !truthView)
+    return makeError("runComparison: a truth engine needs the view prepared on it");
+  if (options.repeat < 1 || options.warmup < 0)
+    return makeError("runComparison: repeat must be at least 1 and warmup at least 0");
   if (options.methods.empty()) return makeError("--methods: the method list is empty");
+  if (options.autoBudgets) return makeError("--budget auto: not wired yet");
   if (options.budgets.empty()) return makeError("--budget: no budget given");
   auto methods = comparedMethods(options);
   if (!methods) return methods.error();
@@ -289,7 +395,9 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   result.engine = std::string(engine.name());
   result.width = w;
   result.height = h;
-  result.compositing = options.compositing;
+  result.rules = options.rules;
+  result.repeat = options.repeat;
+  result.warmup = options.warmup;
   result.capture = options.capture;
   result.flipPixelsPerDegree = options.flipPixelsPerDegree;
   result.samples = view.samples();
@@ -304,7 +412,7 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
     renderOptions.previousNearestCosine = &options.previousNearestCosine;
 
   progress.report("rendering the ground truth (abuffer)");
-  MFR_TRY(renderGroundTruth(engine, view, renderOptions, result));
+  MFR_TRY(renderGroundTruth(engine, view, truthView, renderOptions, options, result));
   ++progress.step;
   // relative budgets: the A-buffer's node bytes of this frame (a count pass)
   FrameCounts counts;
@@ -325,7 +433,7 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
     cb.budgetBytes = spec.bytes ? *spec.bytes : relativeNodeBytes(spec.percent, counts);
     if (spec.isRelative()) cb.percent = spec.percent;
     cb.label = spec.label;
-    for (const MethodDesc& method : *methods) {
+    for (const ComparedMethod& method : *methods) {
       CompareRun& run = cb.runs.emplace_back();
       auto kMap = compareOneRun(setting, spec, cb.label, method, progress, run);
       if (!kMap) return kMap.error();
@@ -361,14 +469,14 @@ Result<void> addSampleCounts(Engine& engine, View view, const CompareOptions& op
     }
     const std::string what = "--sample-counts " + std::to_string(count) + ": ";
     view.samples = count;
-    auto prepared = engine.prepare(view);
+    auto prepared = prepareComparedView(engine, view, options);
     if (!prepared) return makeError(what + prepared.error().message);
     CompareOptions o = options;
     if (options.progress)
       o.progress = [&options, count](const std::string& stage, int done, int total) {
         options.progress(std::to_string(count) + " samples: " + stage, done, total);
       };
-    auto other = runComparison(engine, **prepared, o);
+    auto other = runComparison(engine, *prepared->view, o, prepared->truth.get());
     if (!other) return makeError(what + other.error().message);
     result.sampleCounts.push_back(sampleCountRuns(*other));
   }
@@ -380,9 +488,17 @@ nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersi
   if (!mfrVersion.empty()) j["mfr_version"] = mfrVersion;
   j["scene"] = r.scene;
   j["engine"] = r.engine;
+  j["truth_engine"] = r.truthEngine;
+  if (!r.truthNote.empty()) j["truth_note"] = r.truthNote;
   j["width"] = r.width;
   j["height"] = r.height;
-  j["compositing"] = r.compositing ? toString(*r.compositing) : "per-method";
+  // one rule: its name; several or none (each preset's own): "per-method", the rules listed
+  j["compositing"] = r.rules.size() == 1 ? toString(r.rules[0]) : "per-method";
+  nlohmann::json rules = nlohmann::json::array();
+  for (const Compositing rule : r.rules) rules.push_back(toString(rule));
+  j["compositing_rules"] = rules;
+  j["repeat"] = r.repeat;
+  j["warmup"] = r.warmup;
   j["capture"] = captureName(r.capture);
   j["cull"] = toString(r.groundTruth.stats.cull);  // every run rasterizes the same view
   j["flip_pixels_per_degree"] = r.flipPixelsPerDegree;
@@ -460,10 +576,10 @@ std::string compareToCsv(const CompareResult& r) {
   // every column name a snake_case identifier: "time_peel_1_ms" for pass "peel 1" (two names
   // that would give one column get _2, _3, ...)
   std::ostringstream csv;
-  csv << "budget_bytes,budget_label,method,compositing,status,image,bytes_used,fm_slots,"
+  csv << "budget_bytes,budget_label,method,label,compositing,status,image,bytes_used,fm_slots,"
          "fragment_slots,memory_utilisation,k_min,k_max,fragments_generated,fragments_captured,"
          "fragments_lost,fragments_lost_percent,mse,psnr,mse_linear,psnr_linear,mse_srgb,"
-         "psnr_srgb,flip_mean,total_ms";
+         "psnr_srgb,flip_mean,total_ms,repeats,total_ms_min,total_ms_max";
   std::vector<std::string> columns;
   for (const std::string& p : passes) {
     const std::string base = "time_" + columnIdentifier(p) + "_ms";
@@ -477,11 +593,11 @@ std::string compareToCsv(const CompareResult& r) {
   // budget_label: the budget as given ("20MB", "25%"), empty for the ground truth
   const auto row = [&](const CompareRun& run, const std::string& budgetLabel) {
     csv << (run.budgetBytes ? std::to_string(*run.budgetBytes) : std::string()) << ','
-        << csvField(budgetLabel) << ',' << csvField(run.method) << ',' << toString(run.compositing)
-        << ',';
+        << csvField(budgetLabel) << ',' << csvField(run.method) << ',' << csvField(run.label) << ','
+        << toString(run.compositing) << ',';
     if (run.error) {
       csv << "error";
-      for (size_t i = 0; i < 20 + passes.size(); ++i) csv << ',';
+      for (size_t i = 0; i < 23 + passes.size(); ++i) csv << ',';
       csv << csvField(*run.error) << "\n";
       return;
     }
@@ -494,7 +610,8 @@ std::string compareToCsv(const CompareResult& r) {
         << number(s.lostPercent()) << ',' << number(m.mseLinear) << ',' << number(m.psnrLinear)
         << ',' << number(m.mseLinear) << ',' << number(m.psnrLinear) << ',' << number(m.mseSrgb)
         << ',' << number(m.psnrSrgb) << ',' << number(m.flipMean) << ','
-        << number(s.totalMs(), "%.3f");
+        << number(s.totalMs(), "%.3f") << ',' << run.timing.repeats << ','
+        << number(run.timing.minMs, "%.3f") << ',' << number(run.timing.maxMs, "%.3f");
     for (const std::string& p : passes) {
       csv << ',';
       for (const PassTime& t : s.passes)

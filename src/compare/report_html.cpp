@@ -454,7 +454,7 @@ std::string resultsTable(const CompareResult& r, const CompareBudget& cb) {
          format("%.1f", s.totalMs()) + "</td><td class=\"passes\">" + passes(s) + "</td></tr>";
   }
   for (const CompareRun& run : cb.runs) {
-    t += "<tr><td>" + escape(run.method) + "<small> " + toString(run.compositing) + "</small>";
+    t += "<tr><td>" + escape(run.label) + "<small> " + toString(run.compositing) + "</small>";
     if (run.ok() && run.stats.oracle) {
       const OracleReport& o = *run.stats.oracle;
       t += o.exact ? std::string("<small>oracle: proven minimum</small>")
@@ -497,7 +497,7 @@ std::string imageGrid(const CompareResult& r, const CompareBudget& cb) {
   // header
   g += "<div></div><div class=\"head\">ground truth<small>abuffer, exact</small></div>";
   for (const CompareRun& run : cb.runs) {
-    g += "<div class=\"head\">" + escape(run.method);
+    g += "<div class=\"head\">" + escape(run.label);
     if (run.ok())
       g += "<small>" +
            format("FLIP %.4f &middot; PSNR %s dB", run.metrics.flipMean,
@@ -515,7 +515,7 @@ std::string imageGrid(const CompareResult& r, const CompareBudget& cb) {
       g += "<div class=\"cell failed\">" + escape(*run.error) + "</div>";
       continue;
     }
-    g += imageCell(run.imageFile, run.image, run.method + " at " + cb.label, "");
+    g += imageCell(run.imageFile, run.image, run.label + " at " + cb.label, "");
   }
   // FLIP maps
   g += "<div class=\"rowlabel\">FLIP error</div>";
@@ -551,7 +551,7 @@ std::string imageGrid(const CompareResult& r, const CompareBudget& cb) {
 std::vector<std::string> methodNamesOf(const CompareResult& r) {
   std::vector<std::string> methodNames;
   if (!r.budgets.empty())
-    for (const CompareRun& run : r.budgets[0].runs) methodNames.push_back(run.method);
+    for (const CompareRun& run : r.budgets[0].runs) methodNames.push_back(run.label);
   return methodNames;
 }
 
@@ -573,8 +573,9 @@ std::string reportHead(const CompareResult& r, const std::string& size) {
   h += "<p class=\"subtitle\">Scene <code>" + escape(r.scene) + "</code> &middot; " + size +
        " pixels &middot; budget" + (r.budgets.size() > 1 ? "s " : " ") + budgetsText +
        " &middot; " +
-       (r.compositing ? escape(toString(*r.compositing)) + " compositing"
-                      : std::string("each method's own compositing")) +
+       (r.rules.size() == 1 ? escape(toString(r.rules[0])) + " compositing"
+        : r.rules.empty()   ? std::string("each method's own compositing")
+                            : std::string("kbuffer and hybrid compositing")) +
        "</p>\n";
   return h;
 }
@@ -606,11 +607,17 @@ std::string setupSection(const CompareResult& r, const ReportInfo& info,
   const char* kKBufferText =
       " (captured fragments sorted and blended front to back; the rest dropped)";
   h += "<tr><th>Compositing</th><td>" +
-       (r.compositing ? escape(toString(*r.compositing)) +
-                            (*r.compositing == Compositing::Hybrid ? kHybridText : kKBufferText)
-                      : std::string("each preset's own rule: hybrid") + kHybridText +
-                            " for dkb* and optimal*, kbuffer" + kKBufferText +
-                            " for the others (per run in the tables)") +
+       (r.rules.size() == 1 ? escape(toString(r.rules[0])) +
+                                  (r.rules[0] == Compositing::Hybrid ? kHybridText : kKBufferText)
+        : r.rules.empty()
+            ? std::string("each preset's own rule: hybrid") + kHybridText +
+                  " for dkb* and optimal*, kbuffer" + kKBufferText +
+                  " for the others (per run in the tables)"
+            : std::string("every method that takes a rule under both, each row labelled with "
+                          "its rule: kbuffer") +
+                  kKBufferText + "; hybrid" + kHybridText +
+                  "; the oracle (optimal) under each, so it is the proven minimum of the rule "
+                  "beside it") +
        "</td></tr>\n";
   h += "<tr><th>Capture</th><td>" +
        std::string(r.capture == CaptureMode::TileOwned

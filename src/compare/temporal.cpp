@@ -107,7 +107,7 @@ Result<void> TemporalStability::add(const CompareResult& frame) {
     for (const CompareBudget& cb : frame.budgets)
       for (const CompareRun& run : cb.runs) {
         TemporalSeries& s = result_.series.emplace_back();
-        s.method = run.method;
+        s.method = run.label;
         s.budgetLabel = cb.label;
       }
   } else if (frame.width != width_ || frame.height != height_ || runs != previous_.size()) {
@@ -123,8 +123,8 @@ Result<void> TemporalStability::add(const CompareResult& frame) {
   for (const CompareBudget& cb : frame.budgets)
     for (const CompareRun& run : cb.runs) {
       TemporalSeries& s = result_.series[index];
-      if (s.method != run.method || s.budgetLabel != cb.label)
-        return makeError("frame " + std::to_string(frames_) + ": run " + run.method + " at " +
+      if (s.method != run.label || s.budgetLabel != cb.label)
+        return makeError("frame " + std::to_string(frames_) + ": run " + run.label + " at " +
                          cb.label + " where the first frame had " + s.method + " at " +
                          s.budgetLabel);
       Image8& previous = previous_[index++];

@@ -49,7 +49,8 @@ Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest&
   std::vector<float> previousCosine;  // vkb's Fresnel term: the previous frame's nearest |n.v|
   std::string engineName;
   for (int f = 0; f < r.frames; ++f) {
-    auto view = engine.prepare(View{r.scene, path[f], r.width, r.height, r.samples});
+    auto view =
+        prepareComparedView(engine, View{r.scene, path[f], r.width, r.height, r.samples}, options);
     if (!view) return named(view.error());
     options.previousNearestCosine = previousCosine;
     options.progress = [&r, f](const std::string& stage, int done, int total) {
@@ -57,7 +58,7 @@ Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest&
         r.progress("frame " + std::to_string(f + 1) + "/" + std::to_string(r.frames) + ": " + stage,
                    done, total);
     };
-    auto result = runComparison(engine, **view, options);
+    auto result = runComparison(engine, *view->view, options, view->truth.get());
     if (!result) return named(result.error());
     engineName = result->engine;
     char folder[32];
@@ -68,7 +69,7 @@ Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest&
         writeComparison(result.value(), (dir / folder).string(), r.versionNumber, r.info);
     if (!written) return written.error();
     MFR_TRY(temporal.add(result.value()));
-    auto cosine = engine.nearestCosine(**view);
+    auto cosine = engine.nearestCosine(*view->view);
     if (!cosine) return named(cosine.error());
     previousCosine = std::move(cosine.value());
   }

@@ -31,9 +31,29 @@ struct CompareOptions {
   /// At least one, no duplicates; budgets[0] is "the" budget. Bytes, or shares of the exact
   /// A-buffer's node bytes ("30%", budget_spec.hpp: each method's own words on top).
   std::vector<BudgetSpec> budgets;
-  /// Compositing of every method (ground truth: exact); none: each preset's own rule (hybrid for
-  /// dkb*, optimal*; kbuffer for the others).
-  std::optional<Compositing> compositing;
+  /// The compositing rules to run the methods that take a choice under (kbuffer, hybrid: the
+  /// k-buffer family, and depth peeling with maxPeels, whose hybrid form blends what remains into
+  /// a tail): each such method runs once per rule, the oracle (optimal) too, so that it is the
+  /// proven minimum of the rule printed beside it. Empty: each preset's own rule (hybrid for dkb*,
+  /// optimal*; kbuffer for the others). The peer methods (wboit, mboit, mlab, ...) run once under
+  /// their own rule. CompareRequest's default is both rules.
+  std::vector<Compositing> rules;
+  /// Deep k-buffer methods with a user model (`model`): run only under the rules the model was
+  /// trained for instead of refusing the others (the default rule set of CompareRequest).
+  bool modelPicksRules = false;
+  /// Timing: each run is rendered `warmup` times untimed, then `repeat` times; the run keeps the
+  /// first timed render's image and statistics with the passes of the median-time render
+  /// (RunTiming). The ground truth too.
+  int repeat = 1;
+  int warmup = 0;
+  /// The engine the ground truth is rendered on (--truth-engine); null: the comparison's engine.
+  /// runComparison then takes the truth's view prepared on it. With truthFallback, truthEngine
+  /// renders the truth only when the comparison's engine cannot (a GPU's limits refuse the
+  /// A-buffer): CompareResult::truthNote says so.
+  Engine* truthEngine = nullptr;
+  bool truthFallback = false;
+  /// `--budget auto`: `budgets` is chosen from the scene (autoBudgetSpecs) before the runs.
+  bool autoBudgets = false;
   /// Depth peeling (peel, dual-peel): --max-peels, at most this many geometry passes (none: until
   /// no fragment remains); under hybrid compositing what remains goes to a tail.
   std::optional<uint32_t> maxPeels;
@@ -65,13 +85,24 @@ struct CompareMetrics {
   double flipMean = 0.0;  // mean LDR-FLIP
 };
 
+/// The wall-clock spread of a run's timed renders (CompareOptions::repeat, after the warm-up).
+struct RunTiming {
+  int repeats = 1;
+  double medianMs = 0.0;  // of the renders' totals (the lower median of an even count)
+  double minMs = 0.0, maxMs = 0.0;
+};
+
 /// One method at one budget (or the ground truth).
 struct CompareRun {
-  std::string method;                              // preset name
+  std::string method;  // preset name
+  /// What the run is called in tables and files: the preset name, or "NAME-RULE" ("fkb-hybrid")
+  /// when the comparison runs the method under several compositing rules.
+  std::string label;
   std::optional<uint64_t> budgetBytes;             // none for the ground truth
   Compositing compositing = Compositing::KBuffer;  // the rule this run composited with
   std::optional<std::string> error;  // the render failed (e.g. budget too small): no data below
-  RenderStats stats;
+  RenderStats stats;                 // passes: the median-time render's
+  RunTiming timing;
   uint64_t budgetSlots = 0;  // F(M) of the method's memory model (0 without a budget)
   CompareMetrics metrics;
   // images (sRGB8, as written), file names relative to the output folder
@@ -103,9 +134,12 @@ struct SampleCountRuns {
 
 struct CompareResult {
   std::string scene;
-  std::string engine;  // the engine that rendered every run and the ground truth
+  std::string engine;       // the engine that rendered every run
+  std::string truthEngine;  // the engine that rendered the ground truth
+  std::string truthNote;    // why the truth ran on a fallback engine (empty: it did not)
   int width = 0, height = 0;
-  std::optional<Compositing> compositing;  // CompareOptions::compositing (none: per preset)
+  std::vector<Compositing> rules;  // CompareOptions::rules (empty: each preset's own)
+  int repeat = 1, warmup = 0;      // CompareOptions::repeat, warmup
   CaptureMode capture = CaptureMode::TileOwned;
   int samples = 1;  // per pixel (View::samples)
   SampleStorage sampleStorage = SampleStorage::Pixel;
@@ -135,8 +169,18 @@ Result<void> addSampleCounts(Engine& engine, View view, const CompareOptions& op
 /// A method failing at a budget is not an error: its run carries the message.
 /// The result owns its images and statistics: the frame (and its scene) may go once it returns.
 /// compare_output.hpp writes the result as `mfr compare` does (writeComparison).
+/// With options.truthEngine, `truthView` is the same View prepared on it (prepareComparedView).
 Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
-                                    const CompareOptions& options);
+                                    const CompareOptions& options,
+                                    const PreparedView* truthView = nullptr);
+
+/// A view prepared for runComparison: on the comparison's engine, and on the truth engine when
+/// options.truthEngine is set.
+struct ComparedView {
+  std::unique_ptr<PreparedView> view, truth;
+};
+Result<ComparedView> prepareComparedView(Engine& engine, const View& view,
+                                         const CompareOptions& options);
 
 /// The memory pre-flight of runComparison that the image size alone decides: the ground truth's
 /// (the A-buffer's) per-pixel buffers at width x height on `engine` (Engine::preflight), against
