@@ -1,6 +1,9 @@
-// mfr info: what a scene is made of and what an exact A-buffer of it costs.
+// mfr info: what a scene is made of and what an exact A-buffer of it costs; with --methods, each
+// method's smallest budget, the budget at which it keeps every fragment and its fixed memory
+// (mfr/engine/scene_budgets.hpp).
 #include <cstdio>
 #include <memory>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -9,12 +12,140 @@
 #include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
+#include "mfr/engine/render_views.hpp"
+#include "mfr/engine/scene_budgets.hpp"
+#include "mfr/method/make_method.hpp"
 #include "mfr/method/memory_model.hpp"
+#include "mfr/method/pass_plan.hpp"
+#include "mfr/method/peel.hpp"
 
 namespace mfr::cli {
 namespace {
 
-int run(const SceneOptions& o) {
+struct InfoArgs {
+  SceneOptions scene;
+  std::optional<std::string> methods;  // --methods LIST | all: the budget table
+  std::string composite;               // --composite kbuffer|hybrid (k-buffer family)
+  std::string capture = "tile";        // --capture tile|parallel
+};
+
+// "a, b" -> {"a", "b"}; empty items kept (to be refused)
+std::vector<std::string> splitList(const std::string& text) {
+  std::vector<std::string> items;
+  std::string item;
+  std::istringstream in(text);
+  while (std::getline(in, item, ',')) {
+    const size_t b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
+    items.push_back(b == std::string::npos ? std::string() : item.substr(b, e - b + 1));
+  }
+  if (!text.empty() && text.back() == ',') items.emplace_back();
+  return items;
+}
+
+// --methods as compare takes it (its presets, --composite on the k-buffer family's rules), or all
+Result<std::vector<MethodDesc>> budgetMethods(const InfoArgs& a) {
+  std::vector<std::string> names = *a.methods == "all" ? presetNames() : splitList(*a.methods);
+  if (names.empty()) return makeError("--methods: the method list is empty");
+  std::optional<Compositing> compositing;
+  if (!a.composite.empty()) {
+    auto rule = parseCompositing(a.composite);
+    if (!rule) return makeError("--composite: " + rule.error().message);
+    compositing = rule.value();
+  }
+  std::vector<MethodDesc> methods;
+  for (const std::string& name : names) {
+    if (name.empty())
+      return makeError("--methods " + quoteInput(*a.methods) + ": empty method name in the list");
+    auto preset = methodPreset(name);
+    if (!preset) return makeError("--methods: " + preset.error().message);
+    for (const MethodDesc& seen : methods)
+      if (seen.name == name)
+        return makeError("--methods: method " + quoteInput(name) + " listed twice");
+    MethodDesc m = std::move(preset.value());
+    if (compositing && kBufferFamilyRule(m.compositing)) m.compositing = *compositing;
+    if (peelingRule(m.compositing)) m.peelTail = compositing == Compositing::Hybrid;
+    m.importance.seed = a.scene.seed;
+    methods.push_back(std::move(m));
+  }
+  return methods;
+}
+
+std::string bytesCell(const std::optional<uint64_t>& bytes) {
+  return bytes ? formatBytes(*bytes) : std::string("-");
+}
+
+nlohmann::json bytesJson(const std::optional<uint64_t>& bytes) {
+  return bytes ? nlohmann::json(*bytes) : nlohmann::json(nullptr);
+}
+
+nlohmann::json budgetsJson(const SceneBudgets& b) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const MethodBudget& r : b.methods)
+    rows.push_back({{"method", r.method},
+                    {"minimum_bytes", bytesJson(r.minimumBytes)},
+                    {"minimum_percent", r.minimumPercent ? nlohmann::json(*r.minimumPercent)
+                                                         : nlohmann::json(nullptr)},
+                    {"exact_bytes", bytesJson(r.exactBytes)},
+                    {"fixed_bytes", bytesJson(r.fixedBytes)},
+                    {"note", r.note}});
+  nlohmann::json autoList = nlohmann::json::array();
+  for (const BudgetSpec& spec : autoBudgets(b)) autoList.push_back(spec.label);
+  return {{"abuffer_bytes", b.abufferBytes},
+          {"samples", b.samples},
+          {"fragments", b.counts.fragments},
+          {"covered_pixels", b.counts.coveredPixels},
+          {"max_depth_complexity", b.maxDepthComplexity},
+          {"mean_depth_complexity", b.meanDepthComplexity},
+          {"methods", rows},
+          {"auto_budgets", autoList}};
+}
+
+void printBudgets(const nlohmann::json& b) {
+  std::string autoText;
+  for (const auto& label : b["auto_budgets"])
+    autoText += (autoText.empty() ? "" : ",") + label.get<std::string>();
+  std::printf("  A-buffer %s (%llu B); auto budgets %s\n",
+              formatBytes(b["abuffer_bytes"].get<uint64_t>()).c_str(),
+              static_cast<unsigned long long>(b["abuffer_bytes"].get<uint64_t>()),
+              autoText.empty() ? "-" : autoText.c_str());
+  std::printf("  %-24s %-12s %-9s %-12s %-12s %s\n", "method", "minimum", "share", "exact at",
+              "fixed", "note");
+  for (const auto& r : b["methods"]) {
+    const auto bytes = [&](const char* key) {
+      return r[key].is_null() ? std::optional<uint64_t>() : r[key].get<uint64_t>();
+    };
+    std::string share = "-";
+    if (!r["minimum_percent"].is_null()) {
+      char buffer[32];
+      std::snprintf(buffer, sizeof buffer, "%.2f%%", r["minimum_percent"].get<double>());
+      share = r["minimum_percent"].get<double>() == 0.0 ? "any" : buffer;
+    }
+    std::printf("  %-24s %-12s %-9s %-12s %-12s %s\n", r["method"].get<std::string>().c_str(),
+                bytesCell(bytes("minimum_bytes")).c_str(), share.c_str(),
+                bytesCell(bytes("exact_bytes")).c_str(), bytesCell(bytes("fixed_bytes")).c_str(),
+                oneLine(r["note"].get<std::string>(), 300).c_str());
+  }
+}
+
+int run(const InfoArgs& a) {
+  const SceneOptions& o = a.scene;
+  std::vector<MethodDesc> methods;
+  RenderOptions budgetOptions;
+  if (a.methods) {
+    auto listed = budgetMethods(a);
+    if (!listed) return fail(listed.error().message);
+    methods = std::move(listed.value());
+    auto capture = parseCaptureOption(a.capture);
+    if (!capture) return fail(capture.error().message);
+    budgetOptions.capture = capture.value();
+    auto limit = o.memoryLimitBytes();
+    if (!limit) return fail(limit.error().message);
+    budgetOptions.memoryLimitBytes = limit.value();
+    budgetOptions.sampleStorage = o.storage();
+  } else if (!a.composite.empty() || a.capture != "tile") {
+    return fail(std::string(a.composite.empty() ? "--capture" : "--composite") +
+                ": applies to the budget table only (give --methods LIST)");
+  }
   Progress progress(!o.quiet);
   progress.set("loading " + o.source);
   auto prepared = prepareScene(o);
@@ -27,6 +158,18 @@ int run(const SceneOptions& o) {
   const MemoryModel abuffer = MemoryModel::of(methodPreset("abuffer").value());
   auto engine = makeSceneEngine(o);
   if (!engine) return fail(engine.error().message);
+  // the variable k-buffer's previous frame (--orbit-view I: view I - 1), as render reads it
+  std::vector<float> previousCosine;
+  for (const MethodDesc& m : methods)
+    if (m.allocation == AllocationPolicy::Importance &&
+        m.importanceSource == ImportanceSource::Heuristic && previousCosine.empty()) {
+      auto cosine = previousViewCosine(**engine, scene, o.source,
+                                       {prepared->cameras, prepared->previousCamera}, o.width,
+                                       o.height, o.sampleCount());
+      if (!cosine) return fail(cosine.error().message);
+      previousCosine = std::move(cosine.value());
+    }
+  if (!previousCosine.empty()) budgetOptions.previousNearestCosine = &previousCosine;
   for (size_t v = 0; v < prepared->cameras.size(); ++v) {
     progress.set("counting fragments", static_cast<int>(v),
                  static_cast<int>(prepared->cameras.size()));
@@ -55,6 +198,12 @@ int run(const SceneOptions& o) {
          {"max_depth_complexity", maxN},
          {"mean_depth_complexity", covered ? double(total) / covered : 0.0},
          {"abuffer_bytes", abuffer.overhead((*view)->pixelCount()) + total * kNodeBytes}});
+    if (a.methods) {
+      progress.set("budgets", static_cast<int>(v), static_cast<int>(prepared->cameras.size()));
+      auto budgets = sceneBudgets(**engine, **view, methods, budgetOptions);
+      if (!budgets) return fail(echoPath(o.source) + ": " + budgets.error().message);
+      views.back()["budgets"] = budgetsJson(budgets.value());
+    }
   }
   // the file's cameras as --view N numbers them (fileCamera): the same list, the same index
   nlohmann::json fileCameras = nlohmann::json::array();
@@ -107,7 +256,7 @@ int run(const SceneOptions& o) {
       std::printf("camera %-3d  --view %d: eye %g, %g, %g, fov %g degrees\n",
                   c["camera"].get<int>(), c["camera"].get<int>(), c["eye"][0].get<double>(),
                   c["eye"][1].get<double>(), c["eye"][2].get<double>(), c["fov"].get<double>());
-  for (const auto& v : views)
+  for (const auto& v : views) {
     std::printf(
         "view %-3d    %dx%d: %llu fragments on %llu pixels, depth complexity max %u mean "
         "%.2f, A-buffer %s\n",
@@ -116,16 +265,32 @@ int run(const SceneOptions& o) {
         static_cast<unsigned long long>(v["covered_pixels"].get<uint64_t>()),
         v["max_depth_complexity"].get<uint32_t>(), v["mean_depth_complexity"].get<double>(),
         formatBytes(v["abuffer_bytes"].get<uint64_t>()).c_str());
+    if (v.contains("budgets")) {
+      std::printf("budgets     view %d at %dx%d, %d sample%s:\n", v["view"].get<int>(), o.width,
+                  o.height, v["budgets"]["samples"].get<int>(),
+                  v["budgets"]["samples"].get<int>() == 1 ? "" : "s");
+      printBudgets(v["budgets"]);
+    }
+  }
   return 0;
 }
 
 }  // namespace
 
 Runner addInfoCommand(CLI::App& app) {
-  auto options = std::make_shared<SceneOptions>();
-  CLI::App* cmd = app.add_subcommand("info", "Scene statistics and A-buffer cost");
-  options->add(*cmd, true, true);
-  return [options] { return run(*options); };
+  auto args = std::make_shared<InfoArgs>();
+  CLI::App* cmd = app.add_subcommand("info", "Scene statistics, A-buffer cost and method budgets");
+  args->scene.add(*cmd, true, true);
+  cmd->add_option("--methods,-m", args->methods,
+                  "Budget table of these methods (comma-separated, or all): each one's smallest "
+                  "budget, the budget at which it keeps every fragment, its fixed memory. " +
+                      presetHelp());
+  cmd->add_option("--composite", args->composite,
+                  "With --methods: the k-buffer family's compositing rule, kbuffer or hybrid (as "
+                  "compare's; default: each preset's own)");
+  cmd->add_option("--capture", args->capture,
+                  "With --methods: tile (default) or parallel, whose per-pixel lock words count");
+  return [args] { return run(*args); };
 }
 
 }  // namespace mfr::cli

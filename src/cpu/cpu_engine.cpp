@@ -141,6 +141,15 @@ Result<std::vector<uint32_t>> CpuEngine::countFragments(const PreparedView& view
   return std::move(counted.depthComplexity);
 }
 
+Result<std::vector<uint32_t>> CpuEngine::storageFragmentCounts(const PreparedView& view,
+                                                               SampleStorage storage) {
+  auto cpu = cpuView(view);
+  if (!cpu) return cpu.error();
+  auto frame = (*cpu)->frame(storage);
+  if (!frame) return frame.error();
+  return (*cpu)->fragmentCounts(**frame);
+}
+
 Result<std::vector<float>> CpuEngine::nearestCosine(const PreparedView& view) {
   auto frame = cpuFrame(view);
   if (!frame) return frame.error();

@@ -15,6 +15,13 @@ MemoryModel Engine::memoryModel(const MethodDesc& method, const RenderOptions& o
   return MemoryModel::of(method, options.capture == CaptureMode::FragmentParallel);
 }
 
+Result<std::vector<uint32_t>> Engine::storageFragmentCounts(const PreparedView& view,
+                                                            SampleStorage storage) {
+  if (view.samples() == 1) return countFragments(view);
+  return makeError("engine " + std::string(name()) + ": no per-" + toString(storage) +
+                   " fragment counts at " + std::to_string(view.samples()) + " samples");
+}
+
 Result<RenderOutput> Engine::render(const View& view, const MethodDesc& method,
                                     const RenderOptions& options) {
   MFR_TRY(preflight(view.width, view.height, method, options));

@@ -56,6 +56,8 @@ class CpuEngine final : public Engine {
   Result<RenderOutput> render(const PreparedView& view, const MethodDesc& method,
                               const RenderOptions& options) override;
   Result<std::vector<uint32_t>> countFragments(const PreparedView& view) override;
+  Result<std::vector<uint32_t>> storageFragmentCounts(const PreparedView& view,
+                                                      SampleStorage storage) override;
   Result<std::vector<float>> nearestCosine(const PreparedView& view) override;
   /// Frees the buffers kept from the last render (frame_buffers.hpp: its node pool and per-pixel
   /// stores, held until the next render or the engine's end).

@@ -89,6 +89,13 @@ class Engine {
                                       const RenderOptions& options) = 0;
   /// n(p) of every pixel (a coverage count pass), rows top to bottom.
   virtual Result<std::vector<uint32_t>> countFragments(const PreparedView& view) = 0;
+  /// n(p) of every storage pixel of `storage` (core/samples.hpp): what the allocation of a method
+  /// that stores a multisampled view that way reads (per pixel: one count per fragment whatever
+  /// its coverage; per sample: W*S x H counts). With one sample it is countFragments(). Default:
+  /// countFragments() with one sample, else an error naming the engine (scene_budgets.hpp reports
+  /// it instead of a budget).
+  virtual Result<std::vector<uint32_t>> storageFragmentCounts(const PreparedView& view,
+                                                              SampleStorage storage);
   /// |n.v| of each pixel's nearest fragment (0 where none), quantised to 8 bits: the previous
   /// frame's input of the importance allocation (RenderOptions::previousNearestCosine).
   virtual Result<std::vector<float>> nearestCosine(const PreparedView& view) = 0;
