@@ -104,6 +104,11 @@ void printSummary(const CompareResult& r) {
                echoPath(r.scene).c_str(), r.width, r.height, r.truthEngine.c_str(),
                static_cast<unsigned long long>(r.groundTruth.stats.fragmentsGenerated),
                formatBytes(r.groundTruth.stats.bytesUsed).c_str(), r.groundTruth.stats.totalMs());
+  if (r.autoBudgets) {
+    std::string list;
+    for (const CompareBudget& cb : r.budgets) list += (list.empty() ? "" : ", ") + cb.label;
+    std::fprintf(stderr, "budgets from the scene (--budget auto): %s\n", list.c_str());
+  }
   // ms: the median of the timed renders (--repeat), min-max beside it
   std::fprintf(stderr, "  %-22s %-7s %8s %11s %9s %7s %10s %9s %10s %8s %9s %s\n", "method", "rule",
                "budget", "used", "k", "lost%", "mse_lin", "psnr_lin", "psnr_srgb", "flip", "ms",

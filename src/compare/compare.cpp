@@ -9,10 +9,12 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <set>
 #include <sstream>
 
 #include "mfr/core/colormap.hpp"
+#include "mfr/engine/scene_budgets.hpp"
 #include "mfr/method/dkb_model.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/method_options.hpp"
@@ -61,6 +63,8 @@ nlohmann::json runToJson(const CompareRun& run) {
   j["compositing"] = toString(run.compositing);
   if (run.error) {
     j["error"] = *run.error;
+    // the method's smallest budget on this frame (scene_budgets.hpp), where it has one
+    j["minimum_bytes"] = run.minimumBytes ? nlohmann::json(*run.minimumBytes) : nlohmann::json();
     return j;
   }
   nlohmann::json stats = statsToJson(run.stats);
@@ -369,6 +373,41 @@ void colourKMaps(const std::vector<std::vector<uint32_t>>& kMaps, int w, int h,
     }
 }
 
+// --budget auto: the budgets of the scene's table (scene_budgets.hpp) for the compared methods.
+Result<std::vector<BudgetSpec>> autoBudgetList(Engine& engine, const PreparedView& view,
+                                               const std::vector<ComparedMethod>& methods,
+                                               const RenderOptions& renderOptions) {
+  std::vector<MethodDesc> descs;
+  for (const ComparedMethod& m : methods) descs.push_back(m.desc);
+  auto table = sceneBudgets(engine, view, descs, renderOptions);
+  if (!table) return makeError("--budget auto: " + table.error().message);
+  std::vector<BudgetSpec> budgets = autoBudgets(table.value());
+  if (budgets.empty())
+    return makeError("--budget auto: none of the methods runs at any budget on this frame");
+  return budgets;
+}
+
+// A run refused at its budget: the method's smallest budget on this frame (counted once per
+// run label), and the refusal naming it when the budget is below it.
+void explainRefusal(const RunSetting& s, const ComparedMethod& method, const std::string& label,
+                    std::map<std::string, std::optional<uint64_t>>& minimums, CompareRun& run) {
+  auto found = minimums.find(method.label);
+  if (found == minimums.end()) {
+    auto row = methodBudget(s.engine, s.view, method.desc, s.renderOptions);
+    std::optional<uint64_t> minimum;
+    if (row) minimum = row->minimumBytes;
+    found = minimums.emplace(method.label, minimum).first;
+  }
+  run.minimumBytes = found->second;
+  // a share too small already names the smallest share that works (resolveBudget); a budget at
+  // or above the minimum was refused for another reason
+  if (!run.minimumBytes || !run.budgetBytes || *run.budgetBytes >= *run.minimumBytes) return;
+  MethodBudget row;
+  row.method = method.label;
+  row.minimumBytes = run.minimumBytes;
+  run.error = belowMinimumText(row, label, s.sizeName);
+}
+
 }  // namespace
 
 Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
@@ -378,17 +417,29 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   if (options.repeat < 1 || options.warmup < 0)
     return makeError("runComparison: repeat must be at least 1 and warmup at least 0");
   if (options.methods.empty()) return makeError("--methods: the method list is empty");
-  if (options.autoBudgets) return makeError("--budget auto: not wired yet");
-  if (options.budgets.empty()) return makeError("--budget: no budget given");
   auto methods = comparedMethods(options);
   if (!methods) return methods.error();
-  MFR_TRY(checkBudgetList(options.budgets));
-  const bool anyRelative = std::any_of(options.budgets.begin(), options.budgets.end(),
+  RenderOptions renderOptions;
+  renderOptions.capture = options.capture;
+  renderOptions.background = options.background;
+  renderOptions.memoryLimitBytes = options.memoryLimitBytes;
+  renderOptions.sampleStorage = options.sampleStorage;
+  if (!options.previousNearestCosine.empty())
+    renderOptions.previousNearestCosine = &options.previousNearestCosine;
+  std::vector<BudgetSpec> budgets = options.budgets;
+  if (options.autoBudgets) {  // log-spaced from the smallest minimum to the A-buffer's bytes
+    auto picked = autoBudgetList(engine, view, *methods, renderOptions);
+    if (!picked) return picked.error();
+    budgets = std::move(picked.value());
+  }
+  if (budgets.empty()) return makeError("--budget: no budget given");
+  MFR_TRY(checkBudgetList(budgets));
+  const bool anyRelative = std::any_of(budgets.begin(), budgets.end(),
                                        [](const BudgetSpec& b) { return b.isRelative(); });
   MFR_TRY(checkFlipPixelsPerDegree(options.flipPixelsPerDegree));
 
   const int w = view.width(), h = view.height();
-  CompareProgress progress{options, 1 + static_cast<int>(methods->size() * options.budgets.size())};
+  CompareProgress progress{options, 1 + static_cast<int>(methods->size() * budgets.size())};
 
   CompareResult result;
   result.scene = options.scene;
@@ -398,18 +449,11 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   result.rules = options.rules;
   result.repeat = options.repeat;
   result.warmup = options.warmup;
+  result.autoBudgets = options.autoBudgets;
   result.capture = options.capture;
   result.flipPixelsPerDegree = options.flipPixelsPerDegree;
   result.samples = view.samples();
   result.sampleStorage = options.sampleStorage;
-
-  RenderOptions renderOptions;
-  renderOptions.capture = options.capture;
-  renderOptions.background = options.background;
-  renderOptions.memoryLimitBytes = options.memoryLimitBytes;
-  renderOptions.sampleStorage = options.sampleStorage;
-  if (!options.previousNearestCosine.empty())
-    renderOptions.previousNearestCosine = &options.previousNearestCosine;
 
   progress.report("rendering the ground truth (abuffer)");
   MFR_TRY(renderGroundTruth(engine, view, truthView, renderOptions, options, result));
@@ -428,7 +472,8 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
 
   std::vector<std::vector<uint32_t>> kMaps;  // per run, colour-mapped at the end (shared scale)
   float kScale = 1.0f;
-  for (const BudgetSpec& spec : options.budgets) {
+  std::map<std::string, std::optional<uint64_t>> minimums;  // per run label, once it failed
+  for (const BudgetSpec& spec : budgets) {
     CompareBudget& cb = result.budgets.emplace_back();
     cb.budgetBytes = spec.bytes ? *spec.bytes : relativeNodeBytes(spec.percent, counts);
     if (spec.isRelative()) cb.percent = spec.percent;
@@ -437,6 +482,7 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
       CompareRun& run = cb.runs.emplace_back();
       auto kMap = compareOneRun(setting, spec, cb.label, method, progress, run);
       if (!kMap) return kMap.error();
+      if (!run.ok()) explainRefusal(setting, method, cb.label, minimums, run);
       if (run.ok()) kScale = std::max(kScale, static_cast<float>(run.stats.kMax));
       kMaps.push_back(std::move(*kMap));
       ++progress.step;
@@ -446,6 +492,16 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   colourKMaps(kMaps, w, h, result);
   if (options.progress) options.progress("done", progress.total, progress.total);
   return result;
+}
+
+std::vector<BudgetSpec> budgetSpecs(const CompareResult& result) {
+  std::vector<BudgetSpec> specs;
+  for (const CompareBudget& cb : result.budgets) {
+    BudgetSpec spec = cb.percent ? BudgetSpec::relative(*cb.percent) : BudgetSpec(cb.budgetBytes);
+    spec.label = cb.label;
+    specs.push_back(spec);
+  }
+  return specs;
 }
 
 SampleCountRuns sampleCountRuns(const CompareResult& result) {
@@ -472,6 +528,8 @@ Result<void> addSampleCounts(Engine& engine, View view, const CompareOptions& op
     auto prepared = prepareComparedView(engine, view, options);
     if (!prepared) return makeError(what + prepared.error().message);
     CompareOptions o = options;
+    o.budgets = budgetSpecs(result);  // --budget auto: the budgets the first count picked
+    o.autoBudgets = false;
     if (options.progress)
       o.progress = [&options, count](const std::string& stage, int done, int total) {
         options.progress(std::to_string(count) + " samples: " + stage, done, total);
@@ -498,6 +556,7 @@ nlohmann::json compareToJson(const CompareResult& r, const std::string& mfrVersi
   for (const Compositing rule : r.rules) rules.push_back(toString(rule));
   j["compositing_rules"] = rules;
   j["repeat"] = r.repeat;
+  j["budgets_auto"] = r.autoBudgets;
   j["warmup"] = r.warmup;
   j["capture"] = captureName(r.capture);
   j["cull"] = toString(r.groundTruth.stats.cull);  // every run rasterizes the same view

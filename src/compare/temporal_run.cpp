@@ -60,6 +60,8 @@ Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest&
     };
     auto result = runComparison(engine, *view->view, options, view->truth.get());
     if (!result) return named(result.error());
+    options.budgets = budgetSpecs(result.value());  // --budget auto: the first frame's, for all
+    options.autoBudgets = false;
     engineName = result->engine;
     char folder[32];
     std::snprintf(folder, sizeof folder, "frame_%03d", f);

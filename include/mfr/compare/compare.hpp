@@ -101,7 +101,10 @@ struct CompareRun {
   std::optional<uint64_t> budgetBytes;             // none for the ground truth
   Compositing compositing = Compositing::KBuffer;  // the rule this run composited with
   std::optional<std::string> error;  // the render failed (e.g. budget too small): no data below
-  RenderStats stats;                 // passes: the median-time render's
+  /// A failed run: the method's smallest budget on this frame (methodBudget), none where it has
+  /// none; the error names it when the budget was below it.
+  std::optional<uint64_t> minimumBytes;
+  RenderStats stats;  // passes: the median-time render's
   RunTiming timing;
   uint64_t budgetSlots = 0;  // F(M) of the method's memory model (0 without a budget)
   CompareMetrics metrics;
@@ -140,6 +143,7 @@ struct CompareResult {
   int width = 0, height = 0;
   std::vector<Compositing> rules;  // CompareOptions::rules (empty: each preset's own)
   int repeat = 1, warmup = 0;      // CompareOptions::repeat, warmup
+  bool autoBudgets = false;        // the budgets were picked from the scene (--budget auto)
   CaptureMode capture = CaptureMode::TileOwned;
   int samples = 1;  // per pixel (View::samples)
   SampleStorage sampleStorage = SampleStorage::Pixel;
@@ -152,6 +156,9 @@ struct CompareResult {
   /// --sample-counts: every count asked for, in order (the one of `samples` is these budgets' runs)
   std::vector<SampleCountRuns> sampleCounts;
 };
+
+/// The budgets `result` ran at, as specs (after --budget auto: the ones it picked).
+std::vector<BudgetSpec> budgetSpecs(const CompareResult& result);
 
 /// The runs of `result` without their images (what SampleCountRuns keeps).
 SampleCountRuns sampleCountRuns(const CompareResult& result);
