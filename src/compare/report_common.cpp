@@ -131,12 +131,13 @@ table.results td.passes { text-align: left; white-space: normal; color: var(--mu
   min-width: 220px; }
 table.results td.note { text-align: left; white-space: normal; color: var(--muted); font-size: 12.5px; }
 table.results .best { font-weight: 700; }
-table.ranking { width: auto; min-width: 760px; }
-table.sortable th { cursor: pointer; user-select: none; }
-table.sortable th:hover { background: #f1f4f8; }
-table.sortable th::after { content: " \2195"; color: #bbb; font-weight: 400; }
-table.sortable th[aria-sort="ascending"]::after { content: " \25B2"; color: var(--accent); }
-table.sortable th[aria-sort="descending"]::after { content: " \25BC"; color: var(--accent); }
+table.ranking { width: auto; min-width: 760px; max-width: 1100px; }
+table.ranking th:nth-child(2), table.ranking td:nth-child(2) { text-align: left; }
+table[data-sortable] th { cursor: pointer; user-select: none; }
+table[data-sortable] th:hover { background: #f1f4f8; }
+table[data-sortable] th::after { content: " \2195"; color: #bbb; font-weight: 400; }
+table[data-sortable] th[aria-sort="ascending"]::after { content: " \25B2"; color: var(--accent); }
+table[data-sortable] th[aria-sort="descending"]::after { content: " \25BC"; color: var(--accent); }
 .caption { color: var(--muted); font-size: 13px; margin: 4px 0 12px; }
 .verdict { font-size: 16px; margin: 6px 0 4px; }
 .verdict strong { color: #0a6b2d; }
@@ -232,7 +233,7 @@ const char* kScript = R"js(
     rows.sort(function (a, b) { return compare(a, b, i, dir); });
     rows.forEach(function (r) { body.appendChild(r); });
   }
-  Array.prototype.forEach.call(document.querySelectorAll('table.sortable'), function (table) {
+  Array.prototype.forEach.call(document.querySelectorAll('table[data-sortable]'), function (table) {
     Array.prototype.forEach.call(table.tHead.rows[0].cells, function (th) {
       th.title = 'sort by this column';
       th.addEventListener('click', function () { sortBy(table, th); });

@@ -366,7 +366,7 @@ report::PlotSpec frameSpec(const std::string& title, const std::string& yLabel, 
   spec.yLabel = yLabel;
   spec.errorY = errorY;
   spec.zeroBased = errorY;
-  spec.plotWidth = 210;  // three plots in a row
+  spec.plotWidth = 180;  // three plots in a row at 1400 px
   spec.height = 300;
   return spec;
 }
