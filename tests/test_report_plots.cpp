@@ -7,9 +7,12 @@
 //     data-x-* / data-y-* ranges, linear or log), equals the JSON value up to the 0.1 px rounding
 //     of the SVG coordinates;
 //   - the series' line passes through the markers, in budget order.
-// Runs that failed (budget too small) must have no point; nothing else may be plotted. Two
-// scenarios cover both axis mappings: budgets 4x apart (log x) with failed runs and zero errors
-// (linear y), and budgets 2x apart (linear x) whose MSE spans > 20x (log y).
+// Runs that failed (budget too small) must have no point; nothing else may be plotted. Error axes
+// (FLIP, MSE) are log where their positive values span a decade, and then a zero error is drawn
+// at the axis' floor (data-y-floor, the line marked "0 exact"); the fragments lost are linear.
+// Two scenarios cover the axis mappings: budgets 4x apart (log x) with failed runs and zero
+// errors (log MSE with its floor), and budgets 2x apart (linear x) whose MSE spans > 20x (log y,
+// no zeros).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -109,6 +112,7 @@ std::vector<double> numbersIn(const std::string& s) {
 struct Axis {
   bool log = false;
   double lo = 0, hi = 1;
+  double floor = 0;       // log error axes: where 0 is drawn (data-y-floor)
   double p0 = 0, p1 = 1;  // pixel positions of lo and hi
   // A pixel position back to a value.
   double value(double pixel) const {
@@ -224,6 +228,7 @@ Plot parsePlot(const std::string& svg) {
       plot.y.log = t.attrs.at("data-y-scale") == "log";
       plot.y.lo = number(t.attrs, "data-y-lo");
       plot.y.hi = number(t.attrs, "data-y-hi");
+      if (t.attrs.count("data-y-floor")) plot.y.floor = number(t.attrs, "data-y-floor");
       plot.y.p0 = fy + fh;  // lo at the bottom
       plot.y.p1 = fy;
     } else if (inPoint) {
@@ -265,7 +270,8 @@ struct Scenario {
   // the axis mappings this scenario is meant to exercise (the report's choice, checked so that a
   // change of its heuristics cannot silently leave a mapping untested)
   bool logBudgets;  // x of every plot
-  bool logMse;      // y of the MSE plot (the FLIP and fragments-lost plots are always linear)
+  bool logMse;      // y of the MSE plot (the fragments-lost plot is always linear)
+  bool zeroMse;     // some MSE is 0: drawn at the floor of the log axis
 };
 
 const std::vector<Scenario>& scenarios() {
@@ -277,14 +283,16 @@ const std::vector<Scenario>& scenarios() {
        {128u << 10, 64u << 10, 256u << 10},
        /*failures=*/true,
        /*logBudgets=*/true,
-       /*logMse=*/false},
+       /*logMse=*/true,
+       /*zeroMse=*/true},
       // all three methods fit everywhere; MSE from ~7e-2 down to ~2e-5
       {"LinearBudgetsLogMse",
        {"fkb", "kplus-dynamic", "vkb"},
        {72000, 110000, 150000},
        /*failures=*/false,
        /*logBudgets=*/false,
-       /*logMse=*/true},
+       /*logMse=*/true,
+       /*zeroMse=*/false},
   };
   return s;
 }
@@ -310,6 +318,25 @@ const PlotSpec kPlots[] = {{"Mean FLIP vs budget", "flip_mean"},
 // Drawn coordinates are printed with one decimal (0.05 px), and a marker's centre is recovered
 // from a corner or apex printed the same way: 0.15 px covers both roundings and the frame's own.
 constexpr double kPixelTolerance = 0.15;
+
+// whether the positive values of `key` over every successful run span a factor of 10 or more
+bool spansADecade(const nlohmann::json& budgets, const char* key) {
+  double lo = INFINITY, hi = 0.0;
+  for (const nlohmann::json& b : budgets)
+    for (const nlohmann::json& run : b.at("methods"))
+      if (!run.contains("error") && run.at(key).get<double>() > 0.0) {
+        lo = std::min(lo, run.at(key).get<double>());
+        hi = std::max(hi, run.at(key).get<double>());
+      }
+  return std::isfinite(lo) && hi >= 10.0 * lo;
+}
+
+bool hasZero(const nlohmann::json& budgets, const char* key) {
+  for (const nlohmann::json& b : budgets)
+    for (const nlohmann::json& run : b.at("methods"))
+      if (!run.contains("error") && run.at(key).get<double>() == 0.0) return true;
+  return false;
+}
 
 class ReportPlots : public ::testing::TestWithParam<size_t> {};
 
@@ -341,8 +368,21 @@ TEST_P(ReportPlots, EveryPlottedPointIsTheJsonValue) {
     const Plot plot = parsePlot(svg);
     ASSERT_TRUE(plot.haveFrame);
     EXPECT_EQ(plot.x.log, sc.logBudgets) << "the scenario no longer exercises this x mapping";
-    EXPECT_EQ(plot.y.log, std::string(spec.jsonKey) == "mse_linear" && sc.logMse)
-        << "the scenario no longer exercises this y mapping";
+    // error axes are log where their positive values span a decade (zeros drawn at the floor);
+    // the fragments lost always linear
+    const bool errorAxis = std::string(spec.jsonKey) != "fragments_lost_percent";
+    const bool expectLog = errorAxis && spansADecade(budgets, spec.jsonKey);
+    EXPECT_EQ(plot.y.log, expectLog);
+    if (std::string(spec.jsonKey) == "mse_linear") {
+      EXPECT_EQ(plot.y.log, sc.logMse) << "the scenario no longer exercises this y mapping";
+      EXPECT_EQ(plot.y.floor > 0.0, sc.zeroMse) << "the scenario no longer draws zeros on log";
+    }
+    const bool zeros = hasZero(budgets, spec.jsonKey);
+    if (plot.y.log && zeros) {
+      EXPECT_GT(plot.y.floor, 0.0) << "zeros on a log axis need a floor";
+    } else {
+      EXPECT_EQ(plot.y.floor, 0.0);
+    }
 
     // one series per method, in the methods' order
     ASSERT_EQ(plot.series.size(), sc.methods.size());
@@ -373,13 +413,15 @@ TEST_P(ReportPlots, EveryPlottedPointIsTheJsonValue) {
         const double bx = plot.x.value(p.px), vy = plot.y.value(p.py);
         EXPECT_TRUE(plot.x.agrees(bx, p.dataX, kPixelTolerance))
             << "budget " << p.dataX << " drawn at x = " << p.px << " reads back as " << bx;
-        EXPECT_TRUE(plot.y.agrees(vy, e->second, kPixelTolerance))
+        // a zero on a log axis is drawn at its floor (the line marked "0 exact")
+        const double drawn = plot.y.log && e->second == 0.0 ? plot.y.floor : e->second;
+        EXPECT_TRUE(plot.y.agrees(vy, drawn, kPixelTolerance))
             << "budget " << p.dataX << ": JSON " << e->second << ", drawn at y = " << p.py
             << " reads back as " << vy << " (axis " << (plot.y.log ? "log " : "linear ")
             << plot.y.lo << " .. " << plot.y.hi << ")";
         // inside the frame
-        EXPECT_GE(p.dataY, plot.y.lo);
-        EXPECT_LE(p.dataY, plot.y.hi);
+        EXPECT_GE(drawn, plot.y.lo);
+        EXPECT_LE(drawn, plot.y.hi);
       }
 
       // the line joins the markers in budget order (no line for a single point)

@@ -184,9 +184,9 @@ TEST(TemporalStabilityCli, CompareOrbitWritesFramesMeasureAndPlots) {
       dir.parent_path());
   ASSERT_EQ(r.exitCode, 0) << r.err;
   for (const char* f :
-       {"frame_000/results.json", "frame_002/report.html", "report.html", "temporal_100pct.png",
-        "temporal_60pct.png", "temporal_60pct_error_change.png"})
+       {"frame_000/results.json", "frame_002/report.html", "report.html", "results.csv"})
     EXPECT_TRUE(fs::exists(dir / f)) << f;
+  EXPECT_FALSE(fs::exists(dir / "temporal_100pct.png"));  // the plots are in the page
   std::ifstream in(dir / "results.json");
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j["orbit"], 3);
@@ -210,7 +210,29 @@ TEST(TemporalStabilityCli, CompareOrbitWritesFramesMeasureAndPlots) {
   const std::string page((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
   EXPECT_NE(page.find("excess flicker"), std::string::npos);
   EXPECT_NE(page.find("error change"), std::string::npos);
-  EXPECT_NE(page.find("temporal_100pct.png"), std::string::npos);
+  // in the one-view report's style: inline SVG plots per budget, the frames as images
+  EXPECT_NE(page.find("aria-label=\"Excess flicker at 60%\""), std::string::npos);
+  EXPECT_NE(page.find("aria-label=\"Error change at 100%\""), std::string::npos);
+  EXPECT_NE(page.find("aria-label=\"Mean FLIP vs ground truth at 60%\""), std::string::npos);
+  EXPECT_NE(page.find("<img src=\"frame_002/ground_truth.png\""), std::string::npos);
+  EXPECT_NE(page.find("<img src=\"frame_001/" +
+                      frame1["budgets"][1]["methods"][1]["image"].get<std::string>() + "\""),
+            std::string::npos);
+  EXPECT_NE(page.find("data-sortable"), std::string::npos);
+  // mean_flip is the mean of error_flip; results.csv has its row per series
+  const nlohmann::json& s2 = t["series"][2];
+  double sum = 0.0;
+  for (const nlohmann::json& v : s2["error_flip"]) sum += v.get<double>();
+  EXPECT_NEAR(s2["mean_flip"].get<double>(), sum / 3.0, 1e-15);
+  std::ifstream csvIn(dir / "results.csv");
+  std::vector<std::string> rows;
+  for (std::string line; std::getline(csvIn, line);) rows.push_back(line);
+  ASSERT_EQ(rows.size(), 1u + 1u + 6u);
+  EXPECT_EQ(rows[0],
+            "method,budget_label,frames,mean_flip,flicker,excess_flicker,mean_error_change");
+  EXPECT_EQ(rows[1].rfind("abuffer,,3,0,", 0), 0u) << rows[1];
+  EXPECT_EQ(rows[5], "abuffer,60%,3,,,,") << "the A-buffer failed at 60%: empty fields";
+  EXPECT_EQ(rows[4].rfind("vkb-fill,100%,3,", 0), 0u) << rows[4];
 
   auto one = test::runCli(
       "compare procedural:spheres --width 32 --height 32 --quiet --orbit 1 "

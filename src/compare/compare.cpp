@@ -162,8 +162,10 @@ struct ComparedMethod {
 // model was trained for, with modelPicksRules) and for depth peeling bounded by --max-peels (its
 // hybrid form blends what remains into a tail); its own rule otherwise.
 std::vector<Compositing> methodRules(const MethodDesc& m, const CompareOptions& options) {
+  // (the exact A-buffer keeps every fragment: a tail would only cost memory)
   const bool choice =
-      kBufferFamilyRule(m.compositing) || (peelingRule(m.compositing) && m.maxPeels);
+      (kBufferFamilyRule(m.compositing) && m.allocation != AllocationPolicy::Unbounded) ||
+      (peelingRule(m.compositing) && m.maxPeels);
   if (!choice || options.rules.empty()) return {m.compositing};
   std::vector<Compositing> rules;
   for (const Compositing rule : options.rules) {

@@ -17,20 +17,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// One plot per budget and measure; a budget where every method failed has nothing to draw.
-Result<std::vector<std::string>> writePlots(const TemporalResult& t, const CompareOptions& options,
-                                            const fs::path& dir) {
-  std::vector<std::string> plots;
-  for (const BudgetSpec& b : options.budgets)
-    for (const TemporalMeasure m : {TemporalMeasure::ExcessFlicker, TemporalMeasure::ErrorChange}) {
-      auto plot = temporalPlot(t, b.label, m);
-      if (!plot) continue;
-      const std::string file = "temporal_" + b.fileLabel() +
-                               (m == TemporalMeasure::ErrorChange ? "_error_change" : "") + ".png";
-      MFR_TRY(writePng((dir / file).string(), plot.value()));
-      plots.push_back(file);
-    }
-  return plots;
+// the images of one frame as the temporal report shows them: the ground truth's, then each run's
+// in the order of TemporalResult::series (budgets, then methods; empty: the run failed)
+std::vector<std::string> frameImages(const CompareResult& frame) {
+  std::vector<std::string> files = {frame.groundTruth.imageFile};
+  for (const CompareBudget& cb : frame.budgets)
+    for (const CompareRun& run : cb.runs) files.push_back(run.ok() ? run.imageFile : "");
+  return files;
 }
 
 }  // namespace
@@ -45,7 +38,8 @@ Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest&
   const std::vector<Camera> path = orbitPath(r.start, r.frames, run.stepDegrees);
   const fs::path dir(dirText);
   TemporalStability temporal(options.flipPixelsPerDegree);
-  std::vector<std::string> folders;
+  TemporalReportPage page;
+  std::vector<std::string>& folders = page.frameFolders;
   std::vector<float> previousCosine;  // vkb's Fresnel term: the previous frame's nearest |n.v|
   std::string engineName;
   for (int f = 0; f < r.frames; ++f) {
@@ -71,13 +65,12 @@ Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest&
         writeComparison(result.value(), (dir / folder).string(), r.versionNumber, r.info);
     if (!written) return written.error();
     MFR_TRY(temporal.add(result.value()));
+    page.frameImages.push_back(frameImages(result.value()));
     auto cosine = engine.nearestCosine(*view->view);
     if (!cosine) return named(cosine.error());
     previousCosine = std::move(cosine.value());
   }
   run.result = temporal.result();
-  auto plots = writePlots(run.result, options, dir);
-  if (!plots) return plots.error();
   nlohmann::json j;
   j["mfr_version"] = r.versionNumber;
   j["scene"] = r.source;
@@ -87,14 +80,20 @@ Result<TemporalRun> runTemporalComparison(Engine& engine, const TemporalRequest&
   j["orbit"] = r.frames;
   j["orbit_step_degrees"] = run.stepDegrees;
   j["frames"] = folders;
-  j["plots"] = plots.value();
   j["temporal"] = temporalToJson(run.result);
   // a path that is not UTF-8: U+FFFD in the JSON, as compare_output.cpp
   run.jsonText = jsonText(j) + "\n";
   MFR_TRY(writeFileAtomically((dir / "results.json").string(), run.jsonText));
-  MFR_TRY(writeFileAtomically((dir / "report.html").string(),
-                              temporalReportHtml(run.result, r.source, r.width, r.height,
-                                                 plots.value(), folders, r.info.commandLine)));
+  MFR_TRY(writeFileAtomically((dir / "results.csv").string(), temporalToCsv(run.result)));
+  page.scene = r.source;
+  page.width = r.width;
+  page.height = r.height;
+  page.stepDegrees = run.stepDegrees;
+  page.commandLine = r.info.commandLine;
+  page.mfrVersion = r.info.mfrVersion;
+  page.generated = r.info.generated;
+  MFR_TRY(
+      writeFileAtomically((dir / "report.html").string(), temporalReportHtml(run.result, page)));
   return run;
 }
 

@@ -48,6 +48,7 @@ struct TemporalSeries {
   double flicker = 0.0;          // mean of consecutiveFlip (NaN if any transition is missing)
   double excessFlicker = 0.0;    // mean of consecutiveFlip - the ground truth's (NaN likewise)
   double meanErrorChange = 0.0;  // mean of errorChange (NaN likewise)
+  double meanFlip = 0.0;  // mean of errorFlip: the error against the ground truth (NaN likewise)
 };
 
 struct TemporalResult {
@@ -77,8 +78,13 @@ class TemporalStability {
 
 /// results.json's "temporal" object: frames, definition, ground_truth {consecutive_flip, flicker},
 /// series [{method, budget_label, consecutive_flip, error_flip, error_change, flicker,
-/// excess_flicker, mean_error_change}] (NaN as null).
+/// excess_flicker, mean_error_change, mean_flip}] (NaN as null).
 nlohmann::json temporalToJson(const TemporalResult& result);
+
+/// The temporal comparison's results.csv: a header (method, budget_label, frames, mean_flip,
+/// flicker, excess_flicker, mean_error_change) and one row per series after the ground truth's
+/// (method abuffer, empty budget, mean_flip and excess 0); a NaN is an empty field.
+std::string temporalToCsv(const TemporalResult& result);
 
 /// What a temporal plot draws over t.
 enum class TemporalMeasure { ExcessFlicker, ErrorChange };
@@ -88,12 +94,23 @@ enum class TemporalMeasure { ExcessFlicker, ErrorChange };
 Result<Image8> temporalPlot(const TemporalResult& result, const std::string& budgetLabel,
                             TemporalMeasure measure = TemporalMeasure::ExcessFlicker);
 
-/// A self-contained page: the set-up, the flicker table (method, budget, flicker, excess, error
-/// change, mean FLIP against the ground truth over the frames), the plots (`plotFiles`, relative
-/// file names) and links to the frames' own reports (`frameFolders`).
-std::string temporalReportHtml(const TemporalResult& result, const std::string& scene, int width,
-                               int height, const std::vector<std::string>& plotFiles,
-                               const std::vector<std::string>& frameFolders,
-                               const std::string& commandLine);
+/// What the temporal report shows besides the measures.
+struct TemporalReportPage {
+  std::string scene;
+  int width = 0, height = 0;
+  float stepDegrees = 0.0f;
+  std::string commandLine, mfrVersion, generated;  // as ReportInfo
+  std::vector<std::string> frameFolders;           // frame_000, ...: each holds its own report
+  /// Per frame, file names relative to its folder: the ground truth's image, then each series'
+  /// image (TemporalResult::series order; empty where the run failed).
+  std::vector<std::vector<std::string>> frameImages;
+};
+
+/// A self-contained page in the style of the one-view report (shared CSS, sortable tables): the
+/// set-up, per budget the steadiest and the most accurate method, the table (method, budget,
+/// mean FLIP against the ground truth, flicker, excess flicker, error change), inline SVG plots
+/// over the frames per budget (mean FLIP, excess flicker, error change) and the frames as images
+/// linked to their own reports.
+std::string temporalReportHtml(const TemporalResult& result, const TemporalReportPage& page);
 
 }  // namespace mfr

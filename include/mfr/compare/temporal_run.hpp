@@ -1,7 +1,8 @@
 // The temporal comparison of `mfr compare --orbit N` and mfr.compare(orbit=N): every frame of an
 // orbit path compared against its ground truth (runComparison) into DIR/frame_NNN, the stability
-// of each method along the path (temporal.hpp), and DIR/results.json, DIR/report.html and one plot
-// per budget and measure. The front ends stage DIR and report; the work is here once.
+// of each method along the path (temporal.hpp), and DIR/results.json, DIR/results.csv
+// (temporalToCsv) and DIR/report.html (its plots inline). The front ends stage DIR and report; the
+// work is here once.
 #pragma once
 
 #include <functional>
