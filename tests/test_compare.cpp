@@ -345,6 +345,107 @@ TEST(CompareOptionsCheck, BadOptionsAreErrorsNamingTheInput) {
   EXPECT_NE(error(o).find("200KB"), std::string::npos);
 }
 
+// --repeat / --warmup: every run (and the ground truth) is timed `repeat` times; the statistics
+// carry the median render's passes, so the total is the median, between the min and the max.
+TEST(CompareOptionsCheck, RepeatedRunsReportTheMedianAndTheSpread) {
+  static const std::unique_ptr<PreparedView> view = makeView();
+  CompareOptions o;
+  o.methods = {"fkb", "wboit"};
+  o.budgets = {kLarge};
+  o.scene = kScene;
+  o.repeat = 3;
+  o.warmup = 1;
+  auto r = runComparison(engine(), *view, o);
+  ASSERT_TRUE(r.ok()) << r.error().message;
+  std::vector<const CompareRun*> runs = {&r->groundTruth};
+  for (const CompareRun& run : r->budgets[0].runs) runs.push_back(&run);
+  for (const CompareRun* run : runs) {
+    SCOPED_TRACE(run->label);
+    ASSERT_TRUE(run->ok());
+    EXPECT_EQ(run->timing.repeats, 3);
+    EXPECT_LE(run->timing.minMs, run->timing.medianMs);
+    EXPECT_LE(run->timing.medianMs, run->timing.maxMs);
+    EXPECT_NEAR(run->stats.totalMs(), run->timing.medianMs, 1e-9);
+  }
+  const nlohmann::json j = compareToJson(r.value());
+  EXPECT_EQ(j["repeat"], 3);
+  EXPECT_EQ(j["warmup"], 1);
+  EXPECT_EQ(j["methods"][0]["repeats"], 3);
+  EXPECT_EQ(j["methods"][0]["total_ms_max"], r->budgets[0].runs[0].timing.maxMs);
+  o.repeat = 0;  // the library refuses what the request check would
+  EXPECT_FALSE(runComparison(engine(), *view, o).ok());
+}
+
+// An engine that renders like the CPU engine but refuses the A-buffer, as a GPU whose limits
+// refuse the ground truth's node buffer does.
+class RefusingEngine final : public Engine {
+ public:
+  std::string_view name() const override { return "refusing"; }
+  std::map<std::string, std::string> describe() const override { return {}; }
+  Result<std::unique_ptr<PreparedView>> prepare(const View& view) override {
+    return cpu_.prepare(view);
+  }
+  using Engine::render;
+  Result<RenderOutput> render(const PreparedView& view, const MethodDesc& method,
+                              const RenderOptions& options) override {
+    if (method.name == "abuffer") return makeError("node buffer above the device's limit");
+    return cpu_.render(view, method, options);
+  }
+  Result<std::vector<uint32_t>> countFragments(const PreparedView& view) override {
+    return cpu_.countFragments(view);
+  }
+  Result<std::vector<float>> nearestCosine(const PreparedView& view) override {
+    return cpu_.nearestCosine(view);
+  }
+
+ private:
+  CpuEngine cpu_{EngineOptions{2, 16}};
+};
+
+TEST(CompareTruthEngine, TheCpuEngineTakesOverTheTruthAGpuRefusesWithANote) {
+  static const Scene scene = loadScene(kScene).value();
+  const View v{&scene, frameBounds(sceneBounds(scene)), kSize, kSize, 1};
+  CompareOptions o;
+  o.methods = {"fkb"};
+  o.budgets = {kLarge};
+  o.scene = kScene;
+  RefusingEngine gpu;
+  {  // no truth engine: the comparison fails, naming the ground truth
+    auto prepared = prepareComparedView(gpu, v, o);
+    ASSERT_TRUE(prepared.ok());
+    auto r = runComparison(gpu, *prepared->view, o);
+    ASSERT_FALSE(r.ok());
+    EXPECT_EQ(r.error().message, "ground truth (abuffer): node buffer above the device's limit");
+  }
+  CpuEngine cpu(EngineOptions{2, 16});
+  auto own = engine().prepare(v);
+  ASSERT_TRUE(own.ok());
+  auto reference = runComparison(engine(), **own, o);  // everything on the CPU engine
+  ASSERT_TRUE(reference.ok()) << reference.error().message;
+  for (const bool fallback : {true, false}) {
+    SCOPED_TRACE(fallback ? "fallback" : "--truth-engine cpu");
+    o.truthEngine = &cpu;
+    o.truthFallback = fallback;
+    auto prepared = prepareComparedView(gpu, v, o);
+    ASSERT_TRUE(prepared.ok());
+    ASSERT_TRUE(prepared->truth);
+    EXPECT_FALSE(runComparison(gpu, *prepared->view, o).ok());  // the truth's view is required
+    auto r = runComparison(gpu, *prepared->view, o, prepared->truth.get());
+    ASSERT_TRUE(r.ok()) << r.error().message;
+    EXPECT_EQ(r->engine, "refusing");
+    EXPECT_EQ(r->truthEngine, "cpu");
+    EXPECT_EQ(r->truthNote, fallback ? "ground truth on the cpu engine: refusing: node buffer "
+                                       "above the device's limit"
+                                     : "");
+    EXPECT_EQ(r->groundTruth.image.rgba, reference->groundTruth.image.rgba);
+    EXPECT_EQ(r->budgets[0].runs[0].metrics.flipMean,
+              reference->budgets[0].runs[0].metrics.flipMean);
+    const nlohmann::json j = compareToJson(r.value());
+    EXPECT_EQ(j["truth_engine"], "cpu");
+    EXPECT_EQ(j.contains("truth_note"), fallback);
+  }
+}
+
 TEST(CompareOptionsCheck, SingleBudgetHasNoPlotsAndHybridIsRecorded) {
   static const std::unique_ptr<PreparedView> view = makeView();
   CompareOptions o;
@@ -659,11 +760,54 @@ TEST(CompareCliErrors, BadInputIsOneLineNamingIt) {
   expectCleanFailure(scene + " --budget 200KB --methods fkb,fkb", "fkb");
   expectCleanFailure(scene + " --budget 200KB --composite blend", "blend");
   expectCleanFailure("procedural:teapot -q --budget 200KB", "teapot");
+  // the request's checks (compare_request.hpp), before any work
+  expectCleanFailure(scene + " --budget 200KB --composite kbuffer,kbuffer",
+                     "'kbuffer' listed twice");
+  expectCleanFailure(scene + " --budget 200KB --composite weighted-blended",
+                     "'weighted-blended': expected kbuffer or hybrid");
+  expectCleanFailure(scene + " --budget 200KB --repeat 0", "--repeat 0: must be in [1, 1000]");
+  expectCleanFailure(scene + " --budget 200KB --warmup -2", "--warmup -2: must be in [0, 1000]");
+  expectCleanFailure(scene + " --budget auto,200KB", "--budget auto: picks every budget");
+  expectCleanFailure(scene + " --budget 200KB --truth-engine vulkanish", "--truth-engine");
+  expectCleanFailure(scene + " --budget 200KB --methods fkb --max-peels 2",
+                     "--max-peels: none of the methods peels");
   // an output folder that cannot be created: a path below a regular file
   const fs::path file = tempDir() / "a_file";
   std::ofstream(file) << "x";
   const std::string dir = (file / "sub").string();
   expectCleanFailure(scene + " --budget 200KB --out " + dir, dir);
+}
+
+// Without a terminal (a log, CI), a long comparison still says what it does: plain progress
+// lines at most every MFR_PROGRESS_SECONDS, none for a run shorter than that (the error tests'
+// single line stays single).
+TEST(CompareCliProgress, LinesGoToALogWhenStderrIsNoTerminal) {
+  const fs::path out = tempDir() / "progress";
+  const std::string env = "MFR_PROGRESS_SECONDS=0.2 " + std::string(MFR_CLI_PATH) + " ";
+  const CompareCliRun r = mfr::test::runShell(
+      env + "compare " + sceneArgs() +
+          " --budget 200KB,400KB --methods fkb,kplus-dynamic,vkb --repeat 40 --warmup 0 --out " +
+          out.string(),
+      tempDir());
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  std::istringstream lines(r.err);
+  int progress = 0;
+  for (std::string line; std::getline(lines, line);) {
+    EXPECT_EQ(line.find('\r'), std::string::npos) << line;  // no redrawing in a log
+    EXPECT_EQ(line.find('\033'), std::string::npos) << line;
+    if (line.rfind("progress: ", 0) != 0) continue;
+    ++progress;
+    EXPECT_NE(line.find(" s)"), std::string::npos) << line;
+  }
+  EXPECT_GE(progress, 1) << r.err;
+  EXPECT_NE(r.err.find("report: "), std::string::npos) << r.err;  // the summary follows
+  const CompareCliRun quiet = mfr::test::runShell(
+      env + "compare " + sceneArgs() + " --budget 200KB --methods fkb --repeat 40 --quiet --out " +
+          out.string(),
+      tempDir());
+  ASSERT_EQ(quiet.exitCode, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+  fs::remove_all(out);
 }
 
 // ---- the output folder: one whole comparison, never a mix ----------------------------------

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cmath>
@@ -192,6 +193,12 @@ std::string viewPath(const std::string& path, int view, int views) {
 }
 
 Progress::Progress(bool enabled) : enabled_(enabled), terminal_(isatty(STDERR_FILENO) != 0) {
+  // MFR_PROGRESS_SECONDS: the seconds between lines in a log (a number in [0.1, 3600])
+  if (const char* text = std::getenv("MFR_PROGRESS_SECONDS")) {
+    char* end = nullptr;
+    const double seconds = std::strtod(text, &end);
+    if (end != text && *end == '\0' && seconds >= 0.1 && seconds <= 3600.0) logSeconds_ = seconds;
+  }
   if (enabled_) thread_ = std::thread([this] { loop(); });
 }
 
@@ -224,11 +231,11 @@ void Progress::loop() {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (elapsed < 1.0 || stop_) continue;
+    if (elapsed < std::min(1.0, logSeconds_) || stop_) continue;
     std::lock_guard<std::mutex> lock(mutex_);
     if (!terminal_) {  // a log: a plain line every kLogSeconds at most, while the stage changes
-      const bool due = elapsed - lastLine >= kLogSeconds &&
-                       (stage_ != lastStage || elapsed - lastLine >= kQuietLogSeconds);
+      const bool due = elapsed - lastLine >= logSeconds_ &&
+                       (stage_ != lastStage || elapsed - lastLine >= 6.0 * logSeconds_);
       if (!due) continue;
       const std::string count =
           total_ > 0 ? std::to_string(done_) + "/" + std::to_string(total_) + " " : std::string();

@@ -93,12 +93,10 @@ std::string viewPath(const std::string& path, int view, int views);
 /// A progress line on a terminal (stderr), shown only for work that lasts more than a second.
 /// A command's progress on stderr while it works: on a terminal a line redrawn in place after
 /// the first second; otherwise (a log, a pipe) a plain "progress: 3/12 STAGE (12 s)" line at most
-/// every kLogSeconds when the stage has changed, every kQuietLogSeconds when it has not, and
-/// nothing for a command done within kLogSeconds.
+/// every 5 s (MFR_PROGRESS_SECONDS) when the stage has changed, every 30 s (six times that) when
+/// it has not, and nothing for a command done within the first 5 s.
 class Progress {
  public:
-  static constexpr double kLogSeconds = 5.0;
-  static constexpr double kQuietLogSeconds = 30.0;
   explicit Progress(bool enabled);
   ~Progress();
   void set(const std::string& stage, int done = -1, int total = -1);
@@ -109,6 +107,7 @@ class Progress {
   void loop();
   bool enabled_;
   bool terminal_;
+  double logSeconds_ = 5.0;
   std::atomic<bool> stop_{false};
   std::mutex mutex_;
   std::string stage_;

@@ -82,10 +82,10 @@ def cli_error(run_cli):
 
 
 def without_times(value):
-    """A results/stats JSON value without its timing entries (time_ms, total_ms, time_*_ms)."""
+    """A results/stats JSON value without its timing entries (time_ms, total_ms*, time_*_ms)."""
     if isinstance(value, dict):
         return {k: without_times(v) for k, v in value.items()
-                if not (k == "time_ms" or k == "total_ms" or (k.startswith("time_") and
+                if not (k == "time_ms" or k.startswith("total_ms") or (k.startswith("time_") and
                                                                   k.endswith("_ms")))}
     if isinstance(value, list):
         return [without_times(v) for v in value]

@@ -36,7 +36,7 @@ BAD_VALUES = {
 
 # the public classes that are not functions: their methods and settable properties are swept
 # ("Model", "Scene") or they take no arguments from the caller (results, the error, a record)
-CLASSES = {"Model", "Scene", "RenderResult", "Error", "Dataset"}
+CLASSES = {"Model", "Scene", "RenderResult", "Error", "Dataset", "CompareResults"}
 
 
 def valid_calls(work):

@@ -33,7 +33,7 @@ def folders(tmp_path_factory, cli):
 def csv_without_times(path):
     rows = list(csv.reader(io.StringIO(path.read_text())))
     keep = [i for i, name in enumerate(rows[0]) if not (name.startswith("time_") or
-                                                         name == "total_ms")]
+                                                         name.startswith("total_ms"))]
     return [[row[i] for i in keep] for row in rows]
 
 
@@ -42,8 +42,9 @@ def test_same_files_and_images(folders):
     files = sorted(os.listdir(cli))
     assert files == sorted(os.listdir(py))
     pngs = [f for f in files if f.endswith(".png")]
-    # ground truth, its depth complexity, per run image + flip + k-map, + importance (vkb, dkb)
-    assert len(pngs) == 2 + len(BUDGETS) * (3 * len(METHODS) + 2)
+    # ground truth, its depth complexity, per run image + flip + k-map, + importance (vkb, dkb),
+    # each method under both compositing rules (the default)
+    assert len(pngs) == 2 + len(BUDGETS) * 2 * (3 * len(METHODS) + 2)
     for name in pngs:
         assert (cli / name).read_bytes() == (py / name).read_bytes(), name
     assert {"results.json", "results.csv", "report.html"} <= set(files)
@@ -59,7 +60,7 @@ def test_same_results(folders):
     assert csv_without_times(cli / "results.csv") == csv_without_times(py / "results.csv")
     report = html.unescape((py / "report.html").read_text())
     assert "mfr.compare('procedural:bottles?count=3'" in report
-    assert "fkb_40KB.png" in report
+    assert "fkb-kbuffer_40KB.png" in report and "fkb-hybrid_40KB.png" in report
 
 
 def test_metrics_recomputed_from_the_files(folders):
@@ -97,7 +98,7 @@ def test_compare_errors(tmp_path):
 def test_an_old_folder_is_replaced_whole_and_another_never(tmp_path):
     out = tmp_path / "out"
     mfr.compare(SCENE, out, "40KB", methods=["fkb", "vkb"], width=16, height=16)
-    assert (out / "vkb_40KB.png").exists()
+    assert (out / "vkb-kbuffer_40KB.png").exists()
     # a failing compare (here its ground truth does not fit) leaves the old folder as it was
     before = {p.name: p.read_bytes() for p in out.iterdir()}
     with pytest.raises(mfr.Error, match="memory limit"):
@@ -106,7 +107,7 @@ def test_an_old_folder_is_replaced_whole_and_another_never(tmp_path):
     # a complete one replaces it whole, as `mfr compare` does: no file of the old one is left
     mfr.compare(SCENE, out, "40KB", methods=["fkb"], width=24, height=24)
     assert read_json(out / "results.json")["width"] == 24
-    assert not (out / "vkb_40KB.png").exists()
+    assert not (out / "vkb-kbuffer_40KB.png").exists()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]  # no staging folder left
     # a folder holding files a comparison does not write is never replaced
     (tmp_path / "mine").mkdir()
@@ -131,9 +132,10 @@ def test_relative_budgets_match_the_cli(tmp_path, cli):
     budgets = ["40KB", "60%"]
     subprocess.run([cli, "compare", SCENE, "--width", str(SIZE), "--height", str(SIZE),
                     "--budget", ",".join(budgets), "--methods", "vkb,kplus-dynamic",
-                    "--threads", "2", "--out", str(tmp_path / "cli"), "--quiet"], check=True)
+                    "--composite", "kbuffer", "--threads", "2", "--out", str(tmp_path / "cli"),
+                    "--quiet"], check=True)
     py = mfr.compare(SCENE, tmp_path / "py", budgets, methods=["vkb", "kplus-dynamic"],
-                     width=SIZE, height=SIZE, threads=2)
+                     width=SIZE, height=SIZE, threads=2, composite="kbuffer")
     cli_json = read_json(tmp_path / "cli" / "results.json")
     assert without_times(cli_json) == without_times(py)
     share = py["budgets"][1]
@@ -195,3 +197,75 @@ def test_sample_counts_as_the_cli_runs_them(tmp_path, cli):
     with pytest.raises(mfr.Error, match=r"^sample_counts '3': expected 1, 2, 4 or 8$"):
         mfr.compare(SCENE, tmp_path / "x", "80KB", methods=["kplus-heap"], width=SIZE,
                     height=SIZE, sample_counts=[1, 3])
+
+
+def test_the_request_is_checked_as_the_cli_checks_it(tmp_path):
+    # one CompareRequest for both faces: the same checks, the option spelled the Python way
+    kwargs = dict(width=SIZE, height=SIZE, methods=["fkb"])
+    with pytest.raises(mfr.Error, match=r"^repeat 0: must be in \[1, 1000\]"):
+        mfr.compare(SCENE, tmp_path / "a", "40KB", repeat=0, **kwargs)
+    with pytest.raises(mfr.Error, match=r"^warmup -1: must be in \[0, 1000\]"):
+        mfr.compare(SCENE, tmp_path / "a", "40KB", warmup=-1, **kwargs)
+    with pytest.raises(mfr.Error, match=r"^composite: rule 'hybrid' listed twice"):
+        mfr.compare(SCENE, tmp_path / "a", "40KB", composite=["hybrid", "hybrid"], **kwargs)
+    with pytest.raises(mfr.Error, match=r"^max_peels: none of the methods peels"):
+        mfr.compare(SCENE, tmp_path / "a", "40KB", max_peels=2, **kwargs)
+    with pytest.raises(mfr.Error, match=r"^max_peels: must be in \[1, "):
+        mfr.compare(SCENE, tmp_path / "a", "40KB", max_peels=0, methods=["peel"], width=SIZE,
+                    height=SIZE)
+    with pytest.raises(mfr.Error, match=r"^truth_engine: .*'vulkanish'"):
+        mfr.compare(SCENE, tmp_path / "a", "40KB", truth_engine="vulkanish", **kwargs)
+    with pytest.raises(mfr.Error, match=r"^budgets auto: picks every budget"):
+        mfr.compare(SCENE, tmp_path / "a", ["auto", "40KB"], **kwargs)
+    assert not (tmp_path / "a").exists()
+
+
+def test_max_peels_rules_repeats_and_the_table(tmp_path):
+    r = mfr.compare(SCENE, tmp_path / "p", "200KB", methods=["peel", "fkb"], width=SIZE,
+                    height=SIZE, max_peels=1, composite="kbuffer,hybrid", repeat=2, warmup=0)
+    runs = r["methods"]
+    # bounded peeling takes both rules: dropped beyond the pass, or blended into a tail
+    assert [m["label"] for m in runs] == ["peel-kbuffer", "peel-hybrid", "fkb-kbuffer",
+                                          "fkb-hybrid"]
+    assert runs[0]["fragments_lost"] > 0 and runs[0]["peel_passes"] == 1
+    assert runs[1]["flip_mean"] < runs[0]["flip_mean"]  # the tail keeps what the pass dropped
+    for m in runs:
+        assert m["repeats"] == 2
+        assert m["total_ms_min"] <= m["total_ms"] <= m["total_ms_max"]
+    assert r["repeat"] == 2 and r["warmup"] == 0
+    rows = r.rows()
+    assert [row["label"] for row in rows] == ["abuffer"] + [m["label"] for m in runs]
+    assert rows[1]["budget_label"] == "200KB" and rows[0]["budget_label"] == ""
+    table = r.table()
+    try:
+        import pandas
+    except ImportError:
+        assert table == rows
+    else:
+        assert isinstance(table, pandas.DataFrame)
+        assert list(table["label"]) == [row["label"] for row in rows]
+        assert table.loc[1, "flip_mean"] == runs[0]["flip_mean"]
+
+
+def test_auto_budgets_run_from_the_smallest_minimum_to_the_abuffer(tmp_path, run_cli):
+    r = mfr.compare(SCENE, tmp_path / "auto", "auto", methods=["fkb", "kplus-dynamic"],
+                    width=SIZE, height=SIZE, composite="kbuffer", repeat=1, warmup=0)
+    assert r["budgets_auto"] is True
+    sizes = [b["budget_bytes"] for b in r["budgets"]]
+    assert len(sizes) >= 2 and sizes == sorted(sizes) and len(set(sizes)) == len(sizes)
+    info = run_cli("info", SCENE, "--width", str(SIZE), "--height", str(SIZE), "--methods",
+                   "fkb,kplus-dynamic", "--composite", "kbuffer", "--json")
+    import json
+    table = json.loads(info.stdout)
+    views = table["views"] if "views" in table else [table]
+    budgets = views[0]["budgets"]
+    assert [b["budget_label"] for b in r["budgets"]] == budgets["auto_budgets"]
+    minimums = {m["method"]: m["minimum_bytes"] for m in budgets["methods"]}
+    smallest = min(minimums, key=minimums.get)
+    assert minimums[smallest] <= sizes[0] < 2 * minimums[smallest]
+    assert budgets["abuffer_bytes"] <= sizes[-1] < 2 * budgets["abuffer_bytes"]
+    # the method of the smallest minimum runs at the first budget, every method at the last
+    first = {m["name"]: m for m in r["budgets"][0]["methods"]}
+    assert "error" not in first[smallest], first[smallest]
+    for m in r["budgets"][-1]["methods"]:
+        assert "error" not in m, m

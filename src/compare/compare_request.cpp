@@ -40,7 +40,7 @@ Result<std::vector<std::string>> methodList(const CompareRequest& r, Spelling sp
 }
 
 Result<void> budgetList(const CompareRequest& r, Spelling spelling, CompareOptions& options) {
-  const std::string flag = spell(spelling, "--budget");
+  const std::string flag = spelling == Spelling::Cli ? "--budget" : "budgets";
   if (r.budgets.size() == 1 && r.budgets[0] == "auto") {
     options.autoBudgets = true;
     return {};
