@@ -214,9 +214,10 @@ struct ReportInfo {
   std::string generated;    // optional date/time text
 };
 
-/// The self-contained HTML page (inline CSS, inline SVG plots, no scripts) that shows the results
-/// table, the images next to it (referenced by their relative file names) and, with several
-/// budgets, error vs budget plots.
+/// The HTML page (inline CSS, inline SVG plots, one small inline script for sortable tables and
+/// image wipers, no external resources; the images are the PNG files beside it): the
+/// recommendation per budget, the Pareto fronts, the results tables, the worst regions and, with
+/// several budgets, error vs budget plots.
 std::string compareReportHtml(const CompareResult& result, const ReportInfo& info);
 
 }  // namespace mfr
