@@ -62,5 +62,13 @@ foreach(file IN LISTS MFR_PYTHON_PACKAGE_FILES)
   configure_file("${file}" "${MFR_PYTHON_BUILD_DIR}/${name}" COPYONLY)
 endforeach()
 
+# which interpreter the extension is for: `import mfr` under another says so (python/mfr)
+set(MFR_PYTHON_BUILT_FOR "${MFR_PYTHON_BUILD_DIR}/_built_for.py")
+file(WRITE "${MFR_PYTHON_BUILT_FOR}"
+     "# written by cmake/mfr_python.cmake: the Python the extension module _mfr was built for\n"
+     "INTERPRETER = \"${Python3_EXECUTABLE}\"\n"
+     "VERSION = \"${Python3_VERSION_MAJOR}.${Python3_VERSION_MINOR}\"\n")
+
 install(TARGETS mfr_python LIBRARY DESTINATION "${MFR_PYTHON_INSTALL_DIR}/mfr")
-install(FILES ${MFR_PYTHON_PACKAGE_FILES} DESTINATION "${MFR_PYTHON_INSTALL_DIR}/mfr")
+install(FILES ${MFR_PYTHON_PACKAGE_FILES} "${MFR_PYTHON_BUILT_FOR}"
+        DESTINATION "${MFR_PYTHON_INSTALL_DIR}/mfr")

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -320,8 +321,9 @@ TEST_F(CompareLibrary, HtmlReportIsSelfContainedAndShowsEverything) {
   // and every method's error against the bytes per pixel it was charged
   EXPECT_NE(html.find("Mean FLIP vs bytes per pixel"), std::string::npos);
   EXPECT_NE(html.find("bytes per pixel charged"), std::string::npos);
-  // the failure is on the page
+  // the failure is on the page, and the plots' legend names the method's minimum
   EXPECT_NE(html.find("abuffer at 200KB: needs at least"), std::string::npos);
+  EXPECT_NE(html.find("abuffer (needs &#8805; "), std::string::npos);
 }
 
 TEST(CompareOptionsCheck, BadOptionsAreErrorsNamingTheInput) {
@@ -372,6 +374,13 @@ TEST(CompareOptionsCheck, RepeatedRunsReportTheMedianAndTheSpread) {
   EXPECT_EQ(j["warmup"], 1);
   EXPECT_EQ(j["methods"][0]["repeats"], 3);
   EXPECT_EQ(j["methods"][0]["total_ms_max"], r->budgets[0].runs[0].timing.maxMs);
+  // the report's time cell: the median, the range beside it
+  const std::string html = compareReportHtml(r.value(), ReportInfo{});
+  const RunTiming& t = r->budgets[0].runs[0].timing;
+  char cell[96];
+  std::snprintf(cell, sizeof cell, "%.1f<small> %.1f&ndash;%.1f</small>", t.medianMs, t.minMs,
+                t.maxMs);
+  EXPECT_NE(html.find(cell), std::string::npos) << cell;
   o.repeat = 0;  // the library refuses what the request check would
   EXPECT_FALSE(runComparison(engine(), *view, o).ok());
 }

@@ -34,7 +34,7 @@ namespace fs = std::filesystem;
 
 struct CompareArgs {
   SceneOptions scene;
-  std::string budgets;
+  std::string budgets = "auto";
   std::string methods = kDefaultCompareMethods;
   std::string model;
   std::string out;
@@ -134,7 +134,7 @@ void printSummary(const CompareResult& r) {
 
 // --orbit N (no --orbit-view): every frame's comparison in DIR/frame_NNN, and the temporal
 // stability of each method along the path (mfr/compare/temporal.hpp) in DIR/results.json,
-// DIR/report.html and one plot per budget.
+// DIR/results.csv and DIR/report.html (its plots inline).
 int runTemporal(const CompareArgs& a, CompareOptions options, const std::string& version,
                 Engine& engine, const PreparedScene& prepared, Progress& progress,
                 OutputFolder& outFolder) {
@@ -164,15 +164,14 @@ int runTemporal(const CompareArgs& a, CompareOptions options, const std::string&
   if (!a.scene.quiet) {
     std::fprintf(stderr, "%s, %d frames %.3g degrees apart; ground truth flicker %.4f\n",
                  echoPath(a.scene.source).c_str(), frames, step, t.groundTruthFlicker);
-    // flip: the mean over the frames of each frame's mean FLIP against its ground truth
+    // flip: the mean over the frames of each frame's mean FLIP against its ground truth (NaN
+    // where a frame failed)
     std::fprintf(stderr, "  %-22s %8s %8s %9s %9s %12s\n", "method", "budget", "flip", "flicker",
                  "excess", "error change");
-    for (const TemporalSeries& s : t.series) {
-      double flip = 0.0;
-      for (const double f : s.errorFlip) flip += f / static_cast<double>(s.errorFlip.size());
+    for (const TemporalSeries& s : t.series)
       std::fprintf(stderr, "  %-22s %8s %8.4f %9.4f %9.4f %12.4f\n", s.method.c_str(),
-                   s.budgetLabel.c_str(), flip, s.flicker, s.excessFlicker, s.meanErrorChange);
-    }
+                   s.budgetLabel.c_str(), s.meanFlip, s.flicker, s.excessFlicker,
+                   s.meanErrorChange);
     std::fprintf(stderr, "report: %s\n",
                  echoPath((fs::path(a.out) / "report.html").string()).c_str());
   }
@@ -293,8 +292,7 @@ Runner addCompareCommand(CLI::App& app) {
                   "Memory budgets, comma-separated, e.g. 20MB,40MB (MB = 2^20 bytes) or 25%,50% "
                   "(each method's per-pixel words + that share of the exact A-buffer's node "
                   "bytes); lists may mix both; auto: log-spaced from the listed methods' "
-                  "smallest budget to the exact A-buffer's (mfr info --methods)")
-      ->required();
+                  "smallest budget to the exact A-buffer's (mfr info --methods; the default)");
   cmd->add_option("--methods,-m", args->methods,
                   "Methods, comma-separated (default " + args->methods + "). " + presetHelp());
   cmd->add_option("--out,-o", args->out, "Output folder (created if missing)")->required();

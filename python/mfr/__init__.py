@@ -34,7 +34,21 @@ from typing import Any, Iterable, Sequence
 
 import numpy as np
 
-from . import _mfr
+try:
+    from . import _mfr
+except ImportError as _error:  # most often: another Python than the one it was built for
+    import sys as _sys
+    try:
+        from ._built_for import INTERPRETER as _BUILT_FOR, VERSION as _BUILT_VERSION
+    except ImportError:
+        raise _error from None
+    _running = f"{_sys.version_info[0]}.{_sys.version_info[1]}"
+    if _running == _BUILT_VERSION:
+        raise
+    raise ImportError(f"mfr: the extension module was built for Python {_BUILT_VERSION} "
+                      f"({_BUILT_FOR}), not this Python {_running} ({_sys.executable}): run "
+                      f"{_BUILT_FOR}, or rebuild with -DPython3_EXECUTABLE={_sys.executable}"
+                      ) from None
 from ._mfr import (  # noqa: F401  (re-exported)
     DKB_LAYERS,
     FEATURE_COUNT,
@@ -306,7 +320,7 @@ def render(scene, *, method="abuffer", budget=None, k=None, width=1024, height=1
                        sample_storage=sample_storage)
 
 
-def compare(scene, out, budgets, *, methods: Sequence[str] = DEFAULT_COMPARE_METHODS, width=1024,
+def compare(scene, out, budgets="auto", *, methods: Sequence[str] = DEFAULT_COMPARE_METHODS, width=1024,
             height=1024, camera=None, view=None, orbit=0, orbit_view=None, orbit_step=0.0,
             zoom=1.0,
             composite=None, capture="tile", threads=0, seed=1, model=None, ppd=FLIP_DEFAULT_PPD,

@@ -537,7 +537,10 @@ std::string legendSvg(const Frame& f, const std::vector<Series>& series, bool fr
           "stroke-width=\"2\"/>",
           lx, ly, lx + 22, ly, s.colour.c_str());
     svg += markerSvg(s.marker, lx + 11, ly, s.colour);
-    const std::string note = s.points.empty() ? " (failed)" : exact ? " (exact)" : "";
+    const std::string note = !s.note.empty()    ? " (" + s.note + ")"
+                             : s.points.empty() ? " (failed)"
+                             : exact            ? " (exact)"
+                                                : "";
     svg += format("<text x=\"%.1f\" y=\"%.1f\" font-size=\"11\">%s</text>", lx + 28, ly + 4,
                   (escape(s.name) + note).c_str());
     ly += 20;

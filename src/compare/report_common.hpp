@@ -39,6 +39,9 @@ struct Series {
   std::vector<std::string> labels;                // per point, a tooltip (optional)
   std::vector<bool> onFront;  // per point (optional): ringed, class "point front"
   bool line = true;           // false: markers only (a scatter)
+  /// Said after the name in the legend (e.g. "needs >= 1.25 MiB" for a method refused at some
+  /// budgets); empty: "(failed)" without points, "(exact)" for an error of 0 everywhere.
+  std::string note;
 };
 
 struct Ticks {

@@ -90,7 +90,7 @@ const char* kResultsHeader =
     "<th>MSE<span class=\"unit\">sRGB</span></th>"
     "<th>PSNR<span class=\"unit\">sRGB, dB</span></th>"
     "<th>FLIP<span class=\"unit\">mean</span></th>"
-    "<th>Time<span class=\"unit\">total, ms</span></th>"
+    "<th>Time<span class=\"unit\">total, ms: median (min&ndash;max)</span></th>"
     "<th>Passes<span class=\"unit\">ms</span></th>"
     "</tr></thead><tbody>";
 
@@ -111,7 +111,11 @@ std::string groundTruthRow(const CompareRun& gt) {
          "</td><td>" + format("%u&ndash;%u", s.kMin, s.kMax) + "</td><td>" + grouped(s.captured) +
          "</td><td>" + format("%.2f", s.lostPercent()) +
          "</td><td>0</td><td>&infin;</td><td>0</td><td>&infin;</td><td>0</td><td>" +
-         format("%.1f", s.totalMs()) + "</td><td class=\"passes\">" + passesText(s) + "</td></tr>";
+         format("%.1f", s.totalMs()) +
+         (gt.timing.repeats > 1
+              ? format("<small> %.1f&ndash;%.1f</small>", gt.timing.minMs, gt.timing.maxMs)
+              : std::string()) +
+         "</td><td class=\"passes\">" + passesText(s) + "</td></tr>";
 }
 
 // the method cell: name, compositing, the oracle's bound and the report's tags
@@ -121,7 +125,8 @@ std::string methodCell(const CompareRun& run, bool winner, bool fixed) {
   if (fixed) t += "<span class=\"tag fixed\">fixed memory</span>";
   if (run.ok() && run.stats.oracle) {
     const OracleReport& o = *run.stats.oracle;
-    t += o.exact ? std::string("<small>oracle: proven minimum</small>")
+    t += o.exact ? "<small>oracle: proven minimum under " + std::string(toString(run.compositing)) +
+                       "</small>"
                  : "<small>oracle: error &le; lower bound " + sci(o.lowerBound) + " + gap " +
                        sci(o.gap()) + "</small>";
   }
@@ -148,7 +153,12 @@ std::string runRow(const CompareRun& run, const Best& best, bool winner, bool fi
   t += numberCell(m.mseSrgb, sci(m.mseSrgb), cls(m.psnrSrgb == best.psnr));
   t += numberCell(m.psnrSrgb, psnrText(m.psnrSrgb), cls(m.psnrSrgb == best.psnr));
   t += numberCell(m.flipMean, format("%.4f", m.flipMean), cls(m.flipMean == best.flip));
-  t += numberCell(s.totalMs(), format("%.1f", s.totalMs()));
+  // the median of --repeat timed renders, their range beside it
+  t += numberCell(s.totalMs(),
+                  format("%.1f", s.totalMs()) + (run.timing.repeats > 1
+                                                     ? format("<small> %.1f&ndash;%.1f</small>",
+                                                              run.timing.minMs, run.timing.maxMs)
+                                                     : std::string()));
   return t + "<td class=\"passes\">" + passesText(s) + "</td></tr>";
 }
 
@@ -359,9 +369,16 @@ std::vector<Series> seriesOverBudgets(const CompareResult& r,
     s.name = methodNames[m];
     s.colour = paletteColour(m);
     s.marker = static_cast<int>(m);
-    for (const CompareBudget& cb : r.budgets)
-      if (cb.runs[m].ok())
-        s.points.emplace_back(static_cast<double>(cb.budgetBytes), value(cb.runs[m]));
+    std::optional<uint64_t> minimum;  // refused somewhere: the method's smallest budget
+    for (const CompareBudget& cb : r.budgets) {
+      const CompareRun& run = cb.runs[m];
+      if (run.ok())
+        s.points.emplace_back(static_cast<double>(cb.budgetBytes), value(run));
+      else if (run.minimumBytes)
+        minimum = std::min(minimum.value_or(*run.minimumBytes), *run.minimumBytes);
+    }
+    if (minimum)
+      s.note = (s.points.empty() ? "failed; needs &#8805; " : "needs &#8805; ") + mib(*minimum);
     out.push_back(std::move(s));
   }
   return out;
