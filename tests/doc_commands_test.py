@@ -6,7 +6,9 @@ lines that run mfr (`mfr`, `build/mfr`, `./build/mfr`, after optional VAR=value 
 simple `python3` snippet, joins `\\` continuations, and runs each one with bash in a scratch copy
 of the checkout (build/mfr and build/python there point at the build under test; ../shared is
 the checkout's ../shared where one exists). The blocks run in order (README.md, then docs/ by
-name) in one scratch folder, so a command may read what an earlier one wrote. A command fails
+name) in one scratch folder whose out/ is emptied before each doc, so a command may read what an
+earlier one of its doc wrote; a command that already ran is not run again, its outputs copied in
+(`mkdir` lines run too). A command fails
 when it exits non-zero or times out, when a compare prints a failed run, or when it leaves a
 file outside out/. Markers (docs/DOC_TESTS.md) in an HTML comment on the lines just above a block:
 
@@ -269,14 +271,27 @@ def stated_size_checks(cmd, helpinfo, mfr):
     return checks
 
 
+def out_files(folder):
+    """{path under out/: (size, mtime)} of the files of FOLDER/out."""
+    found, top = {}, os.path.join(folder, "out")
+    for base, _, files in os.walk(top):
+        for name in files:
+            path = os.path.join(base, name)
+            st = os.lstat(path)
+            found[os.path.relpath(path, top)] = (st.st_size, st.st_mtime_ns)
+    return found
+
+
 def snapshot(folder):
-    found = set()
+    """{path: (size, mtime)} of every file of FOLDER outside out/ (and the shared link)."""
+    found = {}
     for base, dirs, files in os.walk(folder):
         rel = os.path.relpath(base, folder)
         if rel == ".":
             dirs[:] = [d for d in dirs if d not in ("out", "shared")]
         for name in files + [d for d in dirs if os.path.islink(os.path.join(base, d))]:
-            found.add(os.path.normpath(os.path.join(rel, name)))
+            st = os.lstat(os.path.join(base, name))
+            found[os.path.normpath(os.path.join(rel, name))] = (st.st_size, st.st_mtime_ns)
     return found
 
 
@@ -313,7 +328,7 @@ def main():
     have_shared = os.path.isdir(shared)
     if have_shared:
         os.symlink(shared, os.path.join(tmp, "shared"))
-    env = dict(os.environ)
+    env = dict(os.environ, PYTHONDONTWRITEBYTECODE="1")
     env["PATH"] = os.path.join(work, "build") + os.pathsep + env.get("PATH", "")
     if args.python:
         os.makedirs(os.path.join(tmp, "bin"))
@@ -332,10 +347,12 @@ def main():
         return gl_state
 
     ran = failed = skipped = 0
-    failures, seen = [], {}
+    failures, seen = [], {}  # seen: script -> (file:line, {path under out/: copy of it})
+    cache = os.path.join(tmp, "outputs")
     started = time.time()
     for doc in docs:
         rel = os.path.relpath(doc, root)
+        shutil.rmtree(os.path.join(work, "out"), ignore_errors=True)  # each doc starts afresh
         for block in read_blocks(doc):
             marker_opts = []
             if block.marker is not None:
@@ -359,6 +376,9 @@ def main():
                 where = f"{rel}:{n}"
                 is_mfr = words[k] in MFR_WORDS
                 is_python = words[k] in ("python3", "python")
+                if words[k] == "mkdir":  # mkdir -p out: run, not counted
+                    subprocess.run(["bash", "-c", " ".join(words)], cwd=work, env=env, check=False)
+                    continue
                 if not (is_mfr or is_python):
                     continue  # make, cmake, scripts/...: not run here
                 if "..." in words:
@@ -401,10 +421,13 @@ def main():
                     for check, _, _ in checks:
                         print(f"check {where}: {check}")
                     continue
-                if script in seen:
-                    print(f"same  {where}: as {seen[script]}")
+                if script in seen:  # its outputs copied in: what a later command of the doc reads
+                    first, outputs = seen[script]
+                    for path, copy in outputs.items():
+                        os.makedirs(os.path.dirname(os.path.join(work, "out", path)), exist_ok=True)
+                        shutil.copy2(copy, os.path.join(work, "out", path))
+                    print(f"same  {where}: as {first}")
                     continue
-                seen[script] = where
                 problems = []
                 for check, budgets, rule in checks:
                     p = subprocess.run(["bash", "-c", "\n".join(prelude + [check])], capture_output=True,
@@ -421,7 +444,7 @@ def main():
                                         f"at the stated size, {method['method']}"
                                         f"{' (' + rule + ')' if rule else ''} needs at least "
                                         f"{method['minimum_bytes']} B: budget {spelled} is too small")
-                before = snapshot(work)
+                before, out_before = snapshot(work), out_files(work)
                 t0 = time.time()
                 try:
                     p = subprocess.run(["bash", "-c", script], capture_output=True, text=True, cwd=work, env=env,
@@ -434,7 +457,14 @@ def main():
                     problems.append(f"exit {rc}: {err.strip() or out.strip()[-2000:]}")
                 if is_mfr and cmd.sub == "compare":
                     problems += [f"a run failed: {l.strip()}" for l in out.split("\n") if " failed: " in l]
-                outside = sorted(snapshot(work) - before)
+                outputs = {}
+                for path, state in out_files(work).items():
+                    if out_before.get(path) != state:
+                        outputs[path] = os.path.join(cache, str(len(seen)), path)
+                        os.makedirs(os.path.dirname(outputs[path]), exist_ok=True)
+                        shutil.copy2(os.path.join(work, "out", path), outputs[path])
+                seen[script] = (where, outputs)
+                outside = sorted(p for p, state in snapshot(work).items() if before.get(p) != state)
                 if outside:
                     problems.append("wrote outside out/: " + ", ".join(outside[:8]))
                 ran += 1
