@@ -166,12 +166,16 @@ TEST_F(AtomicWrite, KeepsPermissionsAndWritesSpecialFilesInPlace) {
   // /dev/null is written to, not replaced by a regular file
   ASSERT_TRUE(mfr::writeFileAtomically("/dev/null", "discarded").ok());
   EXPECT_TRUE(fs::is_character_file("/dev/null"));
-  // errors name the path
-  auto missing = mfr::writeFileAtomically(path("no_such_folder/x.json"), "{}");
-  ASSERT_FALSE(missing.ok());
-  EXPECT_NE(missing.error().message.find("no_such_folder/x.json: cannot open for writing"),
+  // a missing folder is made, as for every output
+  ASSERT_TRUE(mfr::writeFileAtomically(path("new_folder/deeper/x.json"), "{}").ok());
+  EXPECT_EQ(readAll(path("new_folder/deeper/x.json")), "{}");
+  // errors name the path: a regular file where a folder should be
+  ASSERT_TRUE(mfr::writeFileAtomically(path("a_file"), "x").ok());
+  auto blocked = mfr::writeFileAtomically(path("a_file/x.json"), "{}");
+  ASSERT_FALSE(blocked.ok());
+  EXPECT_NE(blocked.error().message.find("a_file/x.json: cannot open for writing"),
             std::string::npos)
-      << missing.error().message;
+      << blocked.error().message;
   auto folder = mfr::writeFileAtomically(dir().string(), "x");
   ASSERT_FALSE(folder.ok());
   EXPECT_NE(folder.error().message.find("is a directory"), std::string::npos);

@@ -83,6 +83,33 @@ const char* kOrbitScene = "'procedural:hairball?strands=150'";
 const std::string kOrbitCommon = std::string("render ") + kOrbitScene +
                                  " --width 32 --height 32 --method abuffer --threads 2 -q ";
 
+// Every output makes its missing folder, as the images always did: the statistics, a dataset,
+// a model and its log (not only -o of render), so no run writes one file and fails on the next.
+TEST(CliOptions, EveryOutputMakesItsMissingFolder) {
+  const fs::path dir = tempDir() / "made";
+  fs::remove_all(dir);
+  const std::string d = dir.string();
+  auto r = runCli("render procedural:layers --width 16 --height 16 -q -o " + d +
+                  "/a/x.png --stats-json " + d + "/b/s.json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(dir / "a" / "x.png"));
+  EXPECT_TRUE(fs::is_regular_file(dir / "b" / "s.json"));
+  r = runCli("dataset procedural:layers --width 16 --height 16 --budget-steps 1 -q -o " + d +
+             "/c/x.mfrds");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  r = runCli("train " + d + "/c/x.mfrds --epochs 1 -q -o " + d + "/d/m.mfrnn --log " + d +
+             "/e/log.csv");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_TRUE(fs::is_regular_file(dir / "d" / "m.mfrnn"));
+  EXPECT_TRUE(fs::is_regular_file(dir / "e" / "log.csv"));
+  // a file where the folder should be is still one line naming the path
+  r = runCli("render procedural:layers --width 16 --height 16 -q -o " + d + "/f.png --stats-json " +
+             d + "/a/x.png/s.json");
+  EXPECT_EQ(r.exitCode, 1);
+  EXPECT_NE(r.err.find("a/x.png/s.json: cannot open for writing"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}
+
 TEST(CliOptions, OrbitWritesNSuffixedViewsThatDiffer) {
   const fs::path dir = tempDir() / "orbit";
   fs::create_directories(dir);

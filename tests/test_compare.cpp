@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli_runner.hpp"
+#include "error_assertions.hpp"
 #include "mfr/compare/compare.hpp"
 #include "mfr/core/image.hpp"
 #include "mfr/cpu/cpu_engine.hpp"
@@ -785,6 +786,30 @@ TEST(CompareCliErrors, BadInputIsOneLineNamingIt) {
   std::ofstream(file) << "x";
   const std::string dir = (file / "sub").string();
   expectCleanFailure(scene + " --budget 200KB --out " + dir, dir);
+}
+
+// A comparison where nothing ran exits 1 (a study's loop sees it), after writing the folder of
+// refusals; its last line names the smallest budget that runs.
+TEST(CompareCliErrors, NothingRanIsAnErrorAfterTheFolderIsWritten) {
+  const fs::path out = tempDir() / "nothing ran";
+  fs::remove_all(out);
+  const CompareCliRun r = runCli("compare " + sceneArgs() +
+                                 " --budget 8KB,16KB --methods fkb,kplus-dynamic --composite "
+                                 "kbuffer --repeat 1 --warmup 0 --out '" +
+                                 out.string() + "'");
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  const size_t last = r.err.rfind("mfr: error: ");
+  ASSERT_NE(last, std::string::npos) << r.err;
+  const std::string line = r.err.substr(last);
+  EXPECT_EQ(std::count(line.begin(), line.end(), '\n'), 1) << r.err;
+  EXPECT_TRUE(test::contains(line,
+                             "no run succeeded: every method was refused at every budget (the "
+                             "smallest budget that runs: fkb at "))
+      << line;
+  EXPECT_TRUE(test::contains(line, "the refusals are in ")) << line;
+  const nlohmann::json j = nlohmann::json::parse(std::ifstream(out / "results.json"));
+  EXPECT_EQ(j["budgets"][1]["methods"][0]["minimum_bytes"], kSize * kSize * 12);
+  fs::remove_all(out);
 }
 
 // Without a terminal (a log, CI), a long comparison still says what it does: plain progress

@@ -774,10 +774,12 @@ TEST(ModelFile, ReportsUnreadableAndUnwritablePaths) {
   ASSERT_FALSE(read.ok());
   EXPECT_TRUE(contains(read.error().message, "directory")) << read.error().message;
 
-  const std::string noFolder = tempPath("no_such_folder/model.mfrnn");
-  Result<void> written = writeModel(noFolder, smallModel());
+  // a missing folder is made (every output does so); a file where the folder should be fails
+  ASSERT_TRUE(writeModel(tempPath("new_folder/model.mfrnn"), smallModel()).ok());
+  const std::string blocked = tempPath("new_folder/model.mfrnn/model.mfrnn");
+  Result<void> written = writeModel(blocked, smallModel());
   ASSERT_FALSE(written.ok());
-  EXPECT_TRUE(contains(written.error().message, noFolder) &&
+  EXPECT_TRUE(contains(written.error().message, blocked) &&
               contains(written.error().message, "cannot open"))
       << written.error().message;
 

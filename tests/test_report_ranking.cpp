@@ -166,6 +166,14 @@ TEST(ReportRanking, FixedMemoryMethodsFromTheirBytes) {
   EXPECT_EQ(fixedMemoryMethods(r), std::vector<std::string>{"wboit"});
   r.budgets[0].runs[2] = run("mboit", 0.05, 9, 800);
   EXPECT_EQ(fixedMemoryMethods(r), (std::vector<std::string>{"wboit", "mboit"}));
+  // an exact k-buffer that used the same bytes at both budgets: its node pool (F(M)) grew with
+  // the budget, so the budget does move it
+  CompareRun exactSmall = run("kplus-dynamic", 0.0, 5, 500), exactLarge = exactSmall;
+  exactSmall.budgetSlots = 100;
+  exactLarge.budgetSlots = 400;
+  r.budgets[0].runs.push_back(exactSmall);
+  r.budgets[1].runs.push_back(exactLarge);
+  EXPECT_EQ(fixedMemoryMethods(r), (std::vector<std::string>{"wboit", "mboit"}));
   r.budgets.pop_back();  // one budget: nothing to say
   EXPECT_TRUE(fixedMemoryMethods(r).empty());
 }

@@ -99,6 +99,11 @@ std::string psnrCell(double psnr) {
   return buffer;
 }
 
+// the rule column: kbuffer or hybrid; "own" for the methods with a rule of their own (wboit, ...)
+const char* ruleName(const CompareRun& run) {
+  return kBufferFamilyRule(run.compositing) ? toString(run.compositing) : "own";
+}
+
 void printSummary(const CompareResult& r) {
   std::fprintf(stderr, "%s %dx%d, ground truth (%s engine): %llu fragments, %s, %.1f ms\n",
                echoPath(r.scene).c_str(), r.width, r.height, r.truthEngine.c_str(),
@@ -116,8 +121,8 @@ void printSummary(const CompareResult& r) {
   for (const CompareBudget& cb : r.budgets)
     for (const CompareRun& run : cb.runs) {
       if (!run.ok()) {
-        std::fprintf(stderr, "  %-22s %-7s %8s  failed: %s\n", run.label.c_str(),
-                     toString(run.compositing), cb.label.c_str(), run.error->c_str());
+        std::fprintf(stderr, "  %-22s %-7s %8s  failed: %s\n", run.label.c_str(), ruleName(run),
+                     cb.label.c_str(), run.error->c_str());
         continue;
       }
       const RenderStats& s = run.stats;
@@ -125,7 +130,7 @@ void printSummary(const CompareResult& r) {
       std::snprintf(k, sizeof k, "%u-%u", s.kMin, s.kMax);
       std::snprintf(range, sizeof range, "%.1f-%.1f", run.timing.minMs, run.timing.maxMs);
       std::fprintf(stderr, "  %-22s %-7s %8s %11s %9s %7.2f %10.3e %9s %10s %8.4f %9.1f %s\n",
-                   run.label.c_str(), toString(run.compositing), cb.label.c_str(),
+                   run.label.c_str(), ruleName(run), cb.label.c_str(),
                    formatBytes(s.bytesUsed).c_str(), k, s.lostPercent(), run.metrics.mseLinear,
                    psnrCell(run.metrics.psnrLinear).c_str(), psnrCell(run.metrics.psnrSrgb).c_str(),
                    run.metrics.flipMean, s.totalMs(), range);
@@ -276,6 +281,9 @@ int run(const CompareArgs& a, const std::string& version) {
     std::fprintf(stderr, "report: %s\n", echoPath((dir / "report.html").string()).c_str());
   }
   if (a.scene.json) std::fputs(jsonText.c_str(), stdout);
+  if (auto ran = checkSomeRunRan(r); !ran)
+    return fail(echoPath(a.scene.source) + ": " + ran.error().message + "; the refusals are in " +
+                echoPath(a.out));
   return 0;
 }
 

@@ -9,6 +9,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "mfr/compare/compare_request.hpp"
 #include "mfr/core/json_limits.hpp"
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
@@ -29,45 +30,18 @@ struct InfoArgs {
   std::string capture = "tile";        // --capture tile|parallel
 };
 
-// "a, b" -> {"a", "b"}; empty items kept (to be refused)
-std::vector<std::string> splitList(const std::string& text) {
-  std::vector<std::string> items;
-  std::string item;
-  std::istringstream in(text);
-  while (std::getline(in, item, ',')) {
-    const size_t b = item.find_first_not_of(" \t"), e = item.find_last_not_of(" \t");
-    items.push_back(b == std::string::npos ? std::string() : item.substr(b, e - b + 1));
-  }
-  if (!text.empty() && text.back() == ',') items.emplace_back();
-  return items;
-}
-
-// --methods as compare takes it (its presets, --composite on the k-buffer family's rules), or all
-Result<std::vector<MethodDesc>> budgetMethods(const InfoArgs& a) {
-  std::vector<std::string> names = *a.methods == "all" ? presetNames() : splitList(*a.methods);
-  if (names.empty()) return makeError("--methods: the method list is empty");
-  std::optional<Compositing> compositing;
-  if (!a.composite.empty()) {
-    auto rule = parseCompositing(a.composite);
-    if (!rule) return makeError("--composite: " + rule.error().message);
-    compositing = rule.value();
-  }
-  std::vector<MethodDesc> methods;
-  for (const std::string& name : names) {
-    if (name.empty())
-      return makeError("--methods " + quoteInput(*a.methods) + ": empty method name in the list");
-    auto preset = methodPreset(name);
-    if (!preset) return makeError("--methods: " + preset.error().message);
-    for (const MethodDesc& seen : methods)
-      if (seen.name == name)
-        return makeError("--methods: method " + quoteInput(name) + " listed twice");
-    MethodDesc m = std::move(preset.value());
-    if (compositing && kBufferFamilyRule(m.compositing)) m.compositing = *compositing;
-    if (peelingRule(m.compositing)) m.peelTail = compositing == Compositing::Hybrid;
-    m.importance.seed = a.scene.seed;
-    methods.push_back(std::move(m));
-  }
-  return methods;
+// --methods as compare takes it (compare_request.hpp: its presets, each under the rules of
+// --composite, default both, labelled as compare's runs), or all; the rows' method is the label
+Result<std::vector<ComparedMethod>> listedMethods(const InfoArgs& a) {
+  CompareRequest request;
+  request.methods = *a.methods == "all" ? presetNames() : splitCommaList(*a.methods);
+  request.budgets = {"auto"};
+  if (!a.composite.empty()) request.rules = splitCommaList(a.composite);
+  request.capture = a.capture;
+  request.seed = a.scene.seed;
+  auto options = checkCompareRequest(request);
+  if (!options) return options.error();
+  return comparedMethods(options.value());
 }
 
 std::string bytesCell(const std::optional<uint64_t>& bytes) {
@@ -130,11 +104,15 @@ void printBudgets(const nlohmann::json& b) {
 int run(const InfoArgs& a) {
   const SceneOptions& o = a.scene;
   std::vector<MethodDesc> methods;
+  std::vector<std::string> labels;  // as compare labels the runs
   RenderOptions budgetOptions;
   if (a.methods) {
-    auto listed = budgetMethods(a);
+    auto listed = listedMethods(a);
     if (!listed) return fail(listed.error().message);
-    methods = std::move(listed.value());
+    for (ComparedMethod& m : listed.value()) {
+      methods.push_back(std::move(m.desc));
+      labels.push_back(std::move(m.label));
+    }
     auto capture = parseCaptureOption(a.capture);
     if (!capture) return fail(capture.error().message);
     budgetOptions.capture = capture.value();
@@ -202,6 +180,7 @@ int run(const InfoArgs& a) {
       progress.set("budgets", static_cast<int>(v), static_cast<int>(prepared->cameras.size()));
       auto budgets = sceneBudgets(**engine, **view, methods, budgetOptions);
       if (!budgets) return fail(echoPath(o.source) + ": " + budgets.error().message);
+      for (size_t i = 0; i < labels.size(); ++i) budgets->methods[i].method = labels[i];
       views.back()["budgets"] = budgetsJson(budgets.value());
     }
   }
@@ -286,8 +265,9 @@ Runner addInfoCommand(CLI::App& app) {
                   "budget, the budget at which it keeps every fragment, its fixed memory. " +
                       presetHelp());
   cmd->add_option("--composite", args->composite,
-                  "With --methods: the k-buffer family's compositing rule, kbuffer or hybrid (as "
-                  "compare's; default: each preset's own)");
+                  "With --methods: the compositing rules, kbuffer, hybrid or both, as compare "
+                  "runs them (default both: the methods that take a rule get a row per rule, "
+                  "labelled as compare's runs, fkb-kbuffer, fkb-hybrid)");
   cmd->add_option("--capture", args->capture,
                   "With --methods: tile (default) or parallel, whose per-pixel lock words count");
   return [args] { return run(*args); };

@@ -179,11 +179,12 @@ int runTrain(TrainArgs& a) {
                                    : curve ? kDkbCurveLayers
                                            : learn::kDkbLayers;
   learn::Mlp net = learn::makeMlp(layers, o.seed);
-  // the log is written (atomically, like every output) when training ends; its folder is checked
-  // now so that a bad --log fails before the training, not after it
+  // the log is written (atomically, like every output, its folder made if missing) when
+  // training ends; a path whose folder cannot be made fails now, not after the training
   const std::filesystem::path logFolder = std::filesystem::path(a.log).parent_path();
-  if (std::error_code ec; !std::filesystem::is_directory(logFolder.empty() ? "." : logFolder, ec))
-    return fail("--log " + echoPath(a.log) + ": cannot open for writing (no such folder)");
+  if (std::error_code ec; !logFolder.empty() && !std::filesystem::is_directory(logFolder, ec) &&
+                          !std::filesystem::create_directories(logFolder, ec))
+    return fail("--log " + echoPath(a.log) + ": cannot create its folder (" + ec.message() + ")");
   std::ostringstream log;
   log << "epoch,train_mse,validation_mse,seconds\n";
   Progress progress(!a.quiet);

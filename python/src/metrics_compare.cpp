@@ -253,8 +253,13 @@ py::object compare(const py::object& sceneArg, const py::object& outArg, const p
           !counted)
         throw named(counted.error());
       jsonText = unwrap(writeComparison(result.value(), folder.staging(), MFR_VERSION, info));
+      unwrap(folder.commit());
+      // the folder holds the refusals; a comparison where nothing ran is still an error
+      if (auto ran = checkSomeRunRan(result.value()); !ran)
+        throw LibraryError(echoPath(scene.source) + ": " + ran.error().message +
+                           "; the refusals are in " + echoPath(out));
     }
-    unwrap(folder.commit());
+    if (temporal) unwrap(folder.commit());
   }
   return py::module_::import("json").attr("loads")(jsonText);
 }

@@ -90,9 +90,19 @@ def test_compare_errors(tmp_path):
                                         r"abuffer at 16384 x 16384 pixels: its per-pixel buffers"):
         mfr.compare("procedural:hairball", tmp_path / "c", "40KB", methods=["fkb"], width=16384,
                     height=16384, memory_limit="1GB")
-    # a budget too small for a method is recorded, not raised
-    r = mfr.compare(SCENE, tmp_path / "b", "2KB", methods=["fkb"], **kwargs)
-    assert "error" in r["methods"][0]
+    # a budget too small for a method is recorded, not raised, with the method's minimum
+    r = mfr.compare(SCENE, tmp_path / "b", ["2KB", "80KB"], methods=["fkb"], composite="kbuffer",
+                    **kwargs)
+    assert r["methods"][0]["error"].startswith("fkb at 2KB: needs at least ")
+    assert r["methods"][0]["minimum_bytes"] == SIZE * SIZE * 12
+    assert "error" not in r["budgets"][1]["methods"][0]
+    # but a comparison where nothing ran raises, once its folder holds the refusals
+    with pytest.raises(mfr.Error, match=r"no run succeeded: every method was refused at every "
+                                        r"budget \(the smallest budget that runs: fkb-kbuffer at "
+                                        r"12.00 KiB; mfr info --methods lists them all\); the "
+                                        r"refusals are in "):
+        mfr.compare(SCENE, tmp_path / "c", "2KB", methods=["fkb"], **kwargs)
+    assert read_json(tmp_path / "c" / "results.json")["methods"][1]["label"] == "fkb-hybrid"
 
 
 def test_an_old_folder_is_replaced_whole_and_another_never(tmp_path):
@@ -263,7 +273,8 @@ def test_auto_budgets_run_from_the_smallest_minimum_to_the_abuffer(tmp_path, run
     minimums = {m["method"]: m["minimum_bytes"] for m in budgets["methods"]}
     smallest = min(minimums, key=minimums.get)
     assert minimums[smallest] <= sizes[0] < 2 * minimums[smallest]
-    assert budgets["abuffer_bytes"] <= sizes[-1] < 2 * budgets["abuffer_bytes"]
+    top = max(budgets["abuffer_bytes"], max(minimums.values()))
+    assert top <= sizes[-1] < 2 * top
     # the method of the smallest minimum runs at the first budget, every method at the last
     first = {m["name"]: m for m in r["budgets"][0]["methods"]}
     assert "error" not in first[smallest], first[smallest]

@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "mfr/core/colormap.hpp"
+#include "mfr/core/units.hpp"
 #include "mfr/engine/scene_budgets.hpp"
 #include "mfr/method/dkb_model.hpp"
 #include "mfr/method/memory_model.hpp"
@@ -152,12 +153,6 @@ Result<ComparedView> prepareComparedView(Engine& engine, const View& view,
 
 namespace {
 
-// One run of a comparison's method list: the preset under one compositing rule.
-struct ComparedMethod {
-  MethodDesc desc;
-  std::string label;  // CompareRun::label
-};
-
 // The rules `m` runs under: every one of `options.rules` for the k-buffer family (those its user
 // model was trained for, with modelPicksRules) and for depth peeling bounded by --max-peels (its
 // hybrid form blends what remains into a tail); its own rule otherwise.
@@ -178,6 +173,8 @@ std::vector<Compositing> methodRules(const MethodDesc& m, const CompareOptions& 
   }
   return rules;
 }
+
+}  // namespace
 
 // The presets named in --methods, each under the comparison's rules, with its seed and model.
 Result<std::vector<ComparedMethod>> comparedMethods(const CompareOptions& options) {
@@ -203,6 +200,8 @@ Result<std::vector<ComparedMethod>> comparedMethods(const CompareOptions& option
   }
   return methods;
 }
+
+namespace {
 
 // Every budget above zero and listed once.
 Result<void> checkBudgetList(const std::vector<BudgetSpec>& budgets) {
@@ -494,6 +493,24 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   colourKMaps(kMaps, w, h, result);
   if (options.progress) options.progress("done", progress.total, progress.total);
   return result;
+}
+
+Result<void> checkSomeRunRan(const CompareResult& result) {
+  const CompareRun* smallest = nullptr;  // the failed run of the smallest known minimum
+  for (const CompareBudget& cb : result.budgets)
+    for (const CompareRun& run : cb.runs) {
+      if (run.ok()) return {};
+      if (run.minimumBytes && (!smallest || *run.minimumBytes < *smallest->minimumBytes))
+        smallest = &run;
+    }
+  if (result.budgets.empty() || result.budgets[0].runs.empty()) return {};
+  std::string message = "no run succeeded: every method was refused at every budget";
+  if (smallest)
+    message += " (the smallest budget that runs: " + smallest->label + " at " +
+               formatBytes(*smallest->minimumBytes) + "; mfr info --methods lists them all)";
+  else
+    message += " (" + *result.budgets[0].runs[0].error + ")";
+  return makeError(message);
 }
 
 std::vector<BudgetSpec> budgetSpecs(const CompareResult& result) {

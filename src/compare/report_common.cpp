@@ -584,10 +584,13 @@ std::string svgPlot(const PlotSpec& spec, const std::vector<Series>& series) {
   f.x1 = f.W - right;
   f.y0 = f.H - 52;
   f.y1 = 34;
+  // the legend beside the plot: 20 px an entry, the picture as tall as it needs (many methods)
+  const size_t entries = series.size() + (spec.front.empty() ? 0 : 1);
+  const double height = std::max(f.H, std::ceil(f.y1 + 8 + 20.0 * static_cast<double>(entries)));
   std::string svg = format(
       "<svg xmlns=\"http://www.w3.org/2000/svg\" viewBox=\"0 0 %.0f %.0f\" width=\"%.0f\" "
       "height=\"%.0f\" role=\"img\" aria-label=\"%s\" font-family=\"inherit\" font-size=\"12\">",
-      f.W, f.H, f.W, f.H, escape(spec.title).c_str());
+      f.W, height, f.W, height, escape(spec.title).c_str());
   svg += format(
       "<text x=\"%.1f\" y=\"20\" text-anchor=\"middle\" font-size=\"14\" "
       "font-weight=\"600\">%s</text>",

@@ -266,9 +266,18 @@ std::string setupSection(const CompareResult& r, const ReportInfo& info,
     h += format(", depth complexity max %u, mean %.2f", *gs.maxDepthComplexity,
                 gs.meanDepthComplexity.value_or(0.0));
   h += ", " + escape(formatBytes(gs.bytesUsed)) + format(", %.1f&#8201;ms", gs.totalMs()) +
-       "</td></tr>\n";
+       "; rendered on the " + escape(r.truthEngine.empty() ? r.engine : r.truthEngine) + " engine" +
+       (r.truthNote.empty() ? "" : " (" + escape(r.truthNote) + ")") + "</td></tr>\n";
   h += "<tr><th>Software</th><td>" + escape(info.mfrVersion.empty() ? "mfr" : info.mfrVersion) +
-       " (CPU reference engine)</td></tr>\n";
+       ", the " + escape(r.engine) + " engine" +
+       (r.engine == "cpu" ? std::string(" (the CPU reference engine)") : std::string()) +
+       "</td></tr>\n";
+  h += "<tr><th>Timing</th><td>" +
+       format(
+           "%d timed render%s per run after %d untimed; the tables show the median total and "
+           "the range",
+           r.repeat, r.repeat == 1 ? "" : "s", r.warmup) +
+       "</td></tr>\n";
   if (!info.generated.empty())
     h += "<tr><th>Generated</th><td>" + escape(info.generated) + "</td></tr>\n";
   h += "<tr><th>Command</th><td><pre class=\"cmd\">" + escape(info.commandLine) +
@@ -287,18 +296,19 @@ std::string setupSection(const CompareResult& r, const ReportInfo& info,
 std::string resultsSection(const CompareResult& r, int section) {
   std::string h;
   h += format("<h2 id=\"results\">%d&ensp;Results</h2>\n", section);
-  h +=
-      "<p class=\"caption\">Error of each method against the ground truth (lower MSE and FLIP, "
-      "higher PSNR are better; the best value of each budget is in bold). MSE and PSNR are over "
-      "R, G, B of the 8-bit images as written, on decoded linear-light values (<em>linear</em>) "
-      "or on the sRGB code values / 255 (<em>sRGB</em>); PSNR has peak 1. FLIP is the mean "
-      "LDR-FLIP error" +
-      format(" at %.1f pixels per degree. ", r.flipPixelsPerDegree) +
-      "F(M) = &lfloor;(M &minus; |P|&middot;S<sub>p</sub> &minus; S<sub>i</sub>) / 8&rfloor; is "
-      "the number of 8-byte fragment nodes the budget buys after the method's per-pixel "
-      "(S<sub>p</sub>) "
-      "and per-image (S<sub>i</sub>) overhead; utilisation is captured fragments / F(M). Times "
-      "are wall-clock milliseconds of the CPU engine. Click a column's header to sort by it.</p>\n";
+  h += "<p class=\"caption\">Error of each method against the ground truth (lower MSE and FLIP, "
+       "higher PSNR are better; the best value of each budget is in bold). MSE and PSNR are over "
+       "R, G, B of the 8-bit images as written, on decoded linear-light values (<em>linear</em>) "
+       "or on the sRGB code values / 255 (<em>sRGB</em>); PSNR has peak 1. FLIP is the mean "
+       "LDR-FLIP error" +
+       format(" at %.1f pixels per degree. ", r.flipPixelsPerDegree) +
+       "F(M) = &lfloor;(M &minus; |P|&middot;S<sub>p</sub> &minus; S<sub>i</sub>) / 8&rfloor; is "
+       "the number of 8-byte fragment nodes the budget buys after the method's per-pixel "
+       "(S<sub>p</sub>) "
+       "and per-image (S<sub>i</sub>) overhead; utilisation is captured fragments / F(M). Times "
+       "are milliseconds of the " +
+       escape(r.engine) + " engine (the median of " + std::to_string(r.repeat) +
+       " timed renders, their range beside it). Click a column's header to sort by it.</p>\n";
   for (const CompareBudget& cb : r.budgets) {
     h += "<h3>M = " + budgetTitle(cb) + "</h3>\n";
     h += resultsTable(r, cb) + "\n";

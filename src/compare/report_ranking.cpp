@@ -162,7 +162,10 @@ std::vector<std::string> fixedMemoryMethods(const CompareResult& result) {
     for (const CompareBudget& cb : result.budgets) {
       if (m >= cb.runs.size() || !cb.runs[m].ok()) continue;
       if (!first) first = &cb.runs[m];
-      same = same && cb.runs[m].stats.bytesUsed == first->stats.bytesUsed;
+      // the same bytes and the same F(M): an exact k-buffer that used less than a growing
+      // budget is not fixed, its node pool grew with the budget
+      same = same && cb.runs[m].stats.bytesUsed == first->stats.bytesUsed &&
+             cb.runs[m].budgetSlots == first->budgetSlots;
       ++ran;
     }
     if (ran >= 2 && same) fixed.push_back(first->label);

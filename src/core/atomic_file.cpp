@@ -163,6 +163,8 @@ Result<void> writeFileAtomically(const std::string& path, std::string_view bytes
   if (path.empty()) return makeError("cannot write a file with an empty name");
   fs::path dir = fs::path(path).parent_path();
   if (dir.empty()) dir = ".";
+  // a missing folder is made, for every output alike (a file in its way fails the open below)
+  if (std::error_code ec; !fs::is_directory(dir, ec)) fs::create_directories(dir, ec);
   std::optional<mode_t> mode;  // an existing file keeps its permissions
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0) {

@@ -69,9 +69,6 @@ Result<void> writePng(const std::string& path, const Image8& image) {
   if (!stbi_write_png_to_func(append, &encoded, image.width, image.height, 4, image.rgba.data(),
                               image.width * 4))
     return makeError(what + ": cannot encode PNG");
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  std::error_code ec;
-  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   auto written = writeFileAtomically(path, encoded);
   if (!written) {  // "PATH: cannot open for writing (...)" -> "PATH: cannot write PNG (...)"
     std::string reason = written.error().message;
@@ -97,9 +94,6 @@ Result<void> writePfm(const std::string& path, const ImageRGB& image) {
         std::memcpy(out, &word, 4);
       }
   }
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  std::error_code ec;
-  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   auto written = writeFileAtomically(path, bytes);
   if (!written) {
     std::string reason = written.error().message;

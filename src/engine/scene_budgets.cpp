@@ -366,15 +366,17 @@ Result<MethodBudget> methodBudget(Engine& engine, const PreparedView& view,
 std::vector<BudgetSpec> autoBudgets(const SceneBudgets& budgets, int count) {
   count = std::max(count, 2);
   std::optional<uint64_t> lo, loAll;
+  uint64_t hi = 0;  // the largest minimum: at the last budget every method runs
   for (const MethodBudget& row : budgets.methods) {
     if (!row.minimumBytes) continue;
     loAll = std::min(loAll.value_or(UINT64_MAX), *row.minimumBytes);
+    hi = std::max(hi, *row.minimumBytes);
     if (!row.fixedBytes) lo = std::min(lo.value_or(UINT64_MAX), *row.minimumBytes);
   }
   if (!lo) lo = loAll;
   if (!lo) return {};
   const uint64_t from = std::max<uint64_t>(*lo, 1);
-  const uint64_t to = std::max(from, budgets.abufferBytes);
+  const uint64_t to = std::max({from, budgets.abufferBytes, hi});
   // up to a multiple of an eighth of the leading power of two (at least 1 KiB): never below the
   // value, so the smallest budget stays at or above the smallest minimum
   const auto tidy = [](uint64_t v) {

@@ -157,6 +157,21 @@ struct CompareResult {
   std::vector<SampleCountRuns> sampleCounts;
 };
 
+/// One run of a comparison's method list: a preset under one compositing rule.
+struct ComparedMethod {
+  MethodDesc desc;    // the preset with the rule, --max-peels, seed and model of the options
+  std::string label;  // CompareRun::label: the name, or "NAME-RULE" under several rules
+};
+
+/// options.methods, each under the rules it runs under (CompareOptions::rules), in the order of
+/// a budget's runs. Errors: an unknown or duplicated method.
+Result<std::vector<ComparedMethod>> comparedMethods(const CompareOptions& options);
+
+/// A comparison in which no method ran at any budget is an error for its caller (mfr compare
+/// exits 1, mfr.compare raises, once the folder with the refusals is written): one line naming
+/// the smallest budget that runs among the failed runs.
+Result<void> checkSomeRunRan(const CompareResult& result);
+
 /// The budgets `result` ran at, as specs (after --budget auto: the ones it picked).
 std::vector<BudgetSpec> budgetSpecs(const CompareResult& result);
 

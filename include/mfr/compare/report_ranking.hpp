@@ -75,7 +75,8 @@ int worstWindowSize(int width, int height);
 std::vector<float> flipValuesOfImage(const Image8& flipImage);
 
 /// Methods whose memory the budget does not move: the method succeeded at two budgets or more and
-/// used the same bytes at each (failed runs, e.g. a budget below its fixed need, do not count).
+/// used the same bytes with the same F(M) at each (failed runs, e.g. a budget below its fixed
+/// need, do not count; an exact k-buffer using less than a growing node pool is not fixed).
 /// In the methods' order (the first budget's runs).
 std::vector<std::string> fixedMemoryMethods(const CompareResult& result);
 

@@ -13,7 +13,7 @@
 
 namespace mfr {
 
-/// Writes `bytes` to `path` atomically (its folder must exist): the data goes to a temporary file
+/// Writes `bytes` to `path` atomically (its folder made if missing): the data goes to a temporary file
 /// in the same folder (an unnamed O_TMPFILE where the file system has them, so a
 /// killed process leaves nothing behind; otherwise ".NAME.tmp.PID.N.T", removed on failure; NAME
 /// cut to 128 bytes, so that any name the file system takes, up to NAME_MAX, can be written), is

@@ -26,7 +26,7 @@
 //              multisampled, as compare's ground truth).
 //
 // autoBudgets turns the table into `compare --budget auto`'s list: log-spaced from the smallest
-// minimum to the A-buffer's bytes.
+// minimum to the A-buffer's bytes or the largest minimum, whichever is larger.
 #pragma once
 
 #include <cstdint>
@@ -81,7 +81,9 @@ Result<MethodBudget> methodBudget(Engine& engine, const PreparedView& view,
 
 /// `compare --budget auto`: up to `count` (at least 2) absolute budgets, log-spaced from the
 /// smallest minimum among the methods whose memory depends on the budget (of all of them when
-/// none does) to the A-buffer's bytes (or that minimum, when the A-buffer is smaller), each
+/// none does) to the larger of the A-buffer's bytes and the largest minimum (so that every
+/// method runs at the last budget: on a real scene the exact A-buffer is often smaller than the
+/// accumulating methods' fixed memory), each
 /// rounded up to a tidy size (a multiple of an eighth of its leading power of two, at least
 /// 1 KiB), ascending and distinct. Empty when no method has a minimum.
 std::vector<BudgetSpec> autoBudgets(const SceneBudgets& budgets, int count = 5);
