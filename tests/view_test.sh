@@ -250,6 +250,11 @@ if command -v xdotool >/dev/null; then
   xdotool mousemove --window "$wid" 30 40 keydown ctrl click 1 keyup ctrl
   settle
   xdotool key --window "$wid" Escape
+  # Esc quits within a minute, or the session failed (rather than hanging until ctest's timeout)
+  for _ in $(seq 60); do kill -0 $pid 2>/dev/null || break; sleep 1; done
+  if kill -0 $pid 2>/dev/null; then
+    kill $pid; echo "FAIL: input session: Esc did not quit within 60 s"; cat input_err.txt; exit 1
+  fi
   rc=0; wait $pid || rc=$?
   [ "$rc" -eq 0 ] || { echo "FAIL: input session exit $rc"; cat input_err.txt; exit 1; }
   python3 - <<'PY'
