@@ -6,8 +6,6 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
-#include <set>
-#include <sstream>
 #include <utility>
 
 #include "commands.hpp"
@@ -22,10 +20,6 @@
 #include "mfr/core/quote.hpp"
 #include "mfr/core/units.hpp"
 #include "mfr/engine/render_views.hpp"
-#include "mfr/method/dkb_model.hpp"
-#include "mfr/method/make_method.hpp"
-#include "mfr/method/method_options.hpp"
-#include "mfr/method/peel.hpp"
 
 namespace mfr::cli {
 namespace {

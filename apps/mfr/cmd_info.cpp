@@ -3,7 +3,6 @@
 // (mfr/engine/scene_budgets.hpp).
 #include <cstdio>
 #include <memory>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -15,7 +14,6 @@
 #include "mfr/core/units.hpp"
 #include "mfr/engine/render_views.hpp"
 #include "mfr/engine/scene_budgets.hpp"
-#include "mfr/method/make_method.hpp"
 #include "mfr/method/memory_model.hpp"
 #include "mfr/method/pass_plan.hpp"
 #include "mfr/method/peel.hpp"
@@ -32,7 +30,7 @@ struct InfoArgs {
 
 // --methods as compare takes it (compare_request.hpp: its presets, each under the rules of
 // --composite, default both, labelled as compare's runs), or all; the rows' method is the label
-Result<std::vector<ComparedMethod>> listedMethods(const InfoArgs& a) {
+Result<std::vector<ComparedMethod>> listedMethods(const InfoArgs& a, CaptureMode& capture) {
   CompareRequest request;
   request.methods = *a.methods == "all" ? presetNames() : splitCommaList(*a.methods);
   request.budgets = {"auto"};
@@ -41,6 +39,7 @@ Result<std::vector<ComparedMethod>> listedMethods(const InfoArgs& a) {
   request.seed = a.scene.seed;
   auto options = checkCompareRequest(request);
   if (!options) return options.error();
+  capture = options->capture;
   return comparedMethods(options.value());
 }
 
@@ -107,15 +106,12 @@ int run(const InfoArgs& a) {
   std::vector<std::string> labels;  // as compare labels the runs
   RenderOptions budgetOptions;
   if (a.methods) {
-    auto listed = listedMethods(a);
+    auto listed = listedMethods(a, budgetOptions.capture);
     if (!listed) return fail(listed.error().message);
     for (ComparedMethod& m : listed.value()) {
       methods.push_back(std::move(m.desc));
       labels.push_back(std::move(m.label));
     }
-    auto capture = parseCaptureOption(a.capture);
-    if (!capture) return fail(capture.error().message);
-    budgetOptions.capture = capture.value();
     auto limit = o.memoryLimitBytes();
     if (!limit) return fail(limit.error().message);
     budgetOptions.memoryLimitBytes = limit.value();

@@ -374,22 +374,19 @@ void colourKMaps(const std::vector<std::vector<uint32_t>>& kMaps, int w, int h,
     }
 }
 
-// --budget auto: the budgets of the scene's table (scene_budgets.hpp) for the compared methods.
-Result<std::vector<BudgetSpec>> autoBudgetList(Engine& engine, const PreparedView& view,
-                                               const std::vector<ComparedMethod>& methods,
-                                               const RenderOptions& renderOptions) {
+// The scene's budget table (scene_budgets.hpp) of the compared methods, in their order.
+Result<SceneBudgets> budgetTable(Engine& engine, const PreparedView& view,
+                                 const std::vector<ComparedMethod>& methods,
+                                 const RenderOptions& renderOptions) {
   std::vector<MethodDesc> descs;
   for (const ComparedMethod& m : methods) descs.push_back(m.desc);
   auto table = sceneBudgets(engine, view, descs, renderOptions);
   if (!table) return makeError("--budget auto: " + table.error().message);
-  std::vector<BudgetSpec> budgets = autoBudgets(table.value());
-  if (budgets.empty())
-    return makeError("--budget auto: none of the methods runs at any budget on this frame");
-  return budgets;
+  return table;
 }
 
-// A run refused at its budget: the method's smallest budget on this frame (counted once per
-// run label), and the refusal naming it when the budget is below it.
+// A run refused at its budget: the method's smallest budget on this frame (`minimums`, counted
+// once per run label), and the refusal naming it when the budget is below it.
 void explainRefusal(const RunSetting& s, const ComparedMethod& method, const std::string& label,
                     std::map<std::string, std::optional<uint64_t>>& minimums, CompareRun& run) {
   auto found = minimums.find(method.label);
@@ -428,10 +425,17 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
   if (!options.previousNearestCosine.empty())
     renderOptions.previousNearestCosine = &options.previousNearestCosine;
   std::vector<BudgetSpec> budgets = options.budgets;
+  // each run label's smallest budget on this frame: from --budget auto's table, else counted on
+  // a label's first refusal (explainRefusal)
+  std::map<std::string, std::optional<uint64_t>> minimums;
   if (options.autoBudgets) {  // log-spaced from the smallest minimum to the A-buffer's bytes
-    auto picked = autoBudgetList(engine, view, *methods, renderOptions);
-    if (!picked) return picked.error();
-    budgets = std::move(picked.value());
+    auto table = budgetTable(engine, view, *methods, renderOptions);
+    if (!table) return table.error();
+    budgets = autoBudgets(table.value());
+    if (budgets.empty())
+      return makeError("--budget auto: none of the methods runs at any budget on this frame");
+    for (size_t i = 0; i < methods->size(); ++i)
+      minimums[(*methods)[i].label] = table->methods[i].minimumBytes;
   }
   if (budgets.empty()) return makeError("--budget: no budget given");
   MFR_TRY(checkBudgetList(budgets));
@@ -473,7 +477,6 @@ Result<CompareResult> runComparison(Engine& engine, const PreparedView& view,
 
   std::vector<std::vector<uint32_t>> kMaps;  // per run, colour-mapped at the end (shared scale)
   float kScale = 1.0f;
-  std::map<std::string, std::optional<uint64_t>> minimums;  // per run label, once it failed
   for (const BudgetSpec& spec : budgets) {
     CompareBudget& cb = result.budgets.emplace_back();
     cb.budgetBytes = spec.bytes ? *spec.bytes : relativeNodeBytes(spec.percent, counts);

@@ -13,14 +13,14 @@
 
 namespace mfr {
 
-/// Writes `bytes` to `path` atomically (its folder made if missing): the data goes to a temporary file
-/// in the same folder (an unnamed O_TMPFILE where the file system has them, so a
-/// killed process leaves nothing behind; otherwise ".NAME.tmp.PID.N.T", removed on failure; NAME
-/// cut to 128 bytes, so that any name the file system takes, up to NAME_MAX, can be written), is
-/// fsync'ed, and replaces `path` by rename (an existing file's permissions are kept). A special
-/// file (a terminal, /dev/stdout, a pipe) has nothing to replace and is written directly.
-/// Errors ("PATH: cannot open for writing (...)", "PATH: write error (...)") name `path`; on error
-/// `path` is untouched.
+/// Writes `bytes` to `path` atomically (its folder made if missing): the data goes to a temporary
+/// file in the same folder (an unnamed O_TMPFILE where the file system has them, so a killed
+/// process leaves nothing behind; otherwise ".NAME.tmp.PID.N.T", removed on failure; NAME cut to
+/// 128 bytes, so that any name the file system takes, up to NAME_MAX, can be written), is fsync'ed,
+/// and replaces `path` by rename (an existing file's permissions are kept). A special file (a
+/// terminal, /dev/stdout, a pipe) has nothing to replace and is written directly. Errors ("PATH:
+/// cannot open for writing (...)", "PATH: write error (...)") name `path`; on error `path` is
+/// untouched.
 Result<void> writeFileAtomically(const std::string& path, std::string_view bytes);
 
 /// fsync of a folder, so that renames in it are durable; best effort (errors are ignored).
